@@ -1,0 +1,1 @@
+"""Rigging methods, one per module; discovered at load time."""

@@ -1,0 +1,945 @@
+# cython: language_level=3
+"""Constrained Delaunay triangulation kernel (private; use ``rigger.cdt``).
+
+Incremental Delaunay insertion in Hilbert-curve order with Lawson flips, on a half-edge triangle structure closed by
+"ghost" triangles that share one vertex at infinity (so the convex hull grows without a super-triangle and without its
+precision problems). Constraint segments are then inserted one by one: the triangles the segment crosses are
+retriangulated by flipping the crossed edges (Sloan 1993) and Delaunay-ness is restored by Lawson flips that never
+cross a constraint. Crossing constraints are split at a new Steiner vertex; vertices lying on a segment split it.
+Every decision is made by the exact predicates of ``cdt_predicates.h``.
+
+Half-edge ``h`` is corner ``h % 3`` of triangle ``h // 3`` and runs from ``V[h]`` to ``V[nxt(h)]``; ``N[h]`` is its twin
+and ``C[h]`` how many input segments cover it (0: unconstrained).
+"""
+from libc.stdlib cimport malloc, realloc, free
+from libc.string cimport memset
+
+import numpy as np
+
+cdef extern from "cdt_predicates.h" nogil:
+    int rg_orient2d(double ax, double ay, double bx, double by, double cx, double cy)
+    int rg_incircle(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy)
+
+cdef enum:
+    GHOST = -1
+    ERR_NOMEM = -1
+    ERR_INTERNAL = -2
+    LOC_FACE = 0
+    LOC_EDGE = 1
+    LOC_VERTEX = 2
+
+
+cdef struct Mesh:
+    double *xy          # 2 doubles per vertex
+    int nv
+    int cap_v
+    int *V              # origin vertex of each half-edge (3 per triangle)
+    int *N              # twin half-edge
+    int *C              # constraint multiplicity
+    int nt
+    int cap_t
+    int *VT             # per vertex: one half-edge leaving it, -1 before insertion
+    int *stack          # half-edges waiting for a Lawson check
+    int sn
+    int scap
+    unsigned int rng
+    long long budget    # guard against any non-terminating loop: every step spends one unit
+
+
+cdef inline int nxt(int h) noexcept nogil:
+    return h - 2 if h % 3 == 2 else h + 1
+
+
+cdef inline int prv(int h) noexcept nogil:
+    return h + 2 if h % 3 == 0 else h - 1
+
+
+cdef inline int orient_v(Mesh *m, int a, int b, int c) noexcept nogil:
+    return rg_orient2d(m.xy[2 * a], m.xy[2 * a + 1], m.xy[2 * b], m.xy[2 * b + 1], m.xy[2 * c], m.xy[2 * c + 1])
+
+
+cdef inline int orient_p(Mesh *m, int a, int b, double px, double py) noexcept nogil:
+    return rg_orient2d(m.xy[2 * a], m.xy[2 * a + 1], m.xy[2 * b], m.xy[2 * b + 1], px, py)
+
+
+cdef inline int incircle_v(Mesh *m, int a, int b, int c, int d) noexcept nogil:
+    return rg_incircle(m.xy[2 * a], m.xy[2 * a + 1], m.xy[2 * b], m.xy[2 * b + 1],
+                       m.xy[2 * c], m.xy[2 * c + 1], m.xy[2 * d], m.xy[2 * d + 1])
+
+
+cdef inline int spend(Mesh *m) noexcept nogil:
+    m.budget -= 1
+    return m.budget < 0
+
+
+# ---------------------------------------------------------------------------------------------------- storage
+
+cdef int grow_ints(int **arr, int cap) noexcept nogil:
+    cdef int *p = <int *> realloc(arr[0], <size_t> cap * sizeof(int))
+    if p == NULL:
+        return ERR_NOMEM
+    arr[0] = p
+    return 0
+
+
+cdef int new_triangles(Mesh *m, int count) noexcept nogil:
+    """Index of the first of ``count`` fresh triangles, growing the arrays when full."""
+    cdef int cap
+    if m.nt + count > m.cap_t:
+        cap = m.cap_t + m.cap_t // 2 + count + 16
+        if grow_ints(&m.V, 3 * cap) or grow_ints(&m.N, 3 * cap) or grow_ints(&m.C, 3 * cap):
+            return ERR_NOMEM
+        m.cap_t = cap
+    m.nt += count
+    return m.nt - count
+
+
+cdef int new_vertex(Mesh *m, double x, double y) noexcept nogil:
+    cdef int cap
+    cdef double *p
+    if m.nv == m.cap_v:
+        cap = m.cap_v + m.cap_v // 2 + 16
+        p = <double *> realloc(m.xy, <size_t> cap * 2 * sizeof(double))
+        if p == NULL:
+            return ERR_NOMEM
+        m.xy = p
+        if grow_ints(&m.VT, cap):
+            return ERR_NOMEM
+        m.cap_v = cap
+    m.xy[2 * m.nv] = x
+    m.xy[2 * m.nv + 1] = y
+    m.VT[m.nv] = -1
+    m.nv += 1
+    return m.nv - 1
+
+
+cdef int push(Mesh *m, int h) noexcept nogil:
+    if m.sn == m.scap:
+        m.scap = 2 * m.scap + 16
+        if grow_ints(&m.stack, m.scap):
+            return ERR_NOMEM
+    m.stack[m.sn] = h
+    m.sn += 1
+    return 0
+
+
+cdef inline void link(Mesh *m, int h, int g, int c) noexcept nogil:
+    m.N[h] = g
+    m.N[g] = h
+    m.C[h] = c
+    m.C[g] = c
+
+
+cdef inline void set_tri(Mesh *m, int t, int a, int b, int c) noexcept nogil:
+    m.V[3 * t] = a
+    m.V[3 * t + 1] = b
+    m.V[3 * t + 2] = c
+    if a != GHOST:
+        m.VT[a] = 3 * t
+    if b != GHOST:
+        m.VT[b] = 3 * t + 1
+    if c != GHOST:
+        m.VT[c] = 3 * t + 2
+
+
+# ---------------------------------------------------------------------------------------------------- topology
+
+cdef int find_edge(Mesh *m, int u, int w) noexcept nogil:
+    """The half-edge u -> w, or -1. Turns around u through its fan (closed, thanks to the ghosts)."""
+    cdef int h = m.VT[u], start = h
+    if h < 0:
+        return -1
+    while True:
+        if m.V[nxt(h)] == w:
+            return h
+        h = m.N[prv(h)]
+        if h == start:
+            return -1
+
+
+cdef void flip(Mesh *m, int h) noexcept nogil:
+    """Replace edge a-b shared by (a, b, c) and (b, a, d) with c-d: triangles become (c, a, d) and (d, b, c)."""
+    cdef int o = m.N[h]
+    cdef int h1 = nxt(h), h2 = prv(h), o1 = nxt(o), o2 = prv(o)
+    cdef int a = m.V[h], b = m.V[h1], c = m.V[h2], d = m.V[o2]
+    cdef int x1 = m.N[h1], x2 = m.N[h2], y1 = m.N[o1], y2 = m.N[o2]
+    cdef int cx1 = m.C[h1], cx2 = m.C[h2], cy1 = m.C[o1], cy2 = m.C[o2]
+    m.V[h] = c
+    m.V[h1] = a
+    m.V[h2] = d
+    m.V[o] = d
+    m.V[o1] = b
+    m.V[o2] = c
+    link(m, h, x2, cx2)
+    link(m, h1, y1, cy1)
+    link(m, o, y2, cy2)
+    link(m, o1, x1, cx1)
+    link(m, h2, o2, 0)
+    if a != GHOST:
+        m.VT[a] = h1
+    if b != GHOST:
+        m.VT[b] = o1
+    if c != GHOST:
+        m.VT[c] = h
+    if d != GHOST:
+        m.VT[d] = o
+
+
+cdef int split_triangle(Mesh *m, int t, int p) noexcept nogil:
+    """Insert vertex p inside triangle t (possibly a ghost); queue the three edges opposite p."""
+    cdef int t1 = new_triangles(m, 2)
+    if t1 < 0:
+        return t1
+    cdef int t2 = t1 + 1, base = 3 * t
+    cdef int a = m.V[base], b = m.V[base + 1], c = m.V[base + 2]
+    cdef int n1 = m.N[base + 1], n2 = m.N[base + 2], c1 = m.C[base + 1], c2 = m.C[base + 2]
+    set_tri(m, t, a, b, p)
+    set_tri(m, t1, b, c, p)
+    set_tri(m, t2, c, a, p)
+    link(m, 3 * t1, n1, c1)
+    link(m, 3 * t2, n2, c2)
+    link(m, base + 1, 3 * t1 + 2, 0)
+    link(m, 3 * t1 + 1, 3 * t2 + 2, 0)
+    link(m, 3 * t2 + 1, base + 2, 0)
+    if push(m, base) or push(m, 3 * t1) or push(m, 3 * t2):
+        return ERR_NOMEM
+    return 0
+
+
+cdef int split_edge(Mesh *m, int h, int p) noexcept nogil:
+    """Insert vertex p on the open edge h = a -> b of (a, b, c) / (b, a, d); the four halves keep its constraint."""
+    cdef int t3 = new_triangles(m, 2)
+    if t3 < 0:
+        return t3
+    cdef int t4 = t3 + 1, o = m.N[h]
+    cdef int t1 = h // 3, t2 = o // 3
+    cdef int h1 = nxt(h), h2 = prv(h), o1 = nxt(o), o2 = prv(o)
+    cdef int a = m.V[h], b = m.V[h1], c = m.V[h2], d = m.V[o2]
+    cdef int x1 = m.N[h1], x2 = m.N[h2], y1 = m.N[o1], y2 = m.N[o2]
+    cdef int cx1 = m.C[h1], cx2 = m.C[h2], cy1 = m.C[o1], cy2 = m.C[o2], cc = m.C[h]
+    cdef int b1 = 3 * t1, b2 = 3 * t2, b3 = 3 * t3, b4 = 3 * t4
+    set_tri(m, t1, a, p, c)
+    set_tri(m, t3, p, b, c)
+    set_tri(m, t2, b, p, d)
+    set_tri(m, t4, p, a, d)
+    link(m, b1, b4, cc)
+    link(m, b3, b2, cc)
+    link(m, b1 + 1, b3 + 2, 0)
+    link(m, b2 + 1, b4 + 2, 0)
+    link(m, b1 + 2, x2, cx2)
+    link(m, b3 + 1, x1, cx1)
+    link(m, b2 + 2, y2, cy2)
+    link(m, b4 + 1, y1, cy1)
+    if push(m, b1 + 2) or push(m, b3 + 1) or push(m, b2 + 2) or push(m, b4 + 1):
+        return ERR_NOMEM
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------------- geometry
+
+cdef inline int ghost_corner(Mesh *m, int t) noexcept nogil:
+    if m.V[3 * t] == GHOST:
+        return 0
+    if m.V[3 * t + 1] == GHOST:
+        return 1
+    if m.V[3 * t + 2] == GHOST:
+        return 2
+    return -1
+
+
+cdef int collinear_position(Mesh *m, int u, int w, double px, double py) noexcept nogil:
+    """For p on the line u-w: -2 before u, -1 at u, 0 strictly between, 1 at w, 2 beyond w (exact comparisons)."""
+    cdef double ux = m.xy[2 * u], uy = m.xy[2 * u + 1], wx = m.xy[2 * w], wy = m.xy[2 * w + 1]
+    cdef double dx = wx - ux, dy = wy - uy, pu, pw, s
+    if (dx if dx > 0 else -dx) >= (dy if dy > 0 else -dy):
+        pu = px - ux
+        pw = px - wx
+        s = dx
+    else:
+        pu = py - uy
+        pw = py - wy
+        s = dy
+    if s < 0:
+        pu = -pu
+        pw = -pw
+    if pu < 0:
+        return -2
+    if pu == 0:
+        return -1
+    if pw < 0:
+        return 0
+    if pw == 0:
+        return 1
+    return 2
+
+
+cdef int in_conflict(Mesh *m, int o, int p) noexcept nogil:
+    """Does vertex p lie strictly inside the circumcircle of the triangle of half-edge o (a half-plane for ghosts)?"""
+    cdef int q0 = m.V[o], q1 = m.V[nxt(o)], q2 = m.V[prv(o)]
+    if q2 == GHOST:
+        return orient_v(m, q0, q1, p) > 0
+    if q0 == GHOST:
+        return orient_v(m, q1, q2, p) > 0
+    if q1 == GHOST:
+        return orient_v(m, q2, q0, p) > 0
+    return incircle_v(m, q0, q1, q2, p) > 0
+
+
+cdef int legalize(Mesh *m, int p) noexcept nogil:
+    """Lawson flips around the freshly inserted vertex p until every queued edge is (constrained) Delaunay."""
+    cdef int h, o
+    while m.sn > 0:
+        if spend(m):
+            return ERR_INTERNAL
+        m.sn -= 1
+        h = m.stack[m.sn]
+        o = m.N[h]
+        if m.C[h] or not in_conflict(m, o, p):
+            continue
+        flip(m, h)
+        # p is corner prv(h) of (p, a, d) and corner nxt(o) of (d, b, p): queue the edges facing it
+        if push(m, nxt(h)) or push(m, o):
+            return ERR_NOMEM
+    return 0
+
+
+cdef int locate(Mesh *m, double px, double py, int t, int *out) noexcept nogil:
+    """Walk from triangle t to the point; returns LOC_FACE (out: a half-edge of the triangle or ghost holding it),
+    LOC_EDGE (out: the half-edge whose open segment holds it) or LOC_VERTEX (out: a half-edge leaving that vertex)."""
+    cdef int g, h, k, o, pos, r, zeros, z0, z1
+    while True:
+        if spend(m):
+            return ERR_INTERNAL
+        g = ghost_corner(m, t)
+        if g >= 0:
+            h = 3 * t + (g + 1) % 3
+            o = orient_p(m, m.V[h], m.V[nxt(h)], px, py)
+            if o > 0:
+                out[0] = h
+                return LOC_FACE
+            if o < 0:
+                t = m.N[h] // 3
+                continue
+            pos = collinear_position(m, m.V[h], m.V[nxt(h)], px, py)
+            if pos == 0:
+                out[0] = h
+                return LOC_EDGE
+            if pos == -1:
+                out[0] = h
+                return LOC_VERTEX
+            if pos == 1:
+                out[0] = nxt(h)
+                return LOC_VERTEX
+            t = m.N[nxt(h)] // 3 if pos == 2 else m.N[prv(h)] // 3
+            continue
+        m.rng = m.rng * 1103515245u + 12345u
+        r = (m.rng >> 16) % 3
+        zeros = 0
+        z0 = z1 = -1
+        for k in range(3):
+            h = 3 * t + (r + k) % 3
+            o = orient_p(m, m.V[h], m.V[nxt(h)], px, py)
+            if o < 0:
+                break
+            if o == 0:
+                if zeros == 0:
+                    z0 = h
+                else:
+                    z1 = h
+                zeros += 1
+        else:
+            if zeros == 0:
+                out[0] = 3 * t
+                return LOC_FACE
+            if zeros == 1:
+                out[0] = z0
+                return LOC_EDGE
+            # two collinear edges meet at the vertex the point coincides with
+            out[0] = z1 if nxt(z0) == z1 else z0
+            return LOC_VERTEX
+        t = m.N[h] // 3
+
+
+cdef int insert_at(Mesh *m, int p, int loc, int h) noexcept nogil:
+    cdef int err = split_triangle(m, h // 3, p) if loc == LOC_FACE else split_edge(m, h, p)
+    if err:
+        return err
+    return legalize(m, p)
+
+
+# ---------------------------------------------------------------------------------------------------- Delaunay
+
+cdef void hilbert_order(const double *xy, int n, int *order, unsigned int *keys, unsigned int *tmp_keys,
+                        int *tmp_order) noexcept nogil:
+    """Sort point indices along a Hilbert curve over the bounding box (stable radix sort: duplicates keep index order)."""
+    cdef double x0 = xy[0], x1 = xy[0], y0 = xy[1], y1 = xy[1], sx, sy
+    cdef int i, pass_, shift
+    cdef unsigned int qx, qy, s, rx, ry, d, t
+    cdef int counts[2049]
+    for i in range(n):
+        if xy[2 * i] < x0:
+            x0 = xy[2 * i]
+        if xy[2 * i] > x1:
+            x1 = xy[2 * i]
+        if xy[2 * i + 1] < y0:
+            y0 = xy[2 * i + 1]
+        if xy[2 * i + 1] > y1:
+            y1 = xy[2 * i + 1]
+    sx = 65535.0 / (x1 - x0) if x1 > x0 else 0.0
+    sy = 65535.0 / (y1 - y0) if y1 > y0 else 0.0
+    for i in range(n):
+        qx = <unsigned int> ((xy[2 * i] - x0) * sx)
+        qy = <unsigned int> ((xy[2 * i + 1] - y0) * sy)
+        if qx > 65535:
+            qx = 65535
+        if qy > 65535:
+            qy = 65535
+        d = 0
+        s = 32768
+        while s > 0:
+            rx = 1 if (qx & s) else 0
+            ry = 1 if (qy & s) else 0
+            d += s * s * ((3 * rx) ^ ry)
+            if ry == 0:
+                if rx == 1:
+                    qx = 65535 - qx
+                    qy = 65535 - qy
+                t = qx
+                qx = qy
+                qy = t
+            s >>= 1
+        keys[i] = d
+        order[i] = i
+    for pass_ in range(3):
+        shift = 11 * pass_
+        memset(counts, 0, sizeof(counts))
+        for i in range(n):
+            counts[((keys[i] >> shift) & 0x7FF) + 1] += 1
+        for i in range(2048):
+            counts[i + 1] += counts[i]
+        for i in range(n):
+            d = (keys[i] >> shift) & 0x7FF
+            tmp_keys[counts[d]] = keys[i]
+            tmp_order[counts[d]] = order[i]
+            counts[d] += 1
+        for i in range(n):
+            keys[i] = tmp_keys[i]
+            order[i] = tmp_order[i]
+
+
+cdef int seed_triangle(Mesh *m, int a, int b, int c) noexcept nogil:
+    """The first real triangle (a, b, c), counter-clockwise, closed by three ghosts."""
+    cdef int t = new_triangles(m, 4)
+    if t < 0:
+        return t
+    set_tri(m, t, a, b, c)
+    set_tri(m, t + 1, b, a, GHOST)
+    set_tri(m, t + 2, c, b, GHOST)
+    set_tri(m, t + 3, a, c, GHOST)
+    link(m, 3 * t, 3 * (t + 1), 0)
+    link(m, 3 * t + 1, 3 * (t + 2), 0)
+    link(m, 3 * t + 2, 3 * (t + 3), 0)
+    link(m, 3 * (t + 1) + 1, 3 * (t + 3) + 2, 0)
+    link(m, 3 * (t + 1) + 2, 3 * (t + 2) + 1, 0)
+    link(m, 3 * (t + 2) + 2, 3 * (t + 3) + 1, 0)
+    return 0
+
+
+cdef int delaunay(Mesh *m, int n, const int *order, int *vmap) noexcept nogil:
+    """Insert points 0..n-1 in the given order. Returns 1 when they are all collinear (no triangle), 0 when done."""
+    cdef int i, k, p, a, b = -1, c = -1, loc, h, err, start = -1
+    a = order[0]
+    for k in range(1, n):
+        p = order[k]
+        if m.xy[2 * p] != m.xy[2 * a] or m.xy[2 * p + 1] != m.xy[2 * a + 1]:
+            b = p
+            break
+    if b < 0:
+        return 1
+    for k in range(1, n):
+        p = order[k]
+        if p != b and orient_v(m, a, b, p) != 0:
+            c = p
+            break
+    if c < 0:
+        return 1
+    err = seed_triangle(m, a, b, c) if orient_v(m, a, b, c) > 0 else seed_triangle(m, a, c, b)
+    if err:
+        return err
+    start = 0
+    for k in range(n):
+        p = order[k]
+        if p == a or p == b or p == c:
+            continue
+        loc = locate(m, m.xy[2 * p], m.xy[2 * p + 1], start, &h)
+        if loc < 0:
+            return loc
+        if loc == LOC_VERTEX:
+            vmap[p] = m.V[h]
+            continue
+        err = insert_at(m, p, loc, h)
+        if err:
+            return err
+        start = m.VT[p] // 3
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------------- constraints
+
+cdef struct Buffer:
+    int *data
+    int n
+    int cap
+
+
+cdef int buf_push2(Buffer *b, int x, int y) noexcept nogil:
+    if b.n + 2 > b.cap:
+        b.cap = 2 * b.cap + 64
+        if grow_ints(&b.data, b.cap):
+            return ERR_NOMEM
+    b.data[b.n] = x
+    b.data[b.n + 1] = y
+    b.n += 2
+    return 0
+
+
+cdef int restore_delaunay(Mesh *m, Buffer *pairs) noexcept nogil:
+    """Lawson flips over the listed edges (vertex pairs) and the edges they expose, never across a constraint."""
+    cdef int u, w, h, o, x, y
+    while pairs.n > 0:
+        if spend(m):
+            return ERR_INTERNAL
+        pairs.n -= 2
+        u = pairs.data[pairs.n]
+        w = pairs.data[pairs.n + 1]
+        h = find_edge(m, u, w)
+        if h < 0 or m.C[h]:
+            continue
+        o = m.N[h]
+        x = m.V[prv(h)]
+        y = m.V[prv(o)]
+        if x == GHOST or y == GHOST or incircle_v(m, u, w, x, y) <= 0:
+            continue
+        flip(m, h)
+        if buf_push2(pairs, x, u) or buf_push2(pairs, u, y) or buf_push2(pairs, y, w) or buf_push2(pairs, w, x):
+            return ERR_NOMEM
+    return 0
+
+
+cdef struct Work:
+    int *data      # triples (a, b, count) of segments still to insert
+    int n
+    int cap
+
+
+cdef int work_push(Work *w, int a, int b, int count) noexcept nogil:
+    if w.n + 3 > w.cap:
+        w.cap = 2 * w.cap + 48
+        if grow_ints(&w.data, w.cap):
+            return ERR_NOMEM
+    w.data[w.n] = a
+    w.data[w.n + 1] = b
+    w.data[w.n + 2] = count
+    w.n += 3
+    return 0
+
+
+cdef inline int same_direction(Mesh *m, int a, int b, int p) noexcept nogil:
+    """For p on the line a-b: does it lie on the ray from a through b (exact coordinate comparisons)?"""
+    cdef double dx = m.xy[2 * b] - m.xy[2 * a], dy = m.xy[2 * b + 1] - m.xy[2 * a + 1]
+    cdef double ex = m.xy[2 * p] - m.xy[2 * a], ey = m.xy[2 * p + 1] - m.xy[2 * a + 1]
+    if (dx if dx > 0 else -dx) >= (dy if dy > 0 else -dy):
+        return (dx > 0) == (ex > 0) and ex != 0
+    return (dy > 0) == (ey > 0) and ey != 0
+
+
+cdef int mark(Mesh *m, int h, int count) noexcept nogil:
+    m.C[h] += count
+    m.C[m.N[h]] += count
+    return 0
+
+
+cdef int split_constraint(Mesh *m, Work *w, Buffer *dirty, int h, int a, int b, int count) noexcept nogil:
+    """Segment a-b crosses the constrained edge h = p -> q: split both at a new vertex near their intersection."""
+    cdef int p = m.V[h], q = m.V[nxt(h)], k = m.C[h], loc, at, s, err
+    cdef double ax = m.xy[2 * a], ay = m.xy[2 * a + 1], bx = m.xy[2 * b], by = m.xy[2 * b + 1]
+    cdef double px = m.xy[2 * p], py = m.xy[2 * p + 1], qx = m.xy[2 * q], qy = m.xy[2 * q + 1]
+    cdef double da = (qx - px) * (ay - py) - (qy - py) * (ax - px)
+    cdef double db = (qx - px) * (by - py) - (qy - py) * (bx - px)
+    cdef double t = da / (da - db)
+    if not (t > 0.0):
+        t = 0.0
+    elif not (t < 1.0):
+        t = 1.0
+    cdef double sx = ax + t * (bx - ax), sy = ay + t * (by - ay)
+    m.C[h] = 0
+    m.C[m.N[h]] = 0
+    loc = locate(m, sx, sy, h // 3, &at)
+    if loc < 0:
+        return loc
+    if loc == LOC_VERTEX:
+        s = m.V[at]
+    else:
+        s = new_vertex(m, sx, sy)
+        if s < 0:
+            return s
+        err = insert_at(m, s, loc, at)
+        if err:
+            return err
+    # p-q lost its constraint: it may no longer be Delaunay against the new vertex's side
+    dirty.n = 0
+    if buf_push2(dirty, p, q):
+        return ERR_NOMEM
+    err = restore_delaunay(m, dirty)
+    if err:
+        return err
+    if work_push(w, a, s, count) or work_push(w, s, b, count) or work_push(w, p, s, k) or work_push(w, s, q, k):
+        return ERR_NOMEM
+    return 0
+
+
+cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a, int b, int count) noexcept nogil:
+    """Make a-b an edge (or queue its pieces when a vertex lies on it or a constraint crosses it)."""
+    cdef int h, start, p, q, o, r, s, head, u, v, x, y, k
+    cdef long long guard
+    h = find_edge(m, a, b)
+    if h >= 0:
+        return mark(m, h, count)
+    # the triangle around a that the segment leaves through
+    h = m.VT[a]
+    start = h
+    while True:
+        p = m.V[nxt(h)]
+        q = m.V[prv(h)]
+        if p != GHOST and orient_v(m, a, b, p) == 0 and same_direction(m, a, b, p):
+            mark(m, h, count)
+            return work_push(w, p, b, count)
+        if p != GHOST and q != GHOST and orient_v(m, a, b, p) < 0 and orient_v(m, a, b, q) > 0:
+            h = nxt(h)
+            break
+        h = m.N[prv(h)]
+        if h == start:
+            return ERR_INTERNAL
+    # walk along the segment collecting crossed edges (origin right of a->b, destination left)
+    crossed.n = 0
+    while True:
+        if spend(m):
+            return ERR_INTERNAL
+        if m.C[h]:
+            return split_constraint(m, w, fresh, h, a, b, count)
+        if buf_push2(crossed, m.V[h], m.V[nxt(h)]):
+            return ERR_NOMEM
+        o = m.N[h]
+        r = m.V[prv(o)]
+        if r == b:
+            break
+        if r == GHOST:
+            return ERR_INTERNAL
+        s = orient_v(m, a, b, r)
+        if s == 0:
+            if work_push(w, r, b, count):
+                return ERR_NOMEM
+            b = r
+            break
+        h = nxt(o) if s > 0 else prv(o)
+    # Sloan: flip crossed edges (a ring buffer of vertex pairs) until none crosses a-b
+    fresh.n = 0
+    head = 0
+    k = crossed.n // 2
+    guard = 10 * <long long> k * k + 1000
+    while k > 0:
+        guard -= 1
+        if guard < 0 or spend(m):
+            return ERR_INTERNAL
+        u = crossed.data[2 * head]
+        v = crossed.data[2 * head + 1]
+        head = (head + 1) % (crossed.n // 2)
+        k -= 1
+        h = find_edge(m, u, v)
+        if h < 0:
+            return ERR_INTERNAL
+        x = m.V[prv(h)]
+        y = m.V[prv(m.N[h])]
+        if orient_v(m, x, y, u) * orient_v(m, x, y, v) >= 0:
+            # not strictly convex yet: retry after the others
+            crossed.data[2 * ((head + k) % (crossed.n // 2))] = u
+            crossed.data[2 * ((head + k) % (crossed.n // 2)) + 1] = v
+            k += 1
+            continue
+        flip(m, h)
+        if (x == a and y == b) or (x == b and y == a):
+            continue
+        if orient_v(m, a, b, x) * orient_v(m, a, b, y) < 0:
+            crossed.data[2 * ((head + k) % (crossed.n // 2))] = x
+            crossed.data[2 * ((head + k) % (crossed.n // 2)) + 1] = y
+            k += 1
+        elif buf_push2(fresh, x, y):
+            return ERR_NOMEM
+    h = find_edge(m, a, b)
+    if h < 0:
+        return ERR_INTERNAL
+    mark(m, h, count)
+    return restore_delaunay(m, fresh)
+
+
+cdef int insert_constraints(Mesh *m, const int *segs, int nseg, const int *vmap) noexcept nogil:
+    cdef Work w
+    cdef Buffer crossed, fresh
+    cdef int i, a, b, count, err = 0
+    w.data = NULL
+    w.n = w.cap = 0
+    crossed.data = fresh.data = NULL
+    crossed.n = crossed.cap = fresh.n = fresh.cap = 0
+    for i in range(nseg - 1, -1, -1):
+        err = work_push(&w, vmap[segs[2 * i]], vmap[segs[2 * i + 1]], 1)
+        if err:
+            break
+    while err == 0 and w.n > 0:
+        w.n -= 3
+        a = w.data[w.n]
+        b = w.data[w.n + 1]
+        count = w.data[w.n + 2]
+        if a != b and count > 0:
+            err = insert_segment(m, &w, &crossed, &fresh, a, b, count)
+    free(w.data)
+    free(crossed.data)
+    free(fresh.data)
+    return err
+
+
+# ---------------------------------------------------------------------------------------------------- regions
+
+cdef int flood(Mesh *m, int t, signed char *removed, int *stack) noexcept nogil:
+    """Mark every triangle reachable from t without crossing a constraint (hole seeds)."""
+    cdef int n = 1, u, k, h, v
+    removed[t] = 1
+    stack[0] = t
+    while n > 0:
+        n -= 1
+        u = stack[n]
+        for k in range(3):
+            h = 3 * u + k
+            v = m.N[h] // 3
+            if not m.C[h] and not removed[v]:
+                removed[v] = 1
+                stack[n] = v
+                n += 1
+    return 0
+
+
+cdef int depths(Mesh *m, int *depth, long long *heap, int *stack) noexcept nogil:
+    """Even-odd depth of every triangle: the fewest constraint crossings (with multiplicity) from outside the hull.
+
+    Dijkstra where free moves (across unconstrained edges) flood at the current depth and each crossing of a
+    constraint edge costs its multiplicity; ``heap`` is a binary min-heap of (depth << 32 | triangle).
+    """
+    cdef int hn = 0, sn, t, u, k, h, v, i, c
+    cdef long long item, d
+    for t in range(m.nt):
+        depth[t] = -1
+        if ghost_corner(m, t) >= 0:
+            heap[hn] = t
+            hn += 1
+    while hn > 0:
+        item = heap[0]
+        hn -= 1
+        heap[0] = heap[hn]
+        i = 0
+        while True:  # sift down
+            c = 2 * i + 1
+            if c >= hn:
+                break
+            if c + 1 < hn and heap[c + 1] < heap[c]:
+                c += 1
+            if heap[i] <= heap[c]:
+                break
+            d = heap[i]
+            heap[i] = heap[c]
+            heap[c] = d
+            i = c
+        t = <int> (item - ((item >> 32) << 32))
+        d = item >> 32
+        if depth[t] >= 0:
+            continue
+        depth[t] = <int> d
+        stack[0] = t
+        sn = 1
+        while sn > 0:
+            sn -= 1
+            u = stack[sn]
+            for k in range(3):
+                h = 3 * u + k
+                v = m.N[h] // 3
+                if depth[v] >= 0:
+                    continue
+                if m.C[h] == 0:
+                    depth[v] = <int> d
+                    stack[sn] = v
+                    sn += 1
+                else:
+                    heap[hn] = ((d + m.C[h]) << 32) | v
+                    i = hn
+                    hn += 1
+                    while i > 0 and heap[(i - 1) // 2] > heap[i]:  # sift up
+                        item = heap[i]
+                        heap[i] = heap[(i - 1) // 2]
+                        heap[(i - 1) // 2] = item
+                        i = (i - 1) // 2
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------------- Python API
+
+_ERRORS = {ERR_NOMEM: MemoryError("out of memory while triangulating"),
+           ERR_INTERNAL: RuntimeError("internal error in the triangulation (please report the input)")}
+
+
+def orient2d(double ax, double ay, double bx, double by, double cx, double cy):
+    """Exact sign of the orientation of (a, b, c): +1 counter-clockwise, -1 clockwise, 0 collinear."""
+    return rg_orient2d(ax, ay, bx, by, cx, cy)
+
+
+def incircle(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy):
+    """Exact sign of d against the circle through counter-clockwise a, b, c: +1 inside, -1 outside, 0 on it."""
+    return rg_incircle(ax, ay, bx, by, cx, cy, dx, dy)
+
+
+def triangulate(points, segments, bint inside, holes):
+    """Triangulate validated arrays; see ``rigger.cdt.triangulate`` for the contract."""
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    cdef int n = points.shape[0], nseg = segments.shape[0]
+    # scale by a power of two (exact) so that products in the predicates neither overflow nor underflow
+    peak = float(np.abs(points).max()) if n else 0.0
+    exponent = int(np.frexp(peak)[1]) if peak > 0 else 0
+    scaled = np.ldexp(points, -exponent)
+    vmap_arr = np.arange(n, dtype=np.int32)
+    if n < 3:
+        return _collinear_result(points, segments)
+    cdef double[:, ::1] xy = scaled
+    cdef int[::1] vmap = vmap_arr
+    cdef const int[:, ::1] segs = np.ascontiguousarray(segments, dtype=np.int32)
+    cdef Mesh m
+    memset(&m, 0, sizeof(Mesh))
+    m.rng = 12345
+    m.budget = 2000 * (<long long> n + nseg) + 10000000
+    cdef int *order = <int *> malloc(<size_t> n * sizeof(int))
+    cdef int *tmp_order = <int *> malloc(<size_t> n * sizeof(int))
+    cdef unsigned int *keys = <unsigned int *> malloc(<size_t> n * sizeof(unsigned int))
+    cdef unsigned int *tmp_keys = <unsigned int *> malloc(<size_t> n * sizeof(unsigned int))
+    cdef int err = 0, collinear = 0, i
+    try:
+        m.cap_v = n + 16
+        m.cap_t = 2 * n + 16
+        m.xy = <double *> malloc(<size_t> m.cap_v * 2 * sizeof(double))
+        m.VT = <int *> malloc(<size_t> m.cap_v * sizeof(int))
+        m.V = <int *> malloc(<size_t> m.cap_t * 3 * sizeof(int))
+        m.N = <int *> malloc(<size_t> m.cap_t * 3 * sizeof(int))
+        m.C = <int *> malloc(<size_t> m.cap_t * 3 * sizeof(int))
+        if not (order and tmp_order and keys and tmp_keys and m.xy and m.VT and m.V and m.N and m.C):
+            raise MemoryError("out of memory while triangulating")
+        with nogil:
+            for i in range(n):
+                m.xy[2 * i] = xy[i, 0]
+                m.xy[2 * i + 1] = xy[i, 1]
+                m.VT[i] = -1
+            m.nv = n
+            hilbert_order(m.xy, n, order, keys, tmp_keys, tmp_order)
+            err = delaunay(&m, n, order, &vmap[0])
+            if err == 1:
+                collinear = 1
+                err = 0
+            elif err == 0 and nseg:
+                err = insert_constraints(&m, &segs[0, 0], nseg, &vmap[0])
+        if err:
+            raise _ERRORS[err]
+        if collinear:
+            return _collinear_result(points, segments)
+        return _collect(&m, points, exponent, vmap_arr, inside, np.ascontiguousarray(
+            np.ldexp(np.asarray(holes, dtype=np.float64).reshape(-1, 2), -exponent)))
+    finally:
+        free(order)
+        free(tmp_order)
+        free(keys)
+        free(tmp_keys)
+        free(m.xy)
+        free(m.VT)
+        free(m.V)
+        free(m.N)
+        free(m.C)
+        free(m.stack)
+
+
+cdef object _collect(Mesh *m, object points, int exponent, object vmap_arr, bint inside, double[:, ::1] holes):
+    """Keep the wanted real triangles and build the output arrays."""
+    cdef int nt = m.nt, t, k, h, loc, at, start
+    removed_arr = np.zeros(nt, dtype=np.int8)
+    stack_arr = np.empty(nt + 1, dtype=np.int32)
+    cdef signed char[::1] removed = removed_arr
+    cdef int[::1] stack = stack_arr
+    for t in range(nt):
+        if ghost_corner(m, t) >= 0:
+            removed[t] = 1
+    start = m.VT[0] // 3 if m.VT[0] >= 0 else 0
+    for k in range(holes.shape[0]):
+        loc = locate(m, holes[k, 0], holes[k, 1], start, &at)
+        if loc < 0:
+            raise _ERRORS[loc]
+        if not removed[at // 3]:
+            flood(m, at // 3, &removed[0], &stack[0])
+    if inside:
+        depth_arr = np.empty(nt, dtype=np.int32)
+        heap_arr = np.empty(3 * nt + 1, dtype=np.int64)
+        _depths(m, depth_arr, heap_arr, stack_arr)
+        removed_arr |= (depth_arr % 2 == 0).astype(np.int8)
+    V = np.asarray(<int[:3 * nt]> m.V).reshape(nt, 3)
+    N = np.asarray(<int[:3 * nt]> m.N).reshape(nt, 3)
+    C = np.asarray(<int[:3 * nt]> m.C).reshape(nt, 3)
+    keep = removed_arr == 0
+    new_index = np.full(nt + 1, -1, dtype=np.int32)
+    new_index[:nt][keep] = np.arange(int(keep.sum()), dtype=np.int32)
+    triangles = V[keep].astype(np.int32)
+    # edge opposite corner k runs from corner k+1 to corner k+2: half-edge (k + 1) % 3
+    opposite = [1, 2, 0]
+    neighbors = new_index[N[keep][:, opposite] // 3]
+    constrained = C[keep][:, opposite] > 0
+    # every constraint edge once: the half-edge whose origin is the lower vertex, between real vertices
+    dest = V[:, [1, 2, 0]]
+    flat = (C > 0) & (V >= 0) & (dest >= 0) & (V < dest)
+    segs = np.stack([V[flat], dest[flat]], axis=1).astype(np.int32)
+    segs = segs[np.lexsort((segs[:, 1], segs[:, 0]))] if len(segs) else segs.reshape(0, 2)
+    n = len(points)
+    vertices = np.empty((m.nv, 2), dtype=np.float64)
+    vertices[:n] = points
+    if m.nv > n:
+        vertices[n:] = np.ldexp(np.asarray(<double[:2 * m.nv]> m.xy).reshape(m.nv, 2)[n:], exponent)
+    return dict(vertices=vertices, triangles=triangles, neighbors=neighbors.astype(np.int32),
+                constrained=constrained, vertex_map=vmap_arr, segments=segs)
+
+
+cdef void _depths(Mesh *m, int[::1] depth, long long[::1] heap, int[::1] stack):
+    depths(m, &depth[0], &heap[0], &stack[0])
+
+
+def _collinear_result(points, segments):
+    """No triangle: merge duplicates and split the segments at the points lying on them (all points collinear)."""
+    n = len(points)
+    if n:
+        _, first, inverse = np.unique(points, axis=0, return_index=True, return_inverse=True)
+        vmap = first[inverse.reshape(-1)].astype(np.int32)
+    else:
+        vmap = np.zeros(0, np.int32)
+    reps = np.unique(vmap)
+    pieces = []
+    if len(segments) and len(reps) > 1:
+        span = points[reps].max(axis=0) - points[reps].min(axis=0)
+        axis = int(np.argmax(span))
+        line = reps[np.argsort(points[reps, axis], kind="stable")]
+        rank = np.empty(n, dtype=np.int64)
+        rank[line] = np.arange(len(line))
+        for a, b in np.asarray(segments):
+            ra, rb = sorted((rank[vmap[a]], rank[vmap[b]]))
+            pieces.extend(zip(line[ra:rb], line[ra + 1:rb + 1]))
+    segs = np.array(sorted({(min(a, b), max(a, b)) for a, b in pieces}), dtype=np.int32).reshape(-1, 2)
+    return dict(vertices=np.array(points, dtype=np.float64).reshape(-1, 2), triangles=np.zeros((0, 3), np.int32),
+                neighbors=np.zeros((0, 3), np.int32), constrained=np.zeros((0, 3), bool), vertex_map=vmap,
+                segments=segs)

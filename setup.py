@@ -1,0 +1,35 @@
+"""Build Rigger's compiled core into the add-on package.
+
+The add-on lives in ``addon/`` and is imported as ``rigger``. Compiled modules get names unique to this project
+(``rigger._rigger_*``) because Blender shares one site-packages between add-ons.
+"""
+import sys
+
+from Cython.Build import cythonize
+from setuptools import Extension, setup
+
+# Exact geometric predicates need IEEE double arithmetic without fused multiply-add contraction or fast-math.
+if sys.platform == "win32":
+    COMPILE_ARGS = ["/O2", "/fp:precise"]
+else:
+    COMPILE_ARGS = ["-O2", "-ffp-contract=off", "-fno-fast-math", "-Wall", "-Wno-unused-function"]
+
+EXTENSIONS = [
+    Extension("rigger._rigger_cdt", ["ext/cdt.pyx"], include_dirs=["ext"], extra_compile_args=COMPILE_ARGS),
+]
+
+setup(
+    name="rigger",
+    version="0.1.0",
+    description="Automatic rigging for Blender: skeleton extraction, armature building and skinning",
+    license="GPL-3.0-or-later",
+    python_requires=">=3.11",
+    package_dir={"rigger": "addon"},
+    packages=["rigger", "rigger.core", "rigger.methods"],
+    ext_modules=cythonize(
+        EXTENSIONS,
+        language_level=3,
+        compiler_directives={"boundscheck": False, "wraparound": False, "cdivision": True, "initializedcheck": False},
+    ),
+    zip_safe=False,
+)
