@@ -13,12 +13,18 @@ and ``C[h]`` how many input segments cover it (0: unconstrained).
 """
 from libc.stdlib cimport malloc, realloc, free
 from libc.string cimport memset
+from libc.math cimport fabs, sqrt
+
+ctypedef unsigned char npy_bool
 
 import numpy as np
 
 cdef extern from "cdt_predicates.h" nogil:
     int rg_orient2d(double ax, double ay, double bx, double by, double cx, double cy)
     int rg_incircle(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy)
+
+# Crossing constraints closer than this to an endpoint are routed through it (coordinates are scaled to |x| < 1).
+cdef double SNAP = 2.0 ** -40
 
 cdef enum:
     GHOST = -1
@@ -306,7 +312,7 @@ cdef int legalize(Mesh *m, int p) noexcept nogil:
 cdef int locate(Mesh *m, double px, double py, int t, int *out) noexcept nogil:
     """Walk from triangle t to the point; returns LOC_FACE (out: a half-edge of the triangle or ghost holding it),
     LOC_EDGE (out: the half-edge whose open segment holds it) or LOC_VERTEX (out: a half-edge leaving that vertex)."""
-    cdef int g, h, k, o, pos, r, zeros, z0, z1
+    cdef int g, h, k, o, pos, r, zeros, z0, z1, came = -1
     while True:
         if spend(m):
             return ERR_INTERNAL
@@ -318,8 +324,10 @@ cdef int locate(Mesh *m, double px, double py, int t, int *out) noexcept nogil:
                 out[0] = h
                 return LOC_FACE
             if o < 0:
-                t = m.N[h] // 3
+                came = m.N[h]
+                t = came // 3
                 continue
+            came = -1
             pos = collinear_position(m, m.V[h], m.V[nxt(h)], px, py)
             if pos == 0:
                 out[0] = h
@@ -338,6 +346,8 @@ cdef int locate(Mesh *m, double px, double py, int t, int *out) noexcept nogil:
         z0 = z1 = -1
         for k in range(3):
             h = 3 * t + (r + k) % 3
+            if h == came:
+                continue  # the edge just crossed: the point is strictly on its inner side
             o = orient_p(m, m.V[h], m.V[nxt(h)], px, py)
             if o < 0:
                 break
@@ -357,7 +367,8 @@ cdef int locate(Mesh *m, double px, double py, int t, int *out) noexcept nogil:
             # two collinear edges meet at the vertex the point coincides with
             out[0] = z1 if nxt(z0) == z1 else z0
             return LOC_VERTEX
-        t = m.N[h] // 3
+        came = m.N[h]
+        t = came // 3
 
 
 cdef int insert_at(Mesh *m, int p, int loc, int h) noexcept nogil:
@@ -371,7 +382,12 @@ cdef int insert_at(Mesh *m, int p, int loc, int h) noexcept nogil:
 
 cdef void hilbert_order(const double *xy, int n, int *order, unsigned int *keys, unsigned int *tmp_keys,
                         int *tmp_order) noexcept nogil:
-    """Sort point indices along a Hilbert curve over the bounding box (stable radix sort: duplicates keep index order)."""
+    """Biased randomised insertion order (BRIO): random rounds of doubling size, each sorted along a Hilbert curve.
+
+    Pure Hilbert order makes points on a smooth outline see long hull chains and flip quadratically often; random
+    rounds keep the expected work O(n log n) while the curve keeps the walks short. The round of a point comes from a
+    hash of its Hilbert key, so exact duplicates share a round and (the sorts being stable) keep index order.
+    """
     cdef double x0 = xy[0], x1 = xy[0], y0 = xy[1], y1 = xy[1], sx, sy
     cdef int i, pass_, shift
     cdef unsigned int qx, qy, s, rx, ry, d, t
@@ -425,6 +441,34 @@ cdef void hilbert_order(const double *xy, int n, int *order, unsigned int *keys,
         for i in range(n):
             keys[i] = tmp_keys[i]
             order[i] = tmp_order[i]
+    # stable counting sort by round, the rarest (smallest) round first
+    memset(counts, 0, sizeof(counts))
+    for i in range(n):
+        keys[i] = 31 - brio_round(keys[i])
+        counts[keys[i] + 1] += 1
+    for i in range(32):
+        counts[i + 1] += counts[i]
+    for i in range(n):
+        tmp_order[counts[keys[i]]] = order[i]
+        counts[keys[i]] += 1
+    for i in range(n):
+        order[i] = tmp_order[i]
+
+
+cdef inline unsigned int brio_round(unsigned int key) noexcept nogil:
+    """Round 31 - k with probability 2^-(k+1): the trailing zeros of a well-mixed hash of the key."""
+    cdef unsigned int x = key * 0x9E3779B1u
+    x ^= x >> 16
+    x *= 0x85EBCA6Bu
+    x ^= x >> 13
+    x *= 0xC2B2AE35u
+    x ^= x >> 16
+    x |= 0x80000000u
+    cdef unsigned int k = 0
+    while not (x & 1u):
+        x >>= 1
+        k += 1
+    return k
 
 
 cdef int seed_triangle(Mesh *m, int a, int b, int c) noexcept nogil:
@@ -560,42 +604,63 @@ cdef int mark(Mesh *m, int h, int count) noexcept nogil:
 
 
 cdef int split_constraint(Mesh *m, Work *w, Buffer *dirty, int h, int a, int b, int count) noexcept nogil:
-    """Segment a-b crosses the constrained edge h = p -> q: split both at a new vertex near their intersection."""
+    """Segment a-b crosses the constrained edge h = p -> q: split both at a new vertex near their intersection.
+
+    A crossing that passes within SNAP of an endpoint is routed through that endpoint instead: a Steiner vertex there
+    would sit a rounding error away from it and make the next near-parallel segment cross again and again.
+    """
     cdef int p = m.V[h], q = m.V[nxt(h)], k = m.C[h], loc, at, s, err
     cdef double ax = m.xy[2 * a], ay = m.xy[2 * a + 1], bx = m.xy[2 * b], by = m.xy[2 * b + 1]
     cdef double px = m.xy[2 * p], py = m.xy[2 * p + 1], qx = m.xy[2 * q], qy = m.xy[2 * q + 1]
     cdef double da = (qx - px) * (ay - py) - (qy - py) * (ax - px)
     cdef double db = (qx - px) * (by - py) - (qy - py) * (bx - px)
-    cdef double t = da / (da - db)
-    if not (t > 0.0):
-        t = 0.0
-    elif not (t < 1.0):
-        t = 1.0
+    cdef double dp = (bx - ax) * (py - ay) - (by - ay) * (px - ax)
+    cdef double dq = (bx - ax) * (qy - ay) - (by - ay) * (qx - ax)
+    cdef double lab = sqrt((bx - ax) * (bx - ax) + (by - ay) * (by - ay))
+    cdef double lpq = sqrt((qx - px) * (qx - px) + (qy - py) * (qy - py))
+    dp = fabs(dp) / lab
+    dq = fabs(dq) / lab
+    da = fabs(da) / lpq
+    db = fabs(db) / lpq
+    cdef double nearest = min(min(dp, dq), min(da, db))
+    if nearest <= SNAP:
+        if nearest == dp or nearest == dq:
+            s = p if nearest == dp else q
+            if work_push(w, a, s, count) or work_push(w, s, b, count):
+                return ERR_NOMEM
+            return 0
+        s = a if nearest == da else b
+        return (release(m, dirty, p, q) or work_push(w, a, b, count) or work_push(w, p, s, k) or
+                work_push(w, s, q, k))
+    cdef double t = da / (da + db)
     cdef double sx = ax + t * (bx - ax), sy = ay + t * (by - ay)
-    m.C[h] = 0
-    m.C[m.N[h]] = 0
     loc = locate(m, sx, sy, h // 3, &at)
     if loc < 0:
         return loc
     if loc == LOC_VERTEX:
         s = m.V[at]
     else:
+        m.C[h] = 0  # the constraint moves to the two pieces through the new vertex: let the insertion flip it
+        m.C[m.N[h]] = 0
         s = new_vertex(m, sx, sy)
         if s < 0:
             return s
         err = insert_at(m, s, loc, at)
         if err:
             return err
-    # p-q lost its constraint: it may no longer be Delaunay against the new vertex's side
+    return (release(m, dirty, p, q) or work_push(w, p, s, k) or work_push(w, s, q, k) or
+            work_push(w, a, s, count) or work_push(w, s, b, count))
+
+
+cdef int release(Mesh *m, Buffer *dirty, int p, int q) noexcept nogil:
+    """Drop the constraint of edge p-q, if that edge still exists, and flip it if it is no longer Delaunay."""
+    cdef int h = find_edge(m, p, q)
+    if h < 0:
+        return 0
+    m.C[h] = 0
+    m.C[m.N[h]] = 0
     dirty.n = 0
-    if buf_push2(dirty, p, q):
-        return ERR_NOMEM
-    err = restore_delaunay(m, dirty)
-    if err:
-        return err
-    if work_push(w, a, s, count) or work_push(w, s, b, count) or work_push(w, p, s, k) or work_push(w, s, q, k):
-        return ERR_NOMEM
-    return 0
+    return buf_push2(dirty, p, q) or restore_delaunay(m, dirty)
 
 
 cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a, int b, int count) noexcept nogil:
@@ -727,64 +792,62 @@ cdef int flood(Mesh *m, int t, signed char *removed, int *stack) noexcept nogil:
     return 0
 
 
-cdef int depths(Mesh *m, int *depth, long long *heap, int *stack) noexcept nogil:
+cdef int depths(Mesh *m, int *depth, int *entry_t, int *entry_next, int *stack) noexcept nogil:
     """Even-odd depth of every triangle: the fewest constraint crossings (with multiplicity) from outside the hull.
 
-    Dijkstra where free moves (across unconstrained edges) flood at the current depth and each crossing of a
-    constraint edge costs its multiplicity; ``heap`` is a binary min-heap of (depth << 32 | triangle).
+    Dial's shortest paths: free moves (across unconstrained edges) flood at the current depth; crossing a constraint
+    edge costs its multiplicity and parks the triangle in the bucket of that depth (a ring of max-multiplicity + 1
+    singly linked lists). ``entry_*`` need room for every ghost and every constrained half-edge.
     """
-    cdef int hn = 0, sn, t, u, k, h, v, i, c
-    cdef long long item, d
+    cdef int nb = 1, t, u, k, h, v, e, n_entries = 0, pending = 0, sn, d = 0, b
+    for h in range(3 * m.nt):
+        if m.C[h] + 1 > nb:
+            nb = m.C[h] + 1
+    cdef int *head = <int *> malloc(<size_t> nb * sizeof(int))
+    if head == NULL:
+        return ERR_NOMEM
+    for b in range(nb):
+        head[b] = -1
     for t in range(m.nt):
         depth[t] = -1
         if ghost_corner(m, t) >= 0:
-            heap[hn] = t
-            hn += 1
-    while hn > 0:
-        item = heap[0]
-        hn -= 1
-        heap[0] = heap[hn]
-        i = 0
-        while True:  # sift down
-            c = 2 * i + 1
-            if c >= hn:
-                break
-            if c + 1 < hn and heap[c + 1] < heap[c]:
-                c += 1
-            if heap[i] <= heap[c]:
-                break
-            d = heap[i]
-            heap[i] = heap[c]
-            heap[c] = d
-            i = c
-        t = <int> (item - ((item >> 32) << 32))
-        d = item >> 32
-        if depth[t] >= 0:
-            continue
-        depth[t] = <int> d
-        stack[0] = t
-        sn = 1
-        while sn > 0:
-            sn -= 1
-            u = stack[sn]
-            for k in range(3):
-                h = 3 * u + k
-                v = m.N[h] // 3
-                if depth[v] >= 0:
-                    continue
-                if m.C[h] == 0:
-                    depth[v] = <int> d
-                    stack[sn] = v
-                    sn += 1
-                else:
-                    heap[hn] = ((d + m.C[h]) << 32) | v
-                    i = hn
-                    hn += 1
-                    while i > 0 and heap[(i - 1) // 2] > heap[i]:  # sift up
-                        item = heap[i]
-                        heap[i] = heap[(i - 1) // 2]
-                        heap[(i - 1) // 2] = item
-                        i = (i - 1) // 2
+            entry_t[n_entries] = t
+            entry_next[n_entries] = head[0]
+            head[0] = n_entries
+            n_entries += 1
+            pending += 1
+    while pending > 0:
+        b = d % nb
+        while head[b] >= 0:
+            e = head[b]
+            head[b] = entry_next[e]
+            pending -= 1
+            t = entry_t[e]
+            if depth[t] >= 0:
+                continue
+            depth[t] = d
+            stack[0] = t
+            sn = 1
+            while sn > 0:
+                sn -= 1
+                u = stack[sn]
+                for k in range(3):
+                    h = 3 * u + k
+                    v = m.N[h] // 3
+                    if depth[v] >= 0:
+                        continue
+                    if m.C[h] == 0:
+                        depth[v] = d
+                        stack[sn] = v
+                        sn += 1
+                    else:
+                        entry_t[n_entries] = v
+                        entry_next[n_entries] = head[(d + m.C[h]) % nb]
+                        head[(d + m.C[h]) % nb] = n_entries
+                        n_entries += 1
+                        pending += 1
+        d += 1
+    free(head)
     return 0
 
 
@@ -871,7 +934,7 @@ def triangulate(points, segments, bint inside, holes):
 
 cdef object _collect(Mesh *m, object points, int exponent, object vmap_arr, bint inside, double[:, ::1] holes):
     """Keep the wanted real triangles and build the output arrays."""
-    cdef int nt = m.nt, t, k, h, loc, at, start
+    cdef int nt = m.nt, t, k, j, h, loc, at, start, kept = 0, nb, nseg = 0, d
     removed_arr = np.zeros(nt, dtype=np.int8)
     stack_arr = np.empty(nt + 1, dtype=np.int32)
     cdef signed char[::1] removed = removed_arr
@@ -886,38 +949,58 @@ cdef object _collect(Mesh *m, object points, int exponent, object vmap_arr, bint
             raise _ERRORS[loc]
         if not removed[at // 3]:
             flood(m, at // 3, &removed[0], &stack[0])
+    cdef int[::1] depth
     if inside:
-        depth_arr = np.empty(nt, dtype=np.int32)
-        heap_arr = np.empty(3 * nt + 1, dtype=np.int64)
-        _depths(m, depth_arr, heap_arr, stack_arr)
-        removed_arr |= (depth_arr % 2 == 0).astype(np.int8)
-    V = np.asarray(<int[:3 * nt]> m.V).reshape(nt, 3)
-    N = np.asarray(<int[:3 * nt]> m.N).reshape(nt, 3)
-    C = np.asarray(<int[:3 * nt]> m.C).reshape(nt, 3)
-    keep = removed_arr == 0
-    new_index = np.full(nt + 1, -1, dtype=np.int32)
-    new_index[:nt][keep] = np.arange(int(keep.sum()), dtype=np.int32)
-    triangles = V[keep].astype(np.int32)
-    # edge opposite corner k runs from corner k+1 to corner k+2: half-edge (k + 1) % 3
-    opposite = [1, 2, 0]
-    neighbors = new_index[N[keep][:, opposite] // 3]
-    constrained = C[keep][:, opposite] > 0
-    # every constraint edge once: the half-edge whose origin is the lower vertex, between real vertices
-    dest = V[:, [1, 2, 0]]
-    flat = (C > 0) & (V >= 0) & (dest >= 0) & (V < dest)
-    segs = np.stack([V[flat], dest[flat]], axis=1).astype(np.int32)
-    segs = segs[np.lexsort((segs[:, 1], segs[:, 0]))] if len(segs) else segs.reshape(0, 2)
+        depth = np.empty(nt, dtype=np.int32)
+        _depths(m, depth, np.empty(4 * nt + 1, dtype=np.int32), np.empty(4 * nt + 1, dtype=np.int32), stack_arr)
+        for t in range(nt):
+            if depth[t] % 2 == 0:
+                removed[t] = 1
+    cdef int[::1] new_index = stack_arr  # reused: the flood stack is no longer needed
+    for t in range(nt):
+        new_index[t] = -1 if removed[t] else kept
+        kept += 0 if removed[t] else 1
+    triangles = np.empty((kept, 3), dtype=np.int32)
+    neighbors = np.empty((kept, 3), dtype=np.int32)
+    constrained = np.empty((kept, 3), dtype=np.bool_)
+    cdef int[:, ::1] tri_v = triangles, tri_n = neighbors
+    cdef npy_bool[:, ::1] tri_c = constrained
+    for t in range(nt):
+        k = new_index[t]
+        if k < 0:
+            continue
+        for j in range(3):
+            tri_v[k, j] = m.V[3 * t + j]
+            # the edge opposite corner j runs from corner j+1 to corner j+2: half-edge (j + 1) % 3
+            h = 3 * t + (j + 1) % 3
+            tri_n[k, j] = new_index[m.N[h] // 3]
+            tri_c[k, j] = m.C[h] > 0
+    for h in range(3 * nt):
+        d = m.V[nxt(h)]
+        if m.C[h] and m.V[h] >= 0 and d >= 0 and m.V[h] < d:
+            nseg += 1
+    segs = np.empty((nseg, 2), dtype=np.int32)
+    cdef int[:, ::1] seg_v = segs
+    nseg = 0
+    for h in range(3 * nt):
+        d = m.V[nxt(h)]
+        if m.C[h] and m.V[h] >= 0 and d >= 0 and m.V[h] < d:
+            seg_v[nseg, 0] = m.V[h]
+            seg_v[nseg, 1] = d
+            nseg += 1
+    segs = segs[np.lexsort((segs[:, 1], segs[:, 0]))]
     n = len(points)
     vertices = np.empty((m.nv, 2), dtype=np.float64)
     vertices[:n] = points
     if m.nv > n:
         vertices[n:] = np.ldexp(np.asarray(<double[:2 * m.nv]> m.xy).reshape(m.nv, 2)[n:], exponent)
-    return dict(vertices=vertices, triangles=triangles, neighbors=neighbors.astype(np.int32),
-                constrained=constrained, vertex_map=vmap_arr, segments=segs)
+    return dict(vertices=vertices, triangles=triangles, neighbors=neighbors, constrained=constrained,
+                vertex_map=vmap_arr, segments=segs)
 
 
-cdef void _depths(Mesh *m, int[::1] depth, long long[::1] heap, int[::1] stack):
-    depths(m, &depth[0], &heap[0], &stack[0])
+cdef void _depths(Mesh *m, int[::1] depth, int[::1] entry_t, int[::1] entry_next, int[::1] stack):
+    if depths(m, &depth[0], &entry_t[0], &entry_next[0], &stack[0]):
+        raise MemoryError("out of memory while triangulating")
 
 
 def _collinear_result(points, segments):

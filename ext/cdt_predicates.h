@@ -19,6 +19,13 @@
 #define RIGGER_SPLITTER 134217729.0       /* 2^27 + 1 */
 static const double rigger_ccw_bound = (3.0 + 16.0 * RIGGER_EPS) * RIGGER_EPS;
 static const double rigger_icc_bound = (10.0 + 96.0 * RIGGER_EPS) * RIGGER_EPS;
+/* second-stage bounds (Shewchuk): the determinant computed exactly from rounded differences is off by at most this */
+static const double rigger_ccw_bound_b = (2.0 + 12.0 * RIGGER_EPS) * RIGGER_EPS;
+static const double rigger_icc_bound_b = (4.0 + 48.0 * RIGGER_EPS) * RIGGER_EPS;
+/* third stage: first-order corrections for the rounding of the differences, then these bounds */
+static const double rigger_ccw_bound_c = (9.0 + 64.0 * RIGGER_EPS) * RIGGER_EPS * RIGGER_EPS;
+static const double rigger_icc_bound_c = (44.0 + 576.0 * RIGGER_EPS) * RIGGER_EPS * RIGGER_EPS;
+static const double rigger_result_bound = (3.0 + 8.0 * RIGGER_EPS) * RIGGER_EPS;
 
 /* a + b = x + y exactly, |y| <= ulp(x)/2 */
 static inline void rg_two_sum(double a, double b, double *x, double *y) {
@@ -58,14 +65,23 @@ static int rg_grow(int elen, const double *e, double b, double *h) {
     return n;
 }
 
-/* h = e + f. h must hold elen + flen doubles and may not alias e or f. Returns length. */
-static int rg_sum(int elen, const double *e, int flen, const double *f, double *h, double *scratch) {
-    int n = elen;
-    for (int i = 0; i < elen; i++) h[i] = e[i];
-    for (int j = 0; j < flen; j++) {
-        n = rg_grow(n, h, f[j], scratch);
-        for (int i = 0; i < n; i++) h[i] = scratch[i];
+/* h = e + f in linear time: merge both by magnitude, then carry one running sum through (Fast-Expansion-Sum).
+ * h must hold elen + flen doubles and may not alias e or f. Returns length. */
+static int rg_sum(int elen, const double *e, int flen, const double *f, double *h, double *merged) {
+    int i = 0, j = 0, k = 0, n = 0;
+    while (i < elen && j < flen) merged[k++] = (fabs(e[i]) < fabs(f[j])) ? e[i++] : f[j++];
+    while (i < elen) merged[k++] = e[i++];
+    while (j < flen) merged[k++] = f[j++];
+    if (k == 0) {
+        h[0] = 0.0;
+        return 1;
     }
+    double q = merged[0], hh;
+    for (i = 1; i < k; i++) {
+        rg_two_sum(q, merged[i], &q, &hh);
+        if (hh != 0.0) h[n++] = hh;
+    }
+    if (q != 0.0 || n == 0) h[n++] = q;
     return n;
 }
 
@@ -125,6 +141,45 @@ static int rg_orient_exact_expansion(double px, double py, double qx, double qy,
     return n;
 }
 
+/* a - b = x + y exactly */
+static inline void rg_two_diff(double a, double b, double *x, double *y) {
+    double d = a - b;
+    double bv = a - d;
+    double av = d + bv;
+    *x = d;
+    *y = (a - av) + (bv - b);
+}
+
+static double rg_estimate(int n, const double *e) {
+    double sum = 0.0;
+    for (int i = 0; i < n; i++) sum += e[i];
+    return sum;
+}
+
+static inline int rg_sign(double x) { return (x > 0.0) - (x < 0.0); }
+
+/* Exact orientation sign once the plain filter failed. The determinant of the rounded differences, expanded exactly,
+ * decides when the differences were exact (nearby points) or when it clears the second-stage bound; otherwise the
+ * determinant is expanded from the raw coordinates. */
+static int rg_orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy, double detsum) {
+    double acx, acy, bcx, bcy, t0, t1, t2, t3, l[2], r[2], e[12], merged[12];
+    rg_two_diff(ax, cx, &acx, &t0);
+    rg_two_diff(ay, cy, &acy, &t1);
+    rg_two_diff(bx, cx, &bcx, &t2);
+    rg_two_diff(by, cy, &bcy, &t3);
+    rg_two_product(acx, bcy, &l[1], &l[0]);
+    rg_two_product(-acy, bcx, &r[1], &r[0]);
+    int n = rg_sum(2, l, 2, r, e, merged);
+    if (t0 == 0.0 && t1 == 0.0 && t2 == 0.0 && t3 == 0.0) return rg_sign_of(n, e);
+    double est = rg_estimate(n, e);
+    if (fabs(est) >= rigger_ccw_bound_b * detsum) return rg_sign(est);
+    double bound = rigger_ccw_bound_c * detsum + rigger_result_bound * fabs(est);
+    est += (acx * t3 + bcy * t0) - (acy * t2 + bcx * t1);
+    if (fabs(est) >= bound) return rg_sign(est);
+    n = rg_orient_exact_expansion(ax, ay, bx, by, cx, cy, e);
+    return rg_sign_of(n, e);
+}
+
 /* Sign of orient(a, b, c): +1 when counter-clockwise, -1 clockwise, 0 collinear. */
 static inline int rg_orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
     double left = (ax - cx) * (by - cy);
@@ -133,9 +188,7 @@ static inline int rg_orient2d(double ax, double ay, double bx, double by, double
     double bound = rigger_ccw_bound * (fabs(left) + fabs(right));
     if (det > bound) return 1;
     if (-det > bound) return -1;
-    double e[12];
-    int n = rg_orient_exact_expansion(ax, ay, bx, by, cx, cy, e);
-    return rg_sign_of(n, e);
+    return rg_orient2d_exact(ax, ay, bx, by, cx, cy, fabs(left) + fabs(right));
 }
 
 /* Exact x^2 + y^2 (4 doubles). */
@@ -166,6 +219,17 @@ static int rg_incircle_exact(double ax, double ay, double bx, double by, double 
     return tn ? rg_sign_of(tn, total) : 0;
 }
 
+/* x * (p*q - r*s) * x + y * (p*q - r*s) * y, exactly, for one row of the translated in-circle determinant. */
+static int rg_lifted_minor(double x, double y, double p, double q, double r, double s, double *out) {
+    double pq[2], rs[2], minor[4], xm[8], xxm[16], ym[8], yym[16], merged[32];
+    rg_two_product(p, q, &pq[1], &pq[0]);
+    rg_two_product(-r, s, &rs[1], &rs[0]);
+    int mn = rg_sum(2, pq, 2, rs, minor, merged);
+    int n1 = rg_scale(rg_scale(mn, minor, x, xm), xm, x, xxm);
+    int n2 = rg_scale(rg_scale(mn, minor, y, ym), ym, y, yym);
+    return rg_sum(n1, xxm, n2, yym, out, merged);
+}
+
 /* Sign of incircle(a, b, c, d): +1 when d lies strictly inside the circle through counter-clockwise a, b, c. */
 static inline int rg_incircle(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy) {
     double adx = ax - dx, ady = ay - dy, bdx = bx - dx, bdy = by - dy, cdx = cx - dx, cdy = cy - dy;
@@ -178,6 +242,34 @@ static inline int rg_incircle(double ax, double ay, double bx, double by, double
     double bound = rigger_icc_bound * permanent;
     if (det > bound) return 1;
     if (-det > bound) return -1;
+    /* The determinant of the rounded differences, expanded exactly, decides when the differences were exact
+     * (nearby points) or when it clears the second-stage bound; otherwise expand from the raw coordinates. */
+    double t[6], x;
+    rg_two_diff(ax, dx, &x, &t[0]);
+    rg_two_diff(ay, dy, &x, &t[1]);
+    rg_two_diff(bx, dx, &x, &t[2]);
+    rg_two_diff(by, dy, &x, &t[3]);
+    rg_two_diff(cx, dx, &x, &t[4]);
+    rg_two_diff(cy, dy, &x, &t[5]);
+    double ra[32], rb[32], rc[32], ab[64], all[96], merged[96];
+    int na = rg_lifted_minor(adx, ady, bdx, cdy, cdx, bdy, ra);
+    int nb = rg_lifted_minor(bdx, bdy, cdx, ady, adx, cdy, rb);
+    int nc = rg_lifted_minor(cdx, cdy, adx, bdy, bdx, ady, rc);
+    int nab = rg_sum(na, ra, nb, rb, ab, merged);
+    int n = rg_sum(nab, ab, nc, rc, all, merged);
+    if (t[0] == 0.0 && t[1] == 0.0 && t[2] == 0.0 && t[3] == 0.0 && t[4] == 0.0 && t[5] == 0.0)
+        return rg_sign_of(n, all);
+    double est = rg_estimate(n, all);
+    if (fabs(est) >= rigger_icc_bound_b * permanent) return rg_sign(est);
+    /* first-order effect of the differences' tails: d(L_a M_a) = dL_a M_a + L_a dM_a, summed over the rows */
+    bound = rigger_icc_bound_c * permanent + rigger_result_bound * fabs(est);
+    est += (alift * ((bdx * t[5] + cdy * t[2]) - (bdy * t[4] + cdx * t[3])) +
+            2.0 * (adx * t[0] + ady * t[1]) * (bdx * cdy - bdy * cdx)) +
+           (blift * ((cdx * t[1] + ady * t[4]) - (cdy * t[0] + adx * t[5])) +
+            2.0 * (bdx * t[2] + bdy * t[3]) * (cdx * ady - cdy * adx)) +
+           (clift * ((adx * t[3] + bdy * t[0]) - (ady * t[2] + bdx * t[1])) +
+            2.0 * (cdx * t[4] + cdy * t[5]) * (adx * bdy - ady * bdx));
+    if (fabs(est) >= bound) return rg_sign(est);
     return rg_incircle_exact(ax, ay, bx, by, cx, cy, dx, dy);
 }
 
