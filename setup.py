@@ -16,6 +16,8 @@ else:
 
 EXTENSIONS = [
     Extension("rigger._rigger_cdt", ["ext/cdt.pyx"], include_dirs=["ext"], extra_compile_args=COMPILE_ARGS),
+    Extension("rigger._rigger_silhouette", ["ext/silhouette_binding.pyx", "ext/silhouette.c"], include_dirs=["ext"],
+              extra_compile_args=COMPILE_ARGS),
 ]
 
 setup(
@@ -25,7 +27,7 @@ setup(
     license="GPL-3.0-or-later",
     python_requires=">=3.11",
     package_dir={"rigger": "addon"},
-    packages=["rigger", "rigger.core", "rigger.methods"],
+    packages=["rigger", "rigger.blender", "rigger.core", "rigger.methods", "rigger.skeletonize"],
     ext_modules=cythonize(
         EXTENSIONS,
         language_level=3,

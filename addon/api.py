@@ -1,0 +1,56 @@
+"""``rig_mesh``: the one call scripts, the CLI and the Blender layer use to turn a mesh into a skeleton."""
+import time
+
+from .core.mesh import Mesh
+from .core.params import resolve
+from .core.registry import RigMethod, check_method, discover
+from .core.skeleton import Skeleton
+
+_registry = None
+
+
+def method_registry(*, refresh=False, folder=None):
+    """The :class:`~rigger.core.registry.Registry` that ``rig_mesh`` looks method names up in.
+
+    Discovered on first use; ``refresh=True`` discovers again (the Blender layer does so when the add-on is
+    enabled) and ``folder`` discovers another methods folder instead of the shipped one, until the next refresh.
+    """
+    global _registry
+    if _registry is None or refresh or folder is not None:
+        _registry = discover(folder)
+    return _registry
+
+
+def rig_mesh(vertices, triangles, method="silhouette", **params):
+    """Rig a triangle mesh and return its :class:`~rigger.core.skeleton.Skeleton`.
+
+    Args:
+        vertices: (N, 3) array-like of finite coordinates.
+        triangles: (M, 3) array-like of vertex indices.
+        method: a method name from :func:`method_registry`, or a :class:`~rigger.core.registry.RigMethod`
+            subclass (e.g. one defined in a script).
+        **params: the method's parameters by name; values may be strings as typed on a command line.
+
+    Raises ValueError for an unknown method (naming the available ones and any that failed to load), unknown or
+    out-of-range parameters, and bad meshes. The skeleton's ``stages`` gain ``"params"`` (the resolved values) and
+    ``stages["timings"]["total"]`` (seconds for this whole call).
+    """
+    start = time.perf_counter()
+    method_class = _method_class(method)
+    values = resolve(method_class.params, params)
+    mesh = Mesh(vertices, triangles)
+    skeleton = method_class().rig(mesh, **values)
+    if not isinstance(skeleton, Skeleton):
+        raise TypeError(f"method {method_class.name!r} returned {type(skeleton).__name__}, not a Skeleton")
+    skeleton.stages["params"] = values
+    skeleton.stages.setdefault("timings", {})["total"] = time.perf_counter() - start
+    return skeleton
+
+
+def _method_class(method):
+    if isinstance(method, str):
+        return method_registry().lookup(method)
+    if isinstance(method, type) and issubclass(method, RigMethod):
+        check_method(method)
+        return method
+    raise ValueError(f"method must be a method name or a RigMethod subclass, got {method!r}")

@@ -1,0 +1,265 @@
+"""The silhouette rigging method (Pan et al. 2009, "Automatic rigging for animation characters with 3D silhouette").
+
+Pipeline: project the mesh along the axis that shows it widest, trace its silhouette, triangulate it (CDT), take the
+chordal axis of the triangles, merge round blobs and prune outline-noise spurs, root the tree at its most central
+branch point and cut the loops holes make, put every axis point inside the mesh in depth (splitting chains that run
+through several stacked parts, and asking the perpendicular view where the primary one is occluded), then cut the
+chains into bones at sharp turns and at a maximum length. Islands of the silhouette each get their own bones, parented
+to the nearest bone of the largest island.
+"""
+import time
+
+import numpy as np
+
+from .. import cdt, silhouette
+from ..core.params import Param
+from ..core.registry import RigMethod
+from ..core.skeleton import Skeleton
+from ..skeletonize.bones import bone_names, chain_joints, mirror_plane
+from ..skeletonize.chordal import chordal_axis, triangle_classes
+from ..skeletonize.depth import SideAxis, place_chains
+from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chains
+
+AXES = np.eye(3)
+AXIS_NAMES = ("X", "Y", "Z")
+
+
+class SilhouetteMethod(RigMethod):
+    """Skeleton from the chordal axis of the mesh's silhouette, centred in depth."""
+
+    name = "silhouette"
+    label = "Silhouette (Pan 2009)"
+    description = "Chordal axis of the 3D silhouette, centred inside the mesh in depth"
+    params = (
+        Param("view", "enum", "AUTO", items=("AUTO", "X", "Y", "Z"),
+              description="Projection axis; AUTO picks the axis that shows the mesh widest"),
+        Param("resolution", "int", 512, min=64, max=8192,
+              description="Silhouette grid cells along the longest side; higher keeps thinner gaps apart"),
+        Param("outline_spacing", "float", 0.01, min=0.001, max=0.1,
+              description="Longest outline edge fed to the triangulation, as a fraction of the silhouette size"),
+        Param("min_hole", "float", 0.005, min=0.0, max=0.5,
+              description="Holes in the silhouette smaller than this fraction of its area are filled "
+                          "(gaps between parts), larger ones (an arm on the hip) are kept"),
+        Param("merge", "float", 1.0, min=0.0, max=3.0,
+              description="Blob merging: nodes within this many disc radii of a branch point join it"),
+        Param("prune", "float", 0.6, min=0.0, max=5.0,
+              description="Branches reaching less than (1 + prune) disc radii beyond their base are dropped; "
+                          "lower keeps finer branches such as fingers"),
+        Param("bone_angle", "float", 40.0, min=1.0, max=180.0,
+              description="Start a new bone where a chain turns by more than this many degrees"),
+        Param("bone_length", "float", 0.1, min=0.01, max=1.0,
+              description="Longest bone, as a fraction of the mesh's largest extent"),
+        Param("split_layers", "bool", True,
+              description="Split chains whose view rays cross the mesh in separate parts (stacked legs)"),
+        Param("side_view", "bool", True,
+              description="Use the perpendicular silhouette for depth where the primary view is occluded"),
+    )
+
+    def rig(self, mesh, *, view, resolution, outline_spacing, min_hole, merge, prune, bone_angle, bone_length,
+            split_layers, side_view):
+        clock = _Clock()
+        vertices, triangles = mesh.vertices, mesh.triangles
+        axis = choose_axis(vertices, triangles) if view == "AUTO" else AXIS_NAMES.index(view)
+        sil, tri, graph = planar_axis(vertices, triangles, AXES[axis], resolution, outline_spacing, min_hole)
+        clock.lap("silhouette_cdt_axis")
+
+        representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
+        alive = np.unique(representative)
+        _, chains = chains_of(alive.tolist(), merged)
+        kept = prune_spurs(graph.points, graph.radius, chains, prune)
+        clock.lap("merge_prune")
+
+        side = None
+        if side_view:
+            side_axis = max((a for a in range(3) if a != axis), key=lambda a: _spread(vertices, a))
+            side_sil, _, side_graph = planar_axis(vertices, triangles, AXES[side_axis], resolution,
+                                                 outline_spacing, min_hole)
+            side = SideAxis(side_sil, side_graph.points, side_graph.radius, sil.direction)
+        clock.lap("side_view")
+
+        islands = _islands(graph, alive, kept)
+        builder = _BoneBuilder(np.radians(bone_angle), bone_length * mesh.scale)
+        for number, (nodes, links, size) in enumerate(islands):
+            if number and size < bone_length * mesh.scale:
+                continue  # a speck smaller than a bone: skinning gives it to the nearest bone
+            keys, island_chains = chains_of(nodes, links)
+            if not island_chains:
+                builder.add_blob(sil, graph.points[nodes[0]], graph.radius[nodes[0]])
+                continue
+            root, rooted = rooted_chains(graph.points, keys, island_chains, graph.radius)
+            root_point, placed = place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers)
+            builder.add_island(root_point, placed)
+        clock.lap("depth_bones")
+
+        plane = mirror_plane(vertices, 0.01 * mesh.scale)
+        heads, tails, parents = builder.arrays()
+        names = bone_names(builder.chain_of_bone, builder.index_in_chain, heads, tails, plane, 0.05 * mesh.scale)
+        clock.lap("names")
+
+        stages = {
+            "view": sil.direction,
+            "silhouette": {"loops": sil.loops, "origin": sil.origin, "u": sil.u, "v": sil.v,
+                           "direction": sil.direction, "depth": float((mesh.centroid - sil.origin) @ sil.direction)},
+            "cdt": {"vertices": tri.vertices, "triangles": tri.triangles, "classes": triangle_classes(tri)},
+            "axis": {"points": graph.points, "radius": graph.radius, "links": graph.links},
+            "merged": {"links": merged},
+            "pruned": {"links": _removed(merged, kept)},
+            "chains": builder.lines,
+            "joints": np.unique(np.concatenate([heads, tails]), axis=0),
+            "mirror_plane": plane,
+            "timings": clock.laps,
+        }
+        return Skeleton(names, heads, tails, parents, stages=stages)
+
+
+def choose_axis(vertices, triangles):
+    """The axis whose projection spreads the surface widest: the largest sum of the variances of the other two
+    coordinates, over triangle centroids weighted by area (so dense regions do not dominate)."""
+    return int(np.argmax([_spread(vertices, a, triangles) for a in range(3)]))
+
+
+def _spread(vertices, axis, triangles=None):
+    if triangles is None:
+        points, weights = vertices, None
+    else:
+        corners = vertices[triangles]
+        points = corners.mean(axis=1)
+        weights = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+        if not weights.sum() > 0:
+            weights = None
+    others = [a for a in range(3) if a != axis]
+    return float(sum(np.cov(points[:, a], aweights=weights) for a in others))
+
+
+def planar_axis(vertices, triangles, direction, resolution, spacing, min_hole):
+    """Silhouette along ``direction``, its constrained Delaunay triangulation and the chordal axis."""
+    # the tracer's binding wants writable buffers; Mesh arrays are read-only views
+    sil = silhouette.trace(np.array(vertices), np.array(triangles), direction, resolution=resolution)
+    points, segments = _outline(_without_small_holes(sil.loops, min_hole), spacing)
+    tri = cdt.triangulate(points, segments, mode="inside")
+    return sil, tri, chordal_axis(tri)
+
+
+def _without_small_holes(loops, fraction):
+    """Drop the holes (clockwise loops) smaller than ``fraction`` of the silhouette's area."""
+    areas = [0.5 * float(np.sum(l[:, 0] * np.roll(l[:, 1], -1) - np.roll(l[:, 0], -1) * l[:, 1])) for l in loops]
+    total = sum(a for a in areas if a > 0)
+    return [l for l, a in zip(loops, areas) if a > 0 or -a >= fraction * total]
+
+
+def _outline(loops, spacing):
+    """Loop points and closing segments, with long edges subdivided (no point moves, so loops stay simple)."""
+    everything = np.concatenate(loops)
+    step = spacing * float(np.max(everything.max(axis=0) - everything.min(axis=0)))
+    points, segments, offset = [], [], 0
+    for loop in loops:
+        nxt = np.roll(loop, -1, axis=0)
+        pieces = np.maximum(1, np.ceil(np.linalg.norm(nxt - loop, axis=1) / step).astype(int))
+        t = np.concatenate([np.arange(p) / p for p in pieces])
+        start = np.repeat(np.arange(len(loop)), pieces)
+        dense = loop[start] + t[:, None] * (nxt[start] - loop[start])
+        count = len(dense)
+        points.append(dense)
+        segments.append(offset + np.stack([np.arange(count), (np.arange(count) + 1) % count], axis=1))
+        offset += count
+    return np.concatenate(points), np.concatenate(segments)
+
+
+def _islands(graph, alive, links):
+    """(nodes, links, size) per island, the largest (most axis length) first."""
+    result = []
+    for island in np.unique(graph.island[alive]):
+        nodes = alive[graph.island[alive] == island]
+        mask = np.isin(links[:, 0], nodes) if len(links) else np.zeros(0, bool)
+        sub = links[mask]
+        size = float(np.linalg.norm(graph.points[sub[:, 0]] - graph.points[sub[:, 1]], axis=1).sum())
+        size += float(graph.radius[nodes].max())
+        result.append((size, nodes.tolist(), sub))
+    result.sort(key=lambda item: -item[0])
+    return [(nodes, sub, size) for size, nodes, sub in result]
+
+
+def _removed(before, after):
+    kept = set(map(tuple, np.sort(after, axis=1).tolist())) if len(after) else set()
+    gone = [pair for pair in np.sort(before, axis=1).tolist() if tuple(pair) not in kept]
+    return np.array(gone, dtype=np.int64).reshape(-1, 2)
+
+
+class _BoneBuilder:
+    """Accumulates bones island by island; the first island's trunk holds the single root bone."""
+
+    def __init__(self, bone_angle, bone_length):
+        self.bone_angle, self.bone_length = bone_angle, bone_length
+        self.heads, self.tails, self.parents = [], [], []
+        self.chain_of_bone, self.index_in_chain = [], []
+        self.lines = []
+        self.chains = 0
+
+    def add_island(self, root_point, placed):
+        """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk."""
+        roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
+        trunk = max(roots, key=lambda i: placed[i][2])
+        order = [trunk] + [i for i in range(len(placed)) if i != trunk]
+        attach = self._attachment(root_point)
+        last_bone, first_bone = {}, {}
+        for i in order:
+            line, parent, _ = placed[i]
+            joints = chain_joints(line, self.bone_angle, self.bone_length)
+            if parent >= 0:
+                up = last_bone[parent]
+            elif i == trunk:
+                up = attach
+            else:
+                up = first_bone[trunk]
+            chain = self.chains
+            self.chains += 1
+            self.lines.append(line)
+            for k in range(len(joints) - 1):
+                if np.linalg.norm(joints[k + 1] - joints[k]) <= 1e-9 * self.bone_length:
+                    continue
+                self.heads.append(joints[k])
+                self.tails.append(joints[k + 1])
+                self.parents.append(up)
+                self.chain_of_bone.append(chain)
+                self.index_in_chain.append(k)
+                up = len(self.heads) - 1
+                first_bone.setdefault(i, up)
+            last_bone[i] = up
+            first_bone.setdefault(i, up)
+
+    def add_blob(self, sil, point2d, radius):
+        """An island whose axis is a single node (a round speck): one short bone through it, pointing up."""
+        layers = sil.layers(point2d[None])[0]
+        depth = 0.5 * (layers[0, 0] + layers[-1, 1]) if len(layers) else 0.0
+        centre = sil.lift(point2d[None], [depth])[0]
+        half = max(radius, sil.cell) * sil.v
+        self.heads.append(centre - half)
+        self.tails.append(centre + half)
+        self.parents.append(self._attachment(centre))
+        self.chain_of_bone.append(self.chains)
+        self.index_in_chain.append(0)
+        self.lines.append(np.array([centre - half, centre + half]))
+        self.chains += 1
+
+    def _attachment(self, point):
+        """The bone nearest ``point`` (for a new island), or -1 for the first island."""
+        if not self.heads:
+            return -1
+        heads, tails = np.array(self.heads), np.array(self.tails)
+        seg = tails - heads
+        t = np.clip(((point - heads) * seg).sum(1) / np.maximum((seg * seg).sum(1), 1e-300), 0, 1)
+        return int(np.argmin(np.linalg.norm(heads + t[:, None] * seg - point, axis=1)))
+
+    def arrays(self):
+        return np.array(self.heads), np.array(self.tails), np.array(self.parents, dtype=np.int64)
+
+
+class _Clock:
+    def __init__(self):
+        self.laps = {}
+        self._last = time.perf_counter()
+
+    def lap(self, name):
+        now = time.perf_counter()
+        self.laps[name] = now - self._last
+        self._last = now

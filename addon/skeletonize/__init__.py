@@ -1,0 +1,1 @@
+"""Skeleton extraction building blocks: chordal axis, tree surgery, depth placement, bones (bpy-free)."""

@@ -1,0 +1,125 @@
+"""Chordal axis of a triangulated silhouette (Prasad's chordal axis transform, as used by Pan et al. 2009).
+
+Each triangle of the constrained Delaunay triangulation is classified by how many of its edges lie on the outline:
+two make a *terminal* triangle (a branch ends), one a *sleeve* (a branch runs through), none a *junction* (branches
+meet) and three an *isolated* triangle (a whole island). The axis joins the midpoints of the internal edges: a sleeve
+links its two, a junction links its three to its centre, a terminal links its one to its tip.
+
+The result is a :class:`AxisGraph`: points in the silhouette plane with the radius of the part there (half the
+chord, or the junction's circumradius) and undirected links.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+TERMINAL, SLEEVE, JUNCTION, ISOLATED = 2, 1, 0, 3
+CLASS_NAMES = {TERMINAL: "terminal", SLEEVE: "sleeve", JUNCTION: "junction", ISOLATED: "isolated"}
+
+
+@dataclass
+class AxisGraph:
+    """A planar graph along the middle of a shape.
+
+    Attributes:
+        points: (n, 2) node positions in the silhouette plane.
+        radius: (n,) half-width of the shape at each node.
+        junction: (n,) bool, True where branches meet (junction or isolated triangles).
+        links: (m, 2) int node pairs.
+        island: (n,) int, the connected part of the silhouette each node belongs to.
+    """
+
+    points: np.ndarray
+    radius: np.ndarray
+    junction: np.ndarray
+    links: np.ndarray
+    island: np.ndarray
+
+
+def triangle_classes(tri):
+    """Class of every triangle of a ``rigger.cdt`` triangulation (TERMINAL, SLEEVE, JUNCTION or ISOLATED)."""
+    internal = (tri.neighbors >= 0) & ~tri.constrained
+    return 3 - internal.sum(axis=1)
+
+
+def chordal_axis(tri):
+    """The chordal axis of a ``rigger.cdt.Triangulation`` made in mode ``"inside"``, as an :class:`AxisGraph`."""
+    corners = tri.vertices[tri.triangles]                       # (T, 3, 2)
+    internal = (tri.neighbors >= 0) & ~tri.constrained          # (T, 3): edge opposite corner k is internal
+    classes = 3 - internal.sum(axis=1)
+    count = len(tri.triangles)
+
+    # one node per internal edge, numbered from the triangle with the lower index
+    owner_t, owner_k = np.nonzero(internal & (np.arange(count)[:, None] < tri.neighbors))
+    edge_a = corners[owner_t, (owner_k + 1) % 3]
+    edge_b = corners[owner_t, (owner_k + 2) % 3]
+    edge_id = np.full((count, 3), -1, dtype=np.int64)
+    edge_id[owner_t, owner_k] = np.arange(len(owner_t))
+    twin_t = tri.neighbors[owner_t, owner_k]
+    twin_k = np.argmax(tri.neighbors[twin_t] == owner_t[:, None], axis=1)
+    edge_id[twin_t, twin_k] = np.arange(len(owner_t))
+    edge_points = (edge_a + edge_b) / 2
+    edge_radius = np.linalg.norm(edge_a - edge_b, axis=1) / 2
+
+    # one node per junction, terminal and isolated triangle
+    centre_tris = np.flatnonzero(classes != SLEEVE)
+    centre_points, centre_radius = _triangle_centres(corners[centre_tris], classes[centre_tris])
+    centre_id = np.full(count, -1, dtype=np.int64)
+    centre_id[centre_tris] = len(owner_t) + np.arange(len(centre_tris))
+
+    links = []
+    sleeves = np.flatnonzero(classes == SLEEVE)
+    pair = edge_id[sleeves][internal[sleeves]].reshape(-1, 2)
+    links.append(pair)
+    for k in range(3):
+        has = internal[centre_tris, k]
+        links.append(np.stack([centre_id[centre_tris[has]], edge_id[centre_tris[has], k]], axis=1))
+    links = np.concatenate(links).astype(np.int64) if links else np.zeros((0, 2), np.int64)
+
+    points = np.concatenate([edge_points, centre_points])
+    radius = np.concatenate([edge_radius, centre_radius])
+    junction = np.concatenate([np.zeros(len(edge_points), bool), classes[centre_tris] != TERMINAL])
+    return AxisGraph(points, radius, junction, links, _components(len(points), links))
+
+
+def _triangle_centres(corners, classes):
+    """Junctions sit at the circumcentre when it lies inside the triangle (the centre of the largest disc touching
+    the three outline points), otherwise at the centroid; terminals sit at their centroid, near the branch tip."""
+    centroid = corners.mean(axis=1)
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    ab, ac = b - a, c - a
+    denom = 2 * (ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ux = (ac[:, 1] * (ab ** 2).sum(1) - ab[:, 1] * (ac ** 2).sum(1)) / denom
+        uy = (ab[:, 0] * (ac ** 2).sum(1) - ac[:, 0] * (ab ** 2).sum(1)) / denom
+    circum = a + np.stack([ux, uy], axis=1)
+    inside = np.isfinite(circum).all(axis=1) & _inside_triangle(circum, a, b, c)
+    use_circum = inside & (classes != TERMINAL)
+    centre = np.where(use_circum[:, None], circum, centroid)
+    radius = np.linalg.norm(corners - centre[:, None, :], axis=2).min(axis=1)
+    return centre, radius
+
+
+def _inside_triangle(p, a, b, c):
+    def side(u, w):
+        return (w[:, 0] - u[:, 0]) * (p[:, 1] - u[:, 1]) - (w[:, 1] - u[:, 1]) * (p[:, 0] - u[:, 0])
+    return (side(a, b) >= 0) & (side(b, c) >= 0) & (side(c, a) >= 0)
+
+
+def _components(count, links):
+    """Connected component label of every node (union-find, iterative)."""
+    parent = np.arange(count)
+
+    def find(i):
+        root = i
+        while parent[root] != root:
+            root = parent[root]
+        while parent[i] != root:
+            parent[i], i = root, parent[i]
+        return root
+
+    for a, b in links.tolist():
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)
+    roots = np.array([find(i) for i in range(count)], dtype=np.int64)
+    return np.unique(roots, return_inverse=True)[1] if count else roots

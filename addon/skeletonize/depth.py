@@ -1,0 +1,139 @@
+"""Depth: put every planar skeleton chain inside the mesh, in 3D.
+
+Each axis node is a ray along the view direction; ``Silhouette.layers`` gives the depth intervals where that ray is
+inside the mesh. A node is centred in one of them, chosen for continuity along its chain. Where a chain's rays cross
+the mesh in k > 1 separate intervals over most of its length (a quadruped's left and right legs seen from the side),
+the chain is split into k chains, one per interval. Where the chosen interval is much thicker than the part is wide
+(an arm in front of the body merges with it along the ray), the perpendicular silhouette decides, as in Pan et al.:
+its own chordal axis, seen from the side, says at which depth a part of that width and height lies.
+"""
+import numpy as np
+
+# an interval this many times thicker than the part is wide means the part is occluded by (merged with) another
+OCCLUSION_RATIO = 2.5
+
+
+def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
+    """3D polylines for the rooted ``chains`` (see ``tree.rooted_chains``).
+
+    Args:
+        sil: the primary ``Silhouette``.
+        points, radius: the axis nodes (n, 2) in ``sil``'s frame and their half-widths.
+        root: the root node; chains: ``tree.Chain`` list, parents first.
+        side_axis: optional ``SideAxis`` of the perpendicular view, used where the primary view is occluded.
+        split: split chains that run through several separate parts along the view (else follow one).
+
+    Returns (root_point, placed) with ``placed`` a list of (polyline (k, 3), parent_index, mean half-width) —
+    parents first; a split chain yields several entries with the same parent.
+    """
+    used = sorted({root} | {n for c in chains for n in c.nodes})
+    slot = {n: i for i, n in enumerate(used)}
+    layers = sil.layers(points[used])
+    root_layers = layers[slot[root]]
+    root_depth = _middle(root_layers[np.argmax(root_layers[:, 1] - root_layers[:, 0])]) if len(root_layers) else 0.0
+    end_depth = {-1: root_depth}
+    placed = []
+    origin_of = {}  # placed index -> source chain index
+    for ci, chain in enumerate(chains):
+        start_depths = end_depth.get(chain.parent, root_depth)
+        parents = [p for p, src in origin_of.items() if src == chain.parent]
+        node_layers = [layers[slot[n]] for n in chain.nodes]
+        copies = _layer_count(node_layers) if split else 1
+        width = float(radius[chain.nodes].mean())
+        for copy in range(copies):
+            depths = _follow(node_layers, copy, copies, start_depths)
+            depths = _resolve_occlusion(sil, points[chain.nodes], radius[chain.nodes], node_layers, depths, side_axis)
+            line = sil.lift(points[chain.nodes], depths)
+            parent = -1
+            if chain.parent >= 0:
+                # a copy hangs from the copy of its parent chain that ends nearest to it
+                probe = line[min(1, len(line) - 1)]
+                parent = min(parents, key=lambda p: np.linalg.norm(placed[p][0][-1] - probe))
+                line[0] = placed[parent][0][-1]
+            origin_of[len(placed)] = ci
+            placed.append((line, parent, width))
+        end_depth[ci] = depths[-1]
+    return sil.lift(points[[root]], [root_depth])[0], placed
+
+
+def _middle(interval):
+    return 0.5 * (interval[0] + interval[1])
+
+
+def _depth_of(sil, point):
+    return float(np.dot(point - sil.origin, sil.direction))
+
+
+def _layer_count(node_layers):
+    """How many separate parts a chain runs through: the typical interval count over its outer two thirds (the
+    part near its parent often runs into the body)."""
+    counts = np.array([len(layer) for layer in node_layers])
+    outer = counts[len(counts) // 3:]
+    outer = outer[outer > 0]
+    if not len(outer):
+        return 1
+    return int(max(1, np.median(outer)))
+
+
+def _follow(node_layers, copy, copies, start):
+    """Depth along a chain: at nodes with exactly ``copies`` intervals take interval ``copy`` (front to back),
+    elsewhere the interval nearest the previous depth; always the interval's middle."""
+    depths = np.empty(len(node_layers))
+    previous = start
+    for i, layer in enumerate(node_layers):
+        if len(layer) == 0:
+            depths[i] = previous
+            continue
+        if len(layer) == copies:
+            chosen = layer[copy]
+        else:
+            chosen = layer[np.argmin(np.abs(0.5 * (layer[:, 0] + layer[:, 1]) - previous))]
+        depths[i] = previous = _middle(chosen)
+    return depths
+
+
+def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
+    if side_axis is None:
+        return depths
+    out = depths.copy()
+    for i, layer in enumerate(node_layers):
+        if not len(layer):
+            continue
+        interval = layer[np.argmin(np.abs(0.5 * (layer[:, 0] + layer[:, 1]) - depths[i]))]
+        if interval[1] - interval[0] <= OCCLUSION_RATIO * 2 * max(radius[i], sil.cell):
+            continue
+        found = side_axis.depth_at(sil, points[i], radius[i], interval)
+        if found is not None:
+            out[i] = found
+    return out
+
+
+class SideAxis:
+    """The chordal axis of the perpendicular silhouette, indexed for depth look-ups.
+
+    The two views share the axis ``w`` perpendicular to both directions. A primary node at height ``w`` is matched
+    with side-view axis nodes at the same ``w``; their coordinate along the primary direction is the depth.
+    """
+
+    def __init__(self, side_sil, points, radius, primary_direction):
+        world = side_sil.origin + points[:, :1] * side_sil.u + points[:, 1:] * side_sil.v
+        self.w_axis = np.cross(primary_direction, side_sil.direction)
+        self.w = world @ self.w_axis
+        self.along = world @ primary_direction
+        self.radius = radius
+        self.cell = side_sil.cell
+
+    def depth_at(self, sil, point2d, radius, interval):
+        """Depth (in ``sil``'s frame) of the side-view part matching a primary node, inside ``interval``; None if
+        no side-view node fits."""
+        world = sil.origin + point2d[0] * sil.u + point2d[1] * sil.v
+        w0 = float(world @ self.w_axis)
+        base = float(sil.origin @ sil.direction)
+        depth = self.along - base
+        near = np.abs(self.w - w0) <= max(radius, self.cell)
+        near &= (depth >= interval[0]) & (depth <= interval[1])
+        if not near.any():
+            return None
+        candidates = np.flatnonzero(near)
+        best = candidates[np.argmin(np.abs(self.radius[candidates] - radius))]
+        return float(depth[best])

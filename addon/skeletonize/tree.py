@@ -1,0 +1,209 @@
+"""From a chordal-axis graph to a rooted tree of chains: blob merging, spur pruning, cycle cutting, rooting.
+
+A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch points). The steps:
+
+1. Blob merging (Pan's "merge the triangles that lie within one maximal inscribed disc"): every junction, largest
+   first, swallows the axis nodes it reaches without leaving its disc. A round head or belly thus becomes one node
+   instead of a tree of spurious little branches.
+2. Spur pruning: a branch whose end disc pokes out of the disc it hangs on by less than ``prune`` radii is outline
+   noise, not a limb; it is removed, repeatedly, since removing one can expose another.
+3. Rooting at the most central branch point (smallest largest distance to any end), then cutting every cycle (holes
+   in the silhouette) where the two ways around it from the root meet.
+"""
+import heapq
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class Chain:
+    """A polyline of axis nodes from ``nodes[0]`` (towards the root) to ``nodes[-1]``; ``parent`` is the index of
+    the chain it hangs from (-1 for chains leaving the root)."""
+
+    nodes: list
+    parent: int
+
+
+def merge_discs(points, radius, junction, links, scale=1.0):
+    """Contract the nodes each junction's disc (radius times ``scale``) reaches into that junction.
+
+    Returns (representative, links): ``representative[i]`` is the node that node ``i`` became, and the links
+    between representatives (no self-links, no duplicates).
+    """
+    count = len(points)
+    neighbours = _adjacency(count, links)
+    owner = np.full(count, -1, dtype=np.int64)
+    for centre in np.flatnonzero(junction)[np.argsort(-radius[junction], kind="stable")]:
+        if owner[centre] >= 0:
+            continue
+        owner[centre] = centre
+        reach = (scale * radius[centre]) ** 2
+        stack = [centre]
+        while stack:
+            node = stack.pop()
+            for other in neighbours[node]:
+                if owner[other] < 0 and ((points[other] - points[centre]) ** 2).sum() <= reach:
+                    owner[other] = centre
+                    stack.append(other)
+    representative = np.where(owner >= 0, owner, np.arange(count))
+    merged = representative[links] if len(links) else links
+    merged = merged[merged[:, 0] != merged[:, 1]]
+    merged = np.unique(np.sort(merged, axis=1), axis=0) if len(merged) else merged.reshape(0, 2)
+    return representative, merged
+
+
+def chains_of(nodes, links):
+    """Split the graph on ``nodes`` into chains between key nodes (degree other than 2). Returns (keys, chains)
+    with chains as node lists; a cycle without key node is opened at its lowest node."""
+    neighbours = {n: [] for n in nodes}
+    for a, b in links.tolist():
+        neighbours[a].append(b)
+        neighbours[b].append(a)
+    keys = {n for n, adj in neighbours.items() if len(adj) != 2}
+    visited = set()
+    chains = []
+    for start in sorted(keys):
+        for first in neighbours[start]:
+            if (start, first) in visited:
+                continue
+            chains.append(_walk(start, first, neighbours, keys, visited))
+    for start in sorted(neighbours):  # pure cycles
+        if start in keys or any((start, n) in visited for n in neighbours[start]):
+            continue
+        keys.add(start)
+        chains.append(_walk(start, neighbours[start][0], neighbours, keys, visited))
+    return keys, chains
+
+
+def _walk(start, first, neighbours, keys, visited):
+    path = [start, first]
+    visited.add((start, first))
+    visited.add((first, start))
+    while path[-1] not in keys:
+        here, before = path[-1], path[-2]
+        step = neighbours[here][0] if neighbours[here][0] != before else neighbours[here][1]
+        visited.add((here, step))
+        visited.add((step, here))
+        path.append(step)
+    return path
+
+
+def prune_spurs(points, radius, chains, prune):
+    """Drop leaf chains whose end disc reaches less than ``prune`` base radii beyond the disc of the node they hang
+    on, until none does. ``chains`` are node lists; returns the surviving links.
+
+    Measuring the end's disc, not just its centre, keeps short branches that end in a blob (a neck with its head).
+    """
+    chains = [list(c) for c in chains]
+    while True:
+        degree = {}
+        for chain in chains:
+            for end in (chain[0], chain[-1]):
+                degree[end] = degree.get(end, 0) + 1
+        spurs = []
+        for i, chain in enumerate(chains):
+            for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
+                if degree[tip] == 1 and degree[base] >= 3:
+                    beyond = np.linalg.norm(points[tip] - points[base]) + radius[tip] - radius[base]
+                    if beyond <= prune * radius[base]:
+                        spurs.append(i)
+                    break
+        if not spurs:
+            return _links_of(chains)
+        # remove at most one spur per base node per round, the shortest, so a fork never loses all its branches
+        by_base = {}
+        for i in spurs:
+            base = chains[i][0] if degree[chains[i][-1]] == 1 else chains[i][-1]
+            length = _length(points, chains[i])
+            if base not in by_base or length < by_base[base][0]:
+                by_base[base] = (length, i)
+        drop = {i for _, i in by_base.values()}
+        kept = [c for i, c in enumerate(chains) if i not in drop]
+        _, chains = chains_of(sorted({n for c in kept for n in c}), _links_of(kept))
+
+
+def _links_of(chains):
+    pairs = [(c[i], c[i + 1]) for c in chains for i in range(len(c) - 1)]
+    return np.array(pairs, dtype=np.int64).reshape(-1, 2)
+
+
+def _length(points, nodes):
+    return float(np.linalg.norm(np.diff(points[nodes], axis=0), axis=1).sum()) if len(nodes) > 1 else 0.0
+
+
+def rooted_chains(points, keys, chains, radius):
+    """Root the chain graph at its most central branch point and cut its cycles; returns (root, [Chain])
+    ordered parents first."""
+    lengths = [_length(points, c) for c in chains]
+    adjacency = {}
+    for i, c in enumerate(chains):
+        adjacency.setdefault(c[0], []).append((c[-1], i))
+        adjacency.setdefault(c[-1], []).append((c[0], i))
+    branch_points = [k for k in keys if len(adjacency.get(k, ())) >= 3]
+    if branch_points:
+        root = min(branch_points, key=lambda k: (max(_distances(k, adjacency, lengths).values()), -radius[k]))
+    else:
+        return _root_single_path(points, chains, keys)
+    dist, via = _shortest_paths(root, adjacency, lengths)
+    tree = set(via.values())
+    ordered = []
+    chain_of_end = {}
+    # chains on shortest paths, parents first (by distance of their near end)
+    for i in sorted(tree, key=lambda i: min(dist[chains[i][0]], dist[chains[i][-1]])):
+        nodes = chains[i] if dist[chains[i][0]] <= dist[chains[i][-1]] else chains[i][::-1]
+        chain_of_end[nodes[-1]] = len(ordered)
+        ordered.append(Chain(nodes, chain_of_end.get(nodes[0], -1) if nodes[0] != root else -1))
+    # cycles: cut each remaining chain where the ways round from the root meet
+    for i in range(len(chains)):
+        if i in tree:
+            continue
+        nodes = chains[i]
+        steps = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[nodes], axis=0), axis=1))]
+        from_start = dist[nodes[0]] + steps
+        from_end = dist[nodes[-1]] + (steps[-1] - steps)
+        cut = int(np.clip(np.searchsorted(from_start - from_end, 0.0), 1, len(nodes) - 1))
+        for half in (nodes[:cut], nodes[cut:][::-1]):
+            if len(half) > 1:
+                ordered.append(Chain(half, chain_of_end.get(half[0], -1) if half[0] != root else -1))
+    return root, ordered
+
+
+def _root_single_path(points, chains, keys):
+    """A graph without branch points is one path: root it at its middle node."""
+    nodes = chains[0] if chains else sorted(keys)
+    steps = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[nodes], axis=0), axis=1))]
+    middle = int(np.clip(np.searchsorted(steps, steps[-1] / 2), 0, len(nodes) - 1))
+    root = nodes[middle]
+    halves = [nodes[middle:], nodes[:middle + 1][::-1]]
+    return root, [Chain(h, -1) for h in halves if len(h) > 1]
+
+
+def _distances(source, adjacency, lengths):
+    return _shortest_paths(source, adjacency, lengths)[0]
+
+
+def _shortest_paths(source, adjacency, lengths):
+    """Dijkstra over the chain graph: distance to every key node and the chain each was reached through."""
+    dist = {source: 0.0}
+    via = {}
+    heap = [(0.0, source)]
+    while heap:
+        d, node = heapq.heappop(heap)
+        if d > dist[node]:
+            continue
+        for other, chain in adjacency.get(node, ()):
+            nd = d + lengths[chain]
+            if nd < dist.get(other, np.inf):
+                dist[other] = nd
+                via[other] = chain
+                heapq.heappush(heap, (nd, other))
+    return dist, via
+
+
+def _adjacency(count, links):
+    neighbours = [[] for _ in range(count)]
+    for a, b in links.tolist():
+        neighbours[a].append(b)
+        neighbours[b].append(a)
+    return neighbours

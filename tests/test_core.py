@@ -1,0 +1,283 @@
+"""The bpy-free core: mesh validation, polygon triangulation, skeleton trees and parameter coercion."""
+import json
+
+import numpy as np
+import pytest
+
+from rigger.core.mesh import Mesh, triangulate_polygons
+from rigger.core.params import Param, resolve
+from rigger.core.skeleton import Skeleton
+
+TETRA_VERTICES = [(0, 0, 0), (2, 0, 0), (0, 1, 0), (0, 0, 1)]
+TETRA_TRIANGLES = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+
+
+# --- Mesh -----------------------------------------------------------------------------------------------------------
+
+def test_mesh_holds_read_only_float64_and_int32_copies():
+    vertices = np.array(TETRA_VERTICES, dtype=np.int64)
+    mesh = Mesh(vertices, TETRA_TRIANGLES)
+    assert mesh.vertices.dtype == np.float64 and mesh.vertices.shape == (4, 3)
+    assert mesh.triangles.dtype == np.int32 and mesh.triangles.shape == (4, 3)
+    assert mesh.degenerate_count == 0
+    with pytest.raises(ValueError):
+        mesh.vertices[0, 0] = 5.0
+    vertices[0, 0] = 9
+    assert mesh.vertices[0, 0] == 0
+
+
+def test_mesh_geometry_ignores_loose_vertices():
+    mesh = Mesh(TETRA_VERTICES + [(100, 100, 100)], TETRA_TRIANGLES)
+    np.testing.assert_array_equal(mesh.bbox, [[0, 0, 0], [2, 1, 1]])
+    assert mesh.scale == 2.0
+    np.testing.assert_allclose(mesh.centroid, [0.5, 0.25, 0.25])
+
+
+def test_mesh_drops_degenerate_faces_and_counts_them():
+    mesh = Mesh(TETRA_VERTICES, TETRA_TRIANGLES + [(1, 1, 2), (3, 0, 3)])
+    assert mesh.degenerate_count == 2
+    np.testing.assert_array_equal(mesh.triangles, TETRA_TRIANGLES)
+
+
+@pytest.mark.parametrize("vertices, triangles, fragment", [
+    ([], TETRA_TRIANGLES, "no vertices"),
+    (TETRA_VERTICES, [], "no triangles"),
+    (np.zeros((4, 2)), TETRA_TRIANGLES, "shape (N, 3)"),
+    (np.zeros((2, 4, 3)), TETRA_TRIANGLES, "shape (N, 3)"),
+    (TETRA_VERTICES, [(0, 1, 2, 3)], "shape (M, 3)"),
+    ([(0, 0, 0), (1, 0)], TETRA_TRIANGLES, "rectangular array"),
+    ([("a", "b", "c")] * 4, TETRA_TRIANGLES, "real numbers"),
+    (np.ones((4, 3), dtype=bool), TETRA_TRIANGLES, "real numbers"),
+    (TETRA_VERTICES, np.array(TETRA_TRIANGLES, dtype=float), "integer vertex indices"),
+    (TETRA_VERTICES[:3] + [(0, np.nan, 1)], TETRA_TRIANGLES, "NaN or infinite coordinates (the first is vertex 3)"),
+    (TETRA_VERTICES[:3] + [(0, np.inf, 1)], TETRA_TRIANGLES, "NaN or infinite"),
+    (TETRA_VERTICES, TETRA_TRIANGLES + [(0, 1, 4)], "reference vertex 4 but the mesh has only 4 vertices"),
+    (TETRA_VERTICES, TETRA_TRIANGLES + [(0, -1, 2)], "negative vertex index -1"),
+    (TETRA_VERTICES, [(0, 0, 1), (2, 2, 2)], "all 2 triangles are degenerate"),
+    ([(1, 1, 1)] * 4, TETRA_TRIANGLES, "zero size"),
+    ([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)], [(0, 1, 2), (1, 3, 2)], "flat"),
+    ([(0, 0, 0), (1, 1, 1), (2, 2, 2), (3, 3, 3)], [(0, 1, 2), (1, 2, 3)], "flat"),
+])
+def test_mesh_rejects_bad_input_with_a_clear_message(vertices, triangles, fragment):
+    with pytest.raises(ValueError) as error:
+        Mesh(vertices, triangles)
+    assert fragment in str(error.value)
+
+
+def test_flat_check_is_scale_and_position_free():
+    vertices = np.array(TETRA_VERTICES, dtype=float)
+    for scale, offset in ((1e-3, 1e3), (1e3, -1e3)):
+        Mesh(vertices * scale + offset, TETRA_TRIANGLES)
+
+
+def test_triangulate_polygons_fans_each_face_in_order():
+    triangles = triangulate_polygons([(0, 1, 2), (3, 4, 5, 6), (7, 8, 9, 10, 11)])
+    assert triangles.dtype == np.int32
+    np.testing.assert_array_equal(triangles, [(0, 1, 2), (3, 4, 5), (3, 5, 6), (7, 8, 9), (7, 9, 10), (7, 10, 11)])
+    assert triangulate_polygons([]).shape == (0, 3)
+
+
+@pytest.mark.parametrize("faces, fragment", [
+    ([(0, 1, 2), (3, 4)], "face 1 has 2 vertices"),
+    ([(0, 1.5, 2)], "must be integers"),
+    ([(0, 1, 2**40)], "32 bits"),
+])
+def test_triangulate_polygons_rejects_bad_faces(faces, fragment):
+    with pytest.raises(ValueError) as error:
+        triangulate_polygons(faces)
+    assert fragment in str(error.value)
+
+
+# --- Skeleton -------------------------------------------------------------------------------------------------------
+
+def arm():
+    """root -> upper -> lower, with a second child 'side' of root starting away from root's tail."""
+    names = ["root", "upper", "lower", "side"]
+    heads = [(0, 0, 0), (0, 0, 1), (0, 0, 2), (1, 0, 0)]
+    tails = [(0, 0, 1), (0, 0, 2), (0, 0, 3), (2, 0, 0)]
+    return Skeleton(names, heads, tails, [-1, 0, 1, 0], stages={"note": "kept"})
+
+
+def test_skeleton_tree_queries():
+    skeleton = arm()
+    assert len(skeleton) == 4
+    assert skeleton.roots == (0,)
+    assert skeleton.children(0) == (1, 3) and skeleton.children(2) == ()
+    assert skeleton.parents.dtype == np.int32
+    assert skeleton.stages == {"note": "kept"}
+    # heads of all bones plus tails of the leaves 'lower' and 'side'
+    np.testing.assert_array_equal(skeleton.joints(), [(0, 0, 0), (0, 0, 1), (0, 0, 2), (1, 0, 0), (0, 0, 3), (2, 0, 0)])
+
+
+def test_joints_lists_coincident_heads_once():
+    skeleton = Skeleton(["a", "b", "c"], [(0, 0, 0), (0, 0, 1), (0, 0, 1)], [(0, 0, 1), (1, 0, 1), (-1, 0, 1)],
+                        [-1, 0, 0])
+    np.testing.assert_array_equal(skeleton.joints(), [(0, 0, 0), (0, 0, 1), (1, 0, 1), (-1, 0, 1)])
+
+
+def test_parents_may_come_after_children_and_several_roots_are_allowed():
+    skeleton = Skeleton(["hand", "arm", "prop"], [(0, 0, 1), (0, 0, 0), (5, 5, 5)], [(0, 0, 2), (0, 0, 1), (5, 5, 6)],
+                        [1, -1, -1])
+    assert skeleton.roots == (1, 2) and skeleton.children(1) == (0,)
+
+
+@pytest.mark.parametrize("names, heads, tails, parents, fragment", [
+    ([], [], [], [], "at least one bone"),
+    ("ab", [(0, 0, 0)] * 2, [(0, 0, 1)] * 2, [-1, 0], "not one string"),
+    (["a", "a"], [(0, 0, 0)] * 2, [(0, 0, 1)] * 2, [-1, 0], "'a' is used twice"),
+    (["a", ""], [(0, 0, 0)] * 2, [(0, 0, 1)] * 2, [-1, 0], "non-empty strings"),
+    (["a", 3], [(0, 0, 0)] * 2, [(0, 0, 1)] * 2, [-1, 0], "non-empty strings"),
+    (["a", "b"], [(0, 0, 0)], [(0, 0, 1)] * 2, [-1, 0], "heads must have shape (2, 3)"),
+    (["a", "b"], [(0, 0, 0)] * 2, [(0, 0, 1), (0, np.nan, 1)], [-1, 0], "tails contain NaN"),
+    (["a", "b"], [(0, 0, 0)] * 2, [(0, 0, 1), (0, 0, 0)], [-1, 0], "bone 'b' has zero length"),
+    (["a", "b"], [(0, 0, 0)] * 2, [(0, 0, 1)] * 2, [-1, 2], "between 0 and 1"),
+    (["a", "b"], [(0, 0, 0)] * 2, [(0, 0, 1)] * 2, [-2, 0], "between 0 and 1"),
+    (["a", "b"], [(0, 0, 0)] * 2, [(0, 0, 1)] * 2, [-1.0, 0.0], "integer bone indices"),
+    (["a", "b"], [(0, 0, 0)] * 2, [(0, 0, 1)] * 2, [-1], "integer bone indices"),
+    (["a", "b"], [(0, 0, 0)] * 2, [(0, 0, 1)] * 2, [-1, 1], "cycle: b"),
+    (["a", "b", "c"], [(0, 0, 0)] * 3, [(0, 0, 1)] * 3, [1, 2, 0], "cycle: a -> b -> c"),
+    (["r", "a", "b"], [(0, 0, 0)] * 3, [(0, 0, 1)] * 3, [-1, 2, 1], "cycle: a -> b"),
+])
+def test_skeleton_rejects_invalid_trees(names, heads, tails, parents, fragment):
+    with pytest.raises(ValueError) as error:
+        Skeleton(names, heads, tails, parents)
+    assert fragment in str(error.value)
+
+
+def test_to_dict_round_trips_through_json():
+    skeleton = arm()
+    data = json.loads(json.dumps(skeleton.to_dict()))
+    assert data["bones"][0] == {"name": "root", "head": [0.0, 0.0, 0.0], "tail": [0.0, 0.0, 1.0], "parent": None}
+    assert [bone["parent"] for bone in data["bones"]] == [None, "root", "upper", "root"]
+    data["bones"].reverse()  # parents listed after their children
+    back = Skeleton.from_dict(data)
+    assert back.names == tuple(reversed(skeleton.names))
+    order = [back.names.index(name) for name in skeleton.names]
+    np.testing.assert_array_equal(back.heads[order], skeleton.heads)
+    np.testing.assert_array_equal(back.tails[order], skeleton.tails)
+    assert [back.names[p] if p >= 0 else None for p in back.parents[order]] == [None, "root", "upper", "root"]
+
+
+@pytest.mark.parametrize("data, fragment", [
+    ({}, "needs 'bones'"),
+    ({"bones": [{"name": "a", "head": [0, 0, 0], "tail": [0, 0, 1]}]}, "needs 'bones'"),
+    ({"bones": [{"name": "a", "head": [0, 0, 0], "tail": [0, 0, 1], "parent": "b"}]}, "parent 'b' is not a bone"),
+])
+def test_from_dict_rejects_malformed_data(data, fragment):
+    with pytest.raises(ValueError) as error:
+        Skeleton.from_dict(data)
+    assert fragment in str(error.value)
+
+
+def test_transformed_applies_an_affine_matrix_and_keeps_the_tree():
+    skeleton = arm()
+    matrix = np.array([[0, -2, 0, 10], [2, 0, 0, 0], [0, 0, 2, -1], [0, 0, 0, 1]], dtype=float)
+    moved = skeleton.transformed(matrix)
+    np.testing.assert_allclose(moved.heads[3], [10, 2, -1])
+    np.testing.assert_allclose(moved.tails[2], [10, 0, 5])
+    np.testing.assert_array_equal(moved.parents, skeleton.parents)
+    assert moved.names == skeleton.names and moved.stages is skeleton.stages
+    back = moved.transformed(np.linalg.inv(matrix))
+    np.testing.assert_allclose(back.heads, skeleton.heads, atol=1e-12)
+
+
+@pytest.mark.parametrize("matrix, fragment", [
+    (np.eye(3), "4x4"),
+    (np.full((4, 4), np.nan), "4x4"),
+    (np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]), "affine"),
+    (np.diag([1, 0, 1, 1]), "singular"),
+])
+def test_transformed_rejects_bad_matrices(matrix, fragment):
+    with pytest.raises(ValueError) as error:
+        arm().transformed(matrix)
+    assert fragment in str(error.value)
+
+
+def test_skeleton_arrays_are_read_only():
+    skeleton = arm()
+    for array in (skeleton.heads, skeleton.tails, skeleton.parents):
+        with pytest.raises(ValueError):
+            array[0] = 0
+
+
+# --- Param and resolve ----------------------------------------------------------------------------------------------
+
+PARAMS = (
+    Param("bone_angle", "float", 30.0, min=0, max=180, description="Turn that starts a new bone, degrees"),
+    Param("bones", "int", 3, min=1, max=64),
+    Param("mirror", "bool", True),
+    Param("axis", "enum", "AUTO", items=("AUTO", "X", "Y", "Z")),
+    Param("view", "vector", (0, 0, 1), min=-1, max=1),
+)
+
+
+def test_resolve_fills_defaults_and_coerces_python_values():
+    assert resolve(PARAMS, {}) == {"bone_angle": 30.0, "bones": 3, "mirror": True, "axis": "AUTO",
+                                   "view": (0.0, 0.0, 1.0)}
+    values = resolve(PARAMS, {"bone_angle": np.float32(45), "bones": np.int64(5), "mirror": 0, "axis": "Y",
+                              "view": np.array([0, 1, 0])})
+    assert values == {"bone_angle": 45.0, "bones": 5, "mirror": False, "axis": "Y", "view": (0.0, 1.0, 0.0)}
+    assert type(values["bones"]) is int and type(values["bone_angle"]) is float
+
+
+def test_resolve_coerces_command_line_strings():
+    values = resolve(PARAMS, {"bone_angle": " 12.5", "bones": "7", "mirror": "off", "axis": "x",
+                              "view": "0, -1 0"})
+    assert values == {"bone_angle": 12.5, "bones": 7, "mirror": False, "axis": "X", "view": (0.0, -1.0, 0.0)}
+    assert resolve(PARAMS, {"mirror": "YES", "bones": "4.0"})["mirror"] is True
+
+
+@pytest.mark.parametrize("given, fragment", [
+    ({"bone_angle": "wide"}, "'bone_angle': expected a finite number, got 'wide'"),
+    ({"bone_angle": float("nan")}, "expected a finite number"),
+    ({"bone_angle": True}, "expected a finite number"),
+    ({"bone_angle": 181}, "181.0 is above the maximum 180"),
+    ({"bones": 0}, "0 is below the minimum 1"),
+    ({"bones": 2.5}, "expected an integer"),
+    ({"bones": "three"}, "expected an integer"),
+    ({"mirror": "maybe"}, "expected a boolean"),
+    ({"mirror": 2}, "expected a boolean"),
+    ({"axis": "W"}, "expected one of AUTO, X, Y, Z"),
+    ({"axis": 1}, "expected one of AUTO, X, Y, Z"),
+    ({"view": "0,1"}, "expected three numbers"),
+    ({"view": 5}, "expected three numbers"),
+    ({"view": (0, 2, 0)}, "2.0 is above the maximum 1"),
+    ({"view": ("a", 0, 0)}, "three finite numbers"),
+    ({"bone_angel": 3, "bonez": 1},
+     "unknown parameters bone_angel, bonez; valid: bone_angle, bones, mirror, axis, view"),
+])
+def test_resolve_rejects_bad_values_with_the_parameter_named(given, fragment):
+    with pytest.raises(ValueError) as error:
+        resolve(PARAMS, given)
+    assert fragment in str(error.value)
+
+
+def test_resolve_with_no_declared_params():
+    assert resolve((), {}) == {}
+    with pytest.raises(ValueError, match="unknown parameter x; valid: none"):
+        resolve((), {"x": 1})
+
+
+def test_param_label_defaults_from_the_name():
+    assert PARAMS[0].label == "Bone angle"
+    assert Param("x", "bool", False, label="Mirror X").label == "Mirror X"
+
+
+@pytest.mark.parametrize("kwargs, fragment", [
+    (dict(name="bad name", type="int", default=1), "Python identifier"),
+    (dict(name="n", type="string", default="a"), "type must be one of"),
+    (dict(name="n", type="int", default=0, min=1), "0 is below the minimum 1"),
+    (dict(name="n", type="int", default=1, min=2, max=1), "min 2 exceeds max 1"),
+    (dict(name="n", type="int", default=1, min=float("inf")), "finite numbers"),
+    (dict(name="n", type="bool", default=True, max=1), "only to float, int and vector"),
+    (dict(name="n", type="enum", default="A"), "needs items"),
+    (dict(name="n", type="enum", default="A", items="AB"), "needs items"),
+    (dict(name="n", type="enum", default="A", items=("A", "a")), "differ ignoring case"),
+    (dict(name="n", type="enum", default="C", items=("A", "B")), "expected one of A, B"),
+    (dict(name="n", type="float", default=1.0, items=("A",)), "only to enum"),
+    (dict(name="n", type="float", default=1.0, description=None), "must be strings"),
+])
+def test_param_declaration_is_validated(kwargs, fragment):
+    with pytest.raises(ValueError) as error:
+        Param(**kwargs)
+    assert fragment in str(error.value)

@@ -1,0 +1,250 @@
+"""Method discovery (error isolation, re-discovery, order) and the rig_mesh entry point."""
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import rigger
+from rigger import api
+from rigger.core.params import Param
+from rigger.core.registry import RigMethod, discover
+from rigger.core.skeleton import Skeleton
+from rigger.methods._template import TemplateMethod
+
+BOX_VERTICES = [(x, y, z) for x in (0, 1) for y in (0, 4) for z in (0, 1)]
+BOX_TRIANGLES = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
+                 (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+
+
+def stick_method(name, class_name="Stick"):
+    """Source of a one-bone method: a stick of ``length`` up from the centroid."""
+    return f"""
+        from rigger.core.params import Param
+        from rigger.core.registry import RigMethod
+        from rigger.core.skeleton import Skeleton
+
+        class {class_name}(RigMethod):
+            name = "{name}"
+            params = (Param("length", "float", 1.0, min=0.1),)
+
+            def rig(self, mesh, length):
+                head = mesh.centroid
+                return Skeleton(["stick"], [head], [head + (0, 0, length)], [-1], stages={{"timings": {{"up": 0.5}}}})
+        """
+
+
+def write(folder, filename, source):
+    (folder / filename).write_text(textwrap.dedent(source))
+
+
+@pytest.fixture
+def scratch_registry(monkeypatch):
+    """Let a test point rig_mesh at another methods folder; the previous registry comes back afterwards."""
+    monkeypatch.setattr(api, "_registry", None)
+
+
+# --- discovery ------------------------------------------------------------------------------------------------------
+
+def test_discovery_collects_good_methods_and_records_broken_modules(tmp_path):
+    write(tmp_path, "stick.py", stick_method("stick"))
+    write(tmp_path, "broken_syntax.py", "def rig(:\n    pass\n")
+    write(tmp_path, "broken_import.py", "import numpy\nimport rigger_no_such_module\n")
+    write(tmp_path, "broken_runtime.py", "x = 1\nraise RuntimeError('boom')\n")
+    write(tmp_path, "exits.py", "import sys\nsys.exit(3)\n")
+    write(tmp_path, "helpers.py", "SCALE = 2\n")
+    write(tmp_path, "_private.py", stick_method("private"))
+    write(tmp_path, "notes.txt", "not python")
+    registry = discover(tmp_path)
+    assert list(registry.methods) == ["stick"]
+    assert issubclass(registry.methods["stick"], RigMethod)
+    assert set(registry.failures) == {"broken_syntax.py", "broken_import.py", "broken_runtime.py", "exits.py"}
+    assert registry.failures["broken_syntax.py"].startswith("SyntaxError:")
+    assert "(line 1)" in registry.failures["broken_syntax.py"]
+    assert registry.failures["broken_import.py"] == \
+        "ModuleNotFoundError: No module named 'rigger_no_such_module' (line 2)"
+    assert registry.failures["broken_runtime.py"] == "RuntimeError: boom (line 2)"
+    assert registry.failures["exits.py"].startswith("SystemExit: 3")
+
+
+def test_methods_are_sorted_by_name_not_by_file(tmp_path):
+    write(tmp_path, "a_file.py", stick_method("omega"))
+    write(tmp_path, "m_file.py", stick_method("beta", "B") + stick_method("alpha", "A"))
+    write(tmp_path, "z_file.py", stick_method("gamma"))
+    assert list(discover(tmp_path).methods) == ["alpha", "beta", "gamma", "omega"]
+
+
+def test_invalid_methods_are_recorded_and_skipped_without_losing_valid_neighbours(tmp_path):
+    write(tmp_path, "a_first.py", stick_method("twin"))
+    write(tmp_path, "b_mixed.py", stick_method("fine") + """
+        class Nameless(RigMethod):
+            def rig(self, mesh):
+                pass
+
+        class BadParams(RigMethod):
+            name = "bad_params"
+            params = ("length",)
+            def rig(self, mesh):
+                pass
+
+        class Reserved(RigMethod):
+            name = "reserved"
+            params = (Param("method", "int", 1),)
+            def rig(self, mesh, method):
+                pass
+
+        class NoRig(RigMethod):
+            name = "no_rig"
+        """)
+    write(tmp_path, "c_second.py", stick_method("twin", "Twin"))
+    registry = discover(tmp_path)
+    assert list(registry.methods) == ["fine", "twin"]
+    assert registry.methods["twin"].__name__ == "Stick"
+    assert registry.failures == {
+        "b_mixed.py:Nameless": "method name must be a Python identifier, got ''",
+        "b_mixed.py:BadParams": "method 'bad_params': params must be a tuple of Param",
+        "b_mixed.py:Reserved": "method 'reserved': parameter name 'method' is reserved",
+        "b_mixed.py:NoRig": "method 'no_rig' does not define rig(mesh, **params)",
+        "c_second.py:Twin": "duplicate method name 'twin', already defined in a_first.py:Stick",
+    }
+
+
+def test_a_bad_param_declaration_fails_its_module(tmp_path):
+    write(tmp_path, "bad_default.py", """
+        from rigger.core.params import Param
+        LENGTH = Param("length", "float", -1.0, min=0.0)
+        """)
+    assert discover(tmp_path).failures == {
+        "bad_default.py": "ValueError: parameter 'length': -1.0 is below the minimum 0.0 (line 3)"}
+
+
+def test_methods_imported_from_another_module_are_not_collected_again(tmp_path):
+    write(tmp_path, "reexport.py", "from rigger.methods._template import TemplateMethod\n")
+    registry = discover(tmp_path)
+    assert dict(registry.methods) == {} and dict(registry.failures) == {}
+
+
+def test_rediscovery_sees_added_edited_and_removed_files(tmp_path, monkeypatch):
+    monkeypatch.setattr(sys, "dont_write_bytecode", False)  # as inside Blender, where .pyc files get written
+    write(tmp_path, "first.py", stick_method("first"))
+    assert list(discover(tmp_path).methods) == ["first"]
+
+    write(tmp_path, "second.py", stick_method("second"))
+    assert list(discover(tmp_path).methods) == ["first", "second"]
+
+    # Same size, same second: a .pyc keyed on modification time would serve the old name.
+    write(tmp_path, "first.py", stick_method("fixed"))
+    assert list(discover(tmp_path).methods) == ["fixed", "second"]
+
+    (tmp_path / "second.py").unlink()
+    write(tmp_path, "first.py", "raise ImportError('now broken')\n")
+    registry = discover(tmp_path)
+    assert dict(registry.methods) == {}
+    assert registry.failures == {"first.py": "ImportError: now broken (line 1)"}
+
+    write(tmp_path, "first.py", stick_method("first"))
+    registry = discover(tmp_path)
+    assert list(registry.methods) == ["first"] and dict(registry.failures) == {}
+
+
+def test_shipped_methods_all_load_and_the_template_is_skipped():
+    registry = discover()
+    assert dict(registry.failures) == {}
+    assert "template" not in registry.methods
+    assert list(registry.methods) == sorted(registry.methods)
+
+
+def test_lookup_of_an_unknown_name_lists_available_methods_and_failures(tmp_path):
+    write(tmp_path, "stick.py", stick_method("stick"))
+    write(tmp_path, "broken.py", "import rigger_no_such_module\n")
+    with pytest.raises(ValueError) as error:
+        discover(tmp_path).lookup("stik")
+    assert str(error.value) == ("unknown method 'stik'; available: stick; failed to load: "
+                                "broken.py: ModuleNotFoundError: No module named 'rigger_no_such_module' (line 1)")
+
+
+# --- rig_mesh -------------------------------------------------------------------------------------------------------
+
+def test_rig_mesh_runs_a_method_discovered_from_a_folder(tmp_path, scratch_registry):
+    write(tmp_path, "stick.py", stick_method("stick"))
+    assert list(api.method_registry(folder=tmp_path).methods) == ["stick"]
+    skeleton = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method="stick", length="0.5")
+    assert isinstance(skeleton, rigger.Skeleton)
+    np.testing.assert_allclose(skeleton.heads, [(0.5, 2, 0.5)])
+    np.testing.assert_allclose(skeleton.tails, [(0.5, 2, 1.0)])
+    assert skeleton.stages["params"] == {"length": 0.5}
+    timings = skeleton.stages["timings"]
+    assert timings["up"] == 0.5 and 0 < timings["total"] < 10
+
+
+def test_rig_mesh_errors_name_what_is_wrong(tmp_path, scratch_registry):
+    write(tmp_path, "stick.py", stick_method("stick"))
+    write(tmp_path, "broken.py", "import rigger_no_such_module\n")
+    api.method_registry(folder=tmp_path)
+    with pytest.raises(ValueError, match=r"unknown method 'silhouette'; available: stick; failed to load: broken.py"):
+        rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES)
+    with pytest.raises(ValueError, match=r"unknown parameter lenght; valid: length"):
+        rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method="stick", lenght=2)
+    with pytest.raises(ValueError, match=r"'length': 0.0 is below the minimum 0.1"):
+        rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method="stick", length=0)
+    with pytest.raises(ValueError, match=r"reference vertex 8 but the mesh has only 8 vertices"):
+        rigger.rig_mesh(BOX_VERTICES, [(0, 1, 8)], method="stick")
+    with pytest.raises(ValueError, match=r"method must be a method name or a RigMethod subclass"):
+        rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=None)
+
+
+def test_rig_mesh_accepts_a_method_class_and_checks_it():
+    class Wrong(RigMethod):
+        name = "wrong"
+
+        def rig(self, mesh):
+            return [("bone", (0, 0, 0), (0, 0, 1))]
+
+    with pytest.raises(TypeError, match="method 'wrong' returned list, not a Skeleton"):
+        rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=Wrong)
+
+    class Shadowing(Wrong):
+        params = (Param("vertices", "int", 1),)
+
+    with pytest.raises(ValueError, match="parameter name 'vertices' is reserved"):
+        rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=Shadowing)
+
+
+def test_the_template_method_rigs_a_chain_along_the_main_axis():
+    skeleton = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=TemplateMethod, bones="4")
+    assert skeleton.names == ("chain.000", "chain.001", "chain.002", "chain.003")
+    assert list(skeleton.parents) == [-1, 0, 1, 2]
+    np.testing.assert_allclose(skeleton.heads[1:], skeleton.tails[:-1])
+    np.testing.assert_allclose(abs(skeleton.stages["axis"]), [0, 1, 0], atol=1e-12)
+    ends = sorted([skeleton.heads[0][1], skeleton.tails[-1][1]])
+    np.testing.assert_allclose(ends, [0, 4])
+    np.testing.assert_allclose(skeleton.heads[:, [0, 2]], 0.5)
+    assert set(skeleton.stages["timings"]) == {"axis", "chain", "total"}
+    along_z = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=TemplateMethod, axis="z")
+    np.testing.assert_allclose(along_z.heads[0], [0.5, 2, 0])
+    assert len(along_z) == 3
+
+
+def test_the_template_draw_hook_uses_only_layout_and_props():
+    class Layout:
+        def label(self, text):
+            self.text = text
+
+    class Props:
+        bones, axis = 5, "X"
+
+    layout = Layout()
+    TemplateMethod().draw(layout, Props())
+    assert layout.text == "5 bones along X"
+    assert RigMethod().draw(layout, Props()) is None
+
+
+def test_import_rigger_is_cheap_and_exports_lazily():
+    probe = ("import sys, rigger; heavy = [m for m in ('numpy', 'bpy', 'rigger.api') if m in sys.modules]; "
+             "print(heavy); print(rigger.rig_mesh.__module__, rigger.Skeleton.__module__)")
+    result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    assert result.stdout.split("\n")[:2] == ["[]", "rigger.api rigger.core.skeleton"]
+    assert rigger.Skeleton is Skeleton
+    with pytest.raises(AttributeError, match="has no attribute 'rig_meshes'"):
+        rigger.rig_meshes

@@ -1,0 +1,244 @@
+"""The quality benchmark's data and scoring library (bench/rigdata.py) and its baseline skeleton helpers."""
+import pathlib
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import shared_path
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "bench"))
+import quality  # noqa: E402  (bench/ is not a package)
+import rigdata  # noqa: E402
+
+CUBE_VERTICES = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
+# Outward-facing quads of the unit cube (vertex index = 4x + 2y + z).
+CUBE_QUADS = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+
+
+def cube_triangles(quads=CUBE_QUADS):
+    return np.array([tri for a, b, c, d in quads for tri in ((a, b, c), (a, c, d))])
+
+
+def write(tmp_path, name, text):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+# --- OBJ loader ---------------------------------------------------------------------------------------------------
+
+def test_obj_polygons_are_fan_triangulated_and_corner_forms_read(tmp_path):
+    path = write(tmp_path, "poly.obj", "\n".join([
+        "# a quad and a pentagon", "o thing",
+        *(f"v {x} {y} 0 1.0" for x, y in [(0, 0), (1, 0), (1, 1), (0, 1), (2, 0), (2, 1), (1.5, 2)]),
+        "vt 0 0", "vn 0 0 1",
+        "f 1/1/1 2/1/1 3//1 4",
+        "f 2/1 5/1 6/1 7/1 3/1",
+        "l 1 2",
+    ]))
+    vertices, triangles = rigdata.load_obj(path)
+    assert vertices.shape == (7, 3) and vertices[6].tolist() == [1.5, 2.0, 0.0]
+    assert triangles.tolist() == [[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 6], [1, 6, 2]]
+
+
+def test_obj_negative_indices_count_back_from_the_face(tmp_path):
+    path = write(tmp_path, "neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 0 0 1\nf -4/1 -3/1 -1/1\n")
+    vertices, triangles = rigdata.load_obj(path)
+    assert triangles.tolist() == [[0, 1, 2], [0, 1, 3]]
+
+
+@pytest.mark.parametrize("text, message", [
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "index 0"),
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "out of range"),
+    ("v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n", "out of range"),
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", "at least 3 corners"),
+    ("v 0 0\n", "3 coordinates"),
+    ("v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "non-finite"),
+    ("v 0 0 x\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "unreadable"),
+    ("# nothing\n", "no vertices"),
+])
+def test_obj_bad_input_is_a_clear_value_error(tmp_path, text, message):
+    with pytest.raises(ValueError, match=message):
+        rigdata.load_obj(write(tmp_path, "bad.obj", text))
+
+
+# --- rig_info parser and helper filter ----------------------------------------------------------------------------
+
+RIG_TEXT = """joints hips 0 1 0
+joints spine 0 2 0
+joints PoleTarget.L 1 1 1
+joints foot 0 0 1
+joints head 0 3 0
+root hips
+hier hips spine
+hier spine head
+hier hips PoleTarget.L
+hier PoleTarget.L foot
+skin 0 hips 0.25 spine 0.75
+skin 2 head 1.0
+"""
+
+
+def test_rig_parser_reads_joints_hierarchy_and_sparse_skin(tmp_path):
+    rig = rigdata.load_rig(write(tmp_path, "r_rig.txt", RIG_TEXT), n_vertices=4)
+    assert rig.names == ("hips", "spine", "PoleTarget.L", "foot", "head") and rig.root == "hips"
+    assert rig.positions[3].tolist() == [0.0, 0.0, 1.0]
+    assert rig.parents.tolist() == [-1, 0, 0, 2, 1]
+    assert rig.skin.shape == (4, 5)
+    assert rig.skin.toarray()[0].tolist() == [0.25, 0.75, 0, 0, 0] and rig.skin[2, 4] == 1.0 and rig.skin[1].nnz == 0
+
+
+def test_helper_joints_are_dropped_and_their_children_reparented(tmp_path):
+    rig = rigdata.load_rig(write(tmp_path, "r_rig.txt", RIG_TEXT)).without_helpers()
+    assert rig.names == ("hips", "spine", "foot", "head")
+    assert rig.parents.tolist() == [-1, 0, 0, 1]
+    assert rig.skin.shape[1] == 4
+    bones = rig.bones()
+    assert bones.heads.tolist() == [[0, 1, 0], [0, 1, 0], [0, 2, 0]]
+    assert bones.tails.tolist() == [[0, 2, 0], [0, 0, 1], [0, 3, 0]]
+    assert bones.parents.tolist() == [-1, -1, 0]
+
+
+@pytest.mark.parametrize("extra, message", [
+    ("hier hips ghost\n", "unknown joint"),
+    ("hier head hips\n", "two parents|cycle"),
+    ("joints hips 0 0 0\n", "twice"),
+    ("skin 0 ghost 1.0\n", "unknown joint"),
+    ("joints arm 0 x 0\n", "unreadable number"),
+    ("bones a b\n", "unrecognised"),
+])
+def test_rig_parser_bad_input_is_a_clear_value_error(tmp_path, extra, message):
+    with pytest.raises(ValueError, match=message):
+        rigdata.load_rig(write(tmp_path, "bad_rig.txt", RIG_TEXT + extra))
+
+
+def test_rig_parser_rejects_a_hierarchy_cycle(tmp_path):
+    text = "joints a 0 0 0\njoints b 1 0 0\njoints c 2 0 0\nhier a b\nhier c a\nhier b c\n"
+    with pytest.raises(ValueError, match="cycle"):
+        rigdata.load_rig(write(tmp_path, "cycle_rig.txt", text))
+
+
+# --- joint sets, bone samples, normalisation, metrics -------------------------------------------------------------
+
+def chain(*points):
+    points = np.array(points, dtype=float)
+    return rigdata.Bones(points[:-1], points[1:], np.arange(-1, len(points) - 2))
+
+
+def test_joint_set_is_heads_plus_leaf_tails_once_each():
+    # Two bones sharing the root head, the first one with a child whose head is detached from its parent's tail.
+    bones = rigdata.Bones([[0, 0, 0], [0, 0, 0], [2, 2, 0]], [[1, 0, 0], [0, 1, 0], [3, 3, 0]], [-1, -1, 0])
+    assert sorted(map(tuple, bones.joints())) == [(0, 0, 0), (0, 1, 0), (2, 2, 0), (3, 3, 0)]
+
+
+def test_bone_samples_are_at_most_a_step_apart_with_both_ends():
+    bones = chain([0, 0, 0], [0.012, 0, 0], [0.012, 0, 0])
+    samples = bones.samples(step=0.005)
+    assert np.allclose(samples[:4, 0], [0, 0.004, 0.008, 0.012]) and (samples[:, 1:] == 0).all()
+    assert np.allclose(samples[4:], [[0.012, 0, 0], [0.012, 0, 0]])  # a zero-length bone is its two ends
+
+
+def test_normalisation_scales_the_largest_extent_to_one():
+    vertices = np.array([[10, 20, 30], [12, 24, 31]], dtype=float)
+    normalisation = rigdata.Normalisation.of_mesh(vertices)
+    unit = normalisation.points(vertices)
+    assert np.allclose(unit, [[-0.25, -0.5, -0.125], [0.25, 0.5, 0.125]])
+    with pytest.raises(ValueError, match="no extent"):
+        rigdata.Normalisation.of_mesh(np.ones((3, 3)))
+
+
+def scores(predicted, truth):
+    return rigdata.skeleton_distances(predicted.joints(), predicted.samples(), truth.joints(), truth.samples())
+
+
+def test_identical_skeletons_score_zero():
+    bones = chain([0, 0, 0], [0, 0.3, 0], [0.2, 0.5, 0.1])
+    assert scores(bones, bones) == {"cd_j2j": 0.0, "cd_j2b": 0.0, "cd_b2b": 0.0}
+
+
+def test_shifted_skeleton_scores_the_shift():
+    truth = chain([0, 0, 0], [0, 0.3, 0], [0, 0.6, 0])
+    shifted = chain([0.02, 0, 0], [0.02, 0.3, 0], [0.02, 0.6, 0])
+    assert scores(shifted, truth) == pytest.approx({"cd_j2j": 0.02, "cd_j2b": 0.02, "cd_b2b": 0.02})
+
+
+def test_chamfer_distances_average_both_directions():
+    predicted, truth = np.array([[0.0, 0, 0]]), np.array([[0.0, 0, 0], [1.0, 0, 0]])
+    assert rigdata.chamfer_distance(predicted, truth) == pytest.approx((0 + 0.5) / 2)
+    # A joint in the middle of a true bone is on it (distance 0); the true joints are 0.5 from the lone joint.
+    result = rigdata.skeleton_distances(np.array([[0.5, 0, 0]]), np.array([[0.5, 0, 0]]), truth,
+                                        chain([0, 0, 0], [1, 0, 0]).samples())
+    assert result["cd_j2b"] == pytest.approx((0 + 0.5) / 2)
+    with pytest.raises(ValueError, match="non-empty"):
+        rigdata.chamfer_distance(np.zeros((0, 3)), truth)
+
+
+# --- winding number -----------------------------------------------------------------------------------------------
+
+def test_winding_number_is_one_inside_a_cube_and_zero_outside():
+    points = np.array([[0.5, 0.5, 0.5], [0.1, 0.9, 0.2], [1.5, 0.5, 0.5], [-3, 4, 0.2]])
+    winding = rigdata.winding_numbers(points, CUBE_VERTICES, cube_triangles(), chunk_pairs=5)
+    assert np.allclose(winding, [1, 1, 0, 0], atol=1e-9)
+    assert rigdata.inside_fraction(points, CUBE_VERTICES, cube_triangles()) == 0.5
+
+
+def test_winding_number_of_inward_faces_and_open_meshes():
+    inward = cube_triangles()[:, ::-1]
+    assert rigdata.winding_numbers([[0.5, 0.5, 0.5]], CUBE_VERTICES, inward) == pytest.approx([-1])
+    assert rigdata.inside_fraction([[0.5, 0.5, 0.5]], CUBE_VERTICES, inward) == 1.0
+    open_box = cube_triangles(CUBE_QUADS[1:])  # one face missing: the centre sees 5/6 of the full solid angle
+    assert rigdata.winding_numbers([[0.5, 0.5, 0.5]], CUBE_VERTICES, open_box) == pytest.approx([5 / 6])
+
+
+# --- tree checks and the skeletor baseline's forest-to-tree conversion --------------------------------------------
+
+def test_tree_problem_names_what_is_wrong():
+    heads = np.zeros((3, 3))
+    tails = np.ones((3, 3))
+    assert rigdata.tree_problem(rigdata.Bones(heads, tails, [-1, 0, 1])) is None
+    assert "2 root" in rigdata.tree_problem(rigdata.Bones(heads, tails, [-1, -1, 1]))
+    assert "cycle" in rigdata.tree_problem(rigdata.Bones(heads, tails, [-1, 2, 1]))
+    assert "out of range" in rigdata.tree_problem(rigdata.Bones(heads, tails, [-1, 0, 3]))
+    assert "non-finite" in rigdata.tree_problem(rigdata.Bones(heads, np.full((3, 3), np.nan), [-1, 0, 1]))
+    assert rigdata.tree_problem(rigdata.Bones(np.zeros((0, 3)), np.zeros((0, 3)), [])) == "no bones"
+
+
+def test_forest_becomes_one_tree_parented_to_the_largest_piece():
+    # Piece one: node 0 with children 1 and 2, node 3 under 2. Piece two: node 4 -> 5, near node 1.
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 2, 0], [1.1, 0.1, 0], [2, 0, 0]], dtype=float)
+    bones = quality.bones_from_forest(np.array([-1, 0, 0, 2, -1, 4]), positions)
+    assert rigdata.tree_problem(bones) is None
+    assert bones.heads.tolist() == [[0, 0, 0], [0, 0, 0], [0, 1, 0], [1.1, 0.1, 0]]
+    assert bones.parents.tolist() == [-1, 0, 1, 0]
+
+
+def test_stick_baseline_spans_the_main_axis_with_a_middle_joint():
+    rng = np.random.default_rng(7)
+    vertices = rng.normal(size=(500, 3)) * [0.1, 3.0, 0.2] + [5, 6, 7]
+    bones, _ = quality.principal_stick(vertices, None)
+    assert rigdata.tree_problem(bones) is None and len(bones.joints()) == 3
+    direction = bones.tails[1] - bones.heads[0]
+    assert abs(direction[1]) / np.linalg.norm(direction) > 0.99
+    assert np.ptp(vertices[:, 1]) * 0.95 < np.linalg.norm(direction)
+
+
+# --- one real model -----------------------------------------------------------------------------------------------
+
+def test_real_model_loads_and_scores_in_the_rignet_convention():
+    truth = quality.GroundTruth(shared_path("models", "gt", "rignet_2982"))
+    assert truth.vertices.shape == (935, 3) and truth.triangles.shape == (1866, 3)
+    assert len(truth.rig.names) == 27 and (truth.rig.parents < 0).sum() == 1
+    assert len(truth.joints) == 25  # RigNet's root_dup_* joints repeat the root's position: one joint each place
+    assert np.ptp(truth.unit_vertices, axis=0).max() == pytest.approx(1.0)
+    assert truth.inside == 1.0  # the artist's bones lie inside this watertight mesh
+    record = quality.evaluate(truth, "stick", {}, timeout=60)
+    assert 0.1 < record["cd_j2j"] < 0.2 and record["joints"] == 3 and record["tree_problem"] is None
+
+
+def test_real_rig_helper_joints_are_ignored():
+    folder = shared_path("models", "gt", "Quaternius_Fox")
+    rig = rigdata.load_rig(folder / "Quaternius_Fox_rig.txt")
+    kept = rig.without_helpers()
+    assert len(rig.names) == 51 and len(kept.names) == 47
+    assert not any("PoleTarget" in name for name in kept.names)

@@ -1,0 +1,131 @@
+"""The silhouette rigging method on the project's generated characters (exact ground truth) and on bad input."""
+import numpy as np
+import pytest
+
+import rigger
+from characters import load_character, winding_numbers
+from rigger import samples
+
+CHARACTERS = ("humanoid", "humanoid_hips", "quadruped", "octopus", "tree", "snake")
+
+
+def bone_samples(skeleton, per_bone=9):
+    t = np.linspace(0.0, 1.0, per_bone)[None, :, None]
+    return (skeleton.heads[:, None] * (1 - t) + skeleton.tails[:, None] * t).reshape(-1, 3)
+
+
+def chamfer(a, b):
+    d = np.linalg.norm(a[:, None] - b[None], axis=2)
+    return 0.5 * (d.min(axis=1).mean() + d.min(axis=0).mean())
+
+
+@pytest.fixture(scope="module", params=CHARACTERS)
+def rigged(request):
+    vertices, triangles = load_character(request.param)
+    return request.param, vertices, triangles, rigger.rig_mesh(vertices, triangles)
+
+
+def test_a_valid_tree_with_one_root(rigged):
+    _, _, _, skeleton = rigged
+    assert len(skeleton) >= 3
+    assert list(skeleton.roots) == [0]
+    for bone, parent in enumerate(skeleton.parents):
+        assert parent < bone  # parents come first: a tree, no cycle
+    assert len(set(skeleton.names)) == len(skeleton.names)
+
+
+def test_bones_lie_inside_the_mesh(rigged):
+    name, vertices, triangles, skeleton = rigged
+    inside = winding_numbers(vertices, triangles, bone_samples(skeleton)) > 0.5
+    assert inside.mean() >= 0.9, f"{name}: only {inside.mean():.0%} of bone samples inside"
+
+
+def test_joints_near_the_true_skeleton(rigged):
+    name, vertices, _, skeleton = rigged
+    truth = samples.ground_truth_bones(name)
+    size = np.ptp(vertices, axis=0).max()
+    error = chamfer(skeleton.joints(), truth.joints()) / size
+    assert error < 0.08, f"{name}: joint chamfer distance {error:.3f} of the model size"
+
+
+def test_stages_hold_every_intermediate_result(rigged):
+    _, _, _, skeleton = rigged
+    stages = skeleton.stages
+    for key in ("silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints", "timings", "params"):
+        assert key in stages
+    cdt = stages["cdt"]
+    assert len(cdt["classes"]) == len(cdt["triangles"])
+    assert set(np.unique(cdt["classes"])) <= {0, 1, 2, 3}
+    assert all(loop.shape[1] == 2 for loop in stages["silhouette"]["loops"])
+
+
+def test_quadruped_side_view_gets_four_legs():
+    """Left and right legs overlap in the side view: splitting by depth layers must give both."""
+    vertices, triangles = load_character("quadruped")
+    skeleton = rigger.rig_mesh(vertices, triangles, view="X")
+    feet = skeleton.tails[[i for i in range(len(skeleton)) if not skeleton.children(i)]]
+    low = feet[feet[:, 2] < vertices[:, 2].min() + 0.15 * np.ptp(vertices[:, 2])]
+    assert len(low) >= 4
+    assert (low[:, 0] > 0).sum() >= 2 and (low[:, 0] < 0).sum() >= 2  # both sides
+
+
+def test_mirror_pairs_are_named_left_and_right():
+    vertices, triangles = load_character("humanoid")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    left = {n[:-2] for n in skeleton.names if n.endswith(".L")}
+    right = {n[:-2] for n in skeleton.names if n.endswith(".R")}
+    assert left and left == right
+    for i, name in enumerate(skeleton.names):
+        if name.endswith(".L"):
+            assert skeleton.heads[i, 0] + skeleton.tails[i, 0] > 0  # Blender: the character's left is +X
+
+
+def test_the_hole_between_arm_and_body_is_cut():
+    vertices, triangles = load_character("humanoid_hips")
+    skeleton = rigger.rig_mesh(vertices, triangles, view="Y")
+    loops = skeleton.stages["silhouette"]["loops"]
+    assert sum(1 for loop in loops if _area(loop) < 0) == 2  # both holes were seen …
+    assert list(skeleton.roots) == [0]  # … and the result is still a tree
+
+
+def _area(loop):
+    return 0.5 * float(np.sum(loop[:, 0] * np.roll(loop[:, 1], -1) - np.roll(loop[:, 0], -1) * loop[:, 1]))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_same_skeleton_when_moved_rotated_or_scaled(seed):
+    vertices, triangles = load_character("humanoid")
+    reference = rigger.rig_mesh(vertices, triangles)
+    rng = np.random.default_rng(seed)
+    q = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    rotation = q * np.sign(np.linalg.det(q))
+    for scale in (1e-3, 1e3):
+        moved = (vertices @ rotation.T) * scale + rng.normal(size=3) * 10 * scale
+        skeleton = rigger.rig_mesh(moved, triangles)
+        back = ((skeleton.joints() - (moved.mean(axis=0))) @ rotation) / scale + vertices.mean(axis=0)
+        size = np.ptp(vertices, axis=0).max()
+        assert chamfer(back, reference.joints()) / size < 0.03
+
+
+def test_rig_time_is_recorded_per_stage():
+    vertices, triangles = load_character("snake")
+    timings = rigger.rig_mesh(vertices, triangles).stages["timings"]
+    assert {"silhouette_cdt_axis", "merge_prune", "depth_bones", "total"} <= set(timings)
+    assert all(t >= 0 for t in timings.values())
+
+
+@pytest.mark.parametrize("vertices, triangles, message", [
+    (np.zeros((0, 3)), np.zeros((0, 3), int), "no vertices"),
+    (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]), [[0, 1, 2]], "flat"),
+    (np.array([[0, 0, 0], [1, 0, 0], [0, np.nan, 0], [0, 0, 1.0]]), [[0, 1, 2], [0, 1, 3]], "finite"),
+    (np.eye(3).tolist() + [[0, 0, 0]], [[0, 1, 7]], "vertex 7"),
+])
+def test_bad_meshes_get_a_clear_error(vertices, triangles, message):
+    with pytest.raises(ValueError, match=message):
+        rigger.rig_mesh(vertices, triangles)
+
+
+def test_unknown_parameter_is_rejected():
+    vertices, triangles = load_character("snake")
+    with pytest.raises(ValueError, match="bone_lenght"):
+        rigger.rig_mesh(vertices, triangles, bone_lenght=0.2)
