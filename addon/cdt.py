@@ -5,6 +5,9 @@ float64 and decided by exact adaptive orientation and in-circle predicates, so n
 points, collinear runs, cocircular grids, points on segments, crossing or overlapping segments) cannot corrupt the
 triangulation.
 
+The predicates are exact while no product of coordinate differences overflows or underflows: the input is scaled
+by a power of two so its largest coordinate is about 1, which leaves differences down to about 1e-150 of that size.
+
 Example::
 
     from rigger import cdt
@@ -59,6 +62,9 @@ def triangulate(points, segments=None, *, mode="inside", holes=None):
         points: (N, 2) array-like of finite coordinates.
         segments: optional (M, 2) array-like of point-index pairs, the constraint edges. Segments may cross
             (they are split at a new Steiner vertex), overlap, pass through points, or have zero length (ignored).
+            A Steiner vertex is the crossing rounded to doubles, so the pieces through it are off the input
+            segments by a rounding error; to keep such pieces from crossing again and again, a vertex (or a
+            crossing) closer than 2**-40 of the bounding box's size to a segment counts as lying on it.
         mode: ``"inside"`` keeps only the triangles inside the constraint boundaries, by the even-odd rule:
             nested boundaries make holes, disjoint boundaries make separate pieces. A segment given twice
             cancels out. ``"all"`` keeps the whole convex hull.

@@ -23,8 +23,8 @@ cdef extern from "cdt_predicates.h" nogil:
     int rg_orient2d(double ax, double ay, double bx, double by, double cx, double cy)
     int rg_incircle(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy)
 
-# Crossing constraints closer than this to an endpoint are routed through it (coordinates are scaled to |x| < 1).
-cdef double SNAP = 2.0 ** -40
+# Crossing constraints closer than this fraction of the bounding box to an endpoint are routed through it.
+cdef double SNAP_FRACTION = 2.0 ** -40
 
 cdef enum:
     GHOST = -1
@@ -50,6 +50,7 @@ cdef struct Mesh:
     int scap
     unsigned int rng
     long long budget    # guard against any non-terminating loop: every step spends one unit
+    double snap         # SNAP_FRACTION of the bounding box: closer than this to a segment counts as on it
 
 
 cdef inline int nxt(int h) noexcept nogil:
@@ -597,6 +598,19 @@ cdef inline int same_direction(Mesh *m, int a, int b, int p) noexcept nogil:
     return (dy > 0) == (ey > 0) and ey != 0
 
 
+cdef int on_segment(Mesh *m, int a, int b, int p) noexcept nogil:
+    """Does p lie on the open segment a-b, exactly or within SNAP of it (the rounding of a Steiner vertex)?"""
+    cdef double ax = m.xy[2 * a], ay = m.xy[2 * a + 1]
+    cdef double dx = m.xy[2 * b] - ax, dy = m.xy[2 * b + 1] - ay
+    cdef double ex = m.xy[2 * p] - ax, ey = m.xy[2 * p + 1] - ay
+    cdef double length2 = dx * dx + dy * dy, along = dx * ex + dy * ey
+    if orient_v(m, a, b, p) == 0:
+        return same_direction(m, a, b, p)
+    if not (0.0 < along < length2):
+        return 0
+    return fabs(dx * ey - dy * ex) <= m.snap * sqrt(length2)
+
+
 cdef int mark(Mesh *m, int h, int count) noexcept nogil:
     m.C[h] += count
     m.C[m.N[h]] += count
@@ -623,7 +637,7 @@ cdef int split_constraint(Mesh *m, Work *w, Buffer *dirty, int h, int a, int b, 
     da = fabs(da) / lpq
     db = fabs(db) / lpq
     cdef double nearest = min(min(dp, dq), min(da, db))
-    if nearest <= SNAP:
+    if nearest <= m.snap:
         if nearest == dp or nearest == dq:
             s = p if nearest == dp else q
             if work_push(w, a, s, count) or work_push(w, s, b, count):
@@ -669,6 +683,13 @@ cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a,
     cdef long long guard
     h = find_edge(m, a, b)
     if h >= 0:
+        # a sliver apex within SNAP of the edge (beside a Steiner vertex) lies on the segment: route through it
+        r = m.V[prv(h)]
+        if r != GHOST and on_segment(m, a, b, r):
+            return work_push(w, r, b, count) or work_push(w, a, r, count)
+        r = m.V[prv(m.N[h])]
+        if r != GHOST and on_segment(m, a, b, r):
+            return work_push(w, r, b, count) or work_push(w, a, r, count)
         return mark(m, h, count)
     # the triangle around a that the segment leaves through
     h = m.VT[a]
@@ -676,7 +697,7 @@ cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a,
     while True:
         p = m.V[nxt(h)]
         q = m.V[prv(h)]
-        if p != GHOST and orient_v(m, a, b, p) == 0 and same_direction(m, a, b, p):
+        if p != GHOST and on_segment(m, a, b, p):
             mark(m, h, count)
             return work_push(w, p, b, count)
         if p != GHOST and q != GHOST and orient_v(m, a, b, p) < 0 and orient_v(m, a, b, q) > 0:
@@ -690,6 +711,10 @@ cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a,
     while True:
         if spend(m):
             return ERR_INTERNAL
+        # a vertex a rounding error off the segment (beside a Steiner vertex): split there, start again
+        r = m.V[h] if on_segment(m, a, b, m.V[h]) else (m.V[nxt(h)] if on_segment(m, a, b, m.V[nxt(h)]) else -1)
+        if r >= 0:
+            return work_push(w, r, b, count) or work_push(w, a, r, count)
         if m.C[h]:
             return split_constraint(m, w, fresh, h, a, b, count)
         if buf_push2(crossed, m.V[h], m.V[nxt(h)]):
@@ -706,6 +731,9 @@ cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a,
                 return ERR_NOMEM
             b = r
             break
+        if on_segment(m, a, b, r):
+            # a rounding error off the segment (next to a Steiner vertex): split there and start again
+            return work_push(w, r, b, count) or work_push(w, a, r, count)
         h = nxt(o) if s > 0 else prv(o)
     # Sloan: flip crossed edges (a ring buffer of vertex pairs) until none crosses a-b
     fresh.n = 0
@@ -760,6 +788,9 @@ cdef int insert_constraints(Mesh *m, const int *segs, int nseg, const int *vmap)
         if err:
             break
     while err == 0 and w.n > 0:
+        if spend(m):
+            err = ERR_INTERNAL
+            break
         w.n -= 3
         a = w.data[w.n]
         b = w.data[w.n + 1]
@@ -885,6 +916,7 @@ def triangulate(points, segments, bint inside, holes):
     memset(&m, 0, sizeof(Mesh))
     m.rng = 12345
     m.budget = 2000 * (<long long> n + nseg) + 10000000
+    m.snap = SNAP_FRACTION * float(np.ptp(scaled, axis=0).max()) if n else 0.0
     cdef int *order = <int *> malloc(<size_t> n * sizeof(int))
     cdef int *tmp_order = <int *> malloc(<size_t> n * sizeof(int))
     cdef unsigned int *keys = <unsigned int *> malloc(<size_t> n * sizeof(unsigned int))
