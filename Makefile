@@ -4,11 +4,10 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: test build demo bench clean
+.PHONY: test build demo bench bench-quality bench-silhouette clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -r requirements.txt
 	touch $(STAMP)
 
@@ -18,8 +17,18 @@ build: $(STAMP)
 test: build
 	$(PY) -m pytest -q tests
 
+demo: build
+	$(PY) tools/demo.py
+
 bench: build
 	$(PY) bench/cdt.py
 
+bench-quality: build
+	$(PY) -m pip install --quiet -r bench/requirements.txt
+	$(PY) bench/quality.py
+
+bench-silhouette: build
+	$(PY) bench/silhouette.py
+
 clean:
-	rm -rf build dist *.egg-info addon/*.so ext/cdt.c ext/silhouette_binding.c
+	rm -rf build dist out *.egg-info addon/*.so ext/cdt.c ext/silhouette_binding.c

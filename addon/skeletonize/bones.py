@@ -1,11 +1,19 @@
 """Bones from 3D chains: where joints go along a chain, the bone hierarchy, and names with mirror suffixes."""
 import numpy as np
 
+MIN_BONE = 0.35  # shortest bone made at a corner, as a fraction of the longest bone
+
 
 def chain_joints(line, bone_angle, bone_length):
     """Joint positions along a polyline: its ends, the corners where the simplified line turns by more than
     ``bone_angle`` radians, and evenly spaced points so that no bone is longer than ``bone_length``."""
-    keep = _corners(line, bone_angle, tolerance=0.25 * bone_length)
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))]
+    keep = [0]
+    for corner in _corners(line, bone_angle, tolerance=0.25 * bone_length)[1:-1]:
+        # a corner too close to the previous joint or to the end would make a stub bone
+        if arc[corner] - arc[keep[-1]] >= MIN_BONE * bone_length and arc[-1] - arc[corner] >= MIN_BONE * bone_length:
+            keep.append(corner)
+    keep.append(len(line) - 1)
     joints = [line[0]]
     for a, b in zip(keep[:-1], keep[1:]):
         piece = line[a:b + 1]
