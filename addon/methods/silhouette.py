@@ -21,6 +21,7 @@ from ..skeletonize.depth import SideAxis, place_chains
 from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chains
 
 AXES = np.eye(3)
+SPECK = 0.25  # islands whose axis is shorter than this many bone lengths get no bones of their own
 AXIS_NAMES = ("X", "Y", "Z")
 
 
@@ -42,13 +43,15 @@ class SilhouetteMethod(RigMethod):
                           "(gaps between parts), larger ones (an arm on the hip) are kept"),
         Param("merge", "float", 1.0, min=0.0, max=3.0,
               description="Blob merging: nodes within this many disc radii of a branch point join it"),
-        Param("prune", "float", 0.6, min=0.0, max=5.0,
+        Param("prune", "float", 1.5, min=0.0, max=5.0,
               description="Branches reaching less than (1 + prune) disc radii beyond their base are dropped; "
                           "lower keeps finer branches such as fingers"),
         Param("bone_angle", "float", 40.0, min=1.0, max=180.0,
               description="Start a new bone where a chain turns by more than this many degrees"),
         Param("bone_length", "float", 0.1, min=0.01, max=1.0,
-              description="Longest bone, as a fraction of the mesh's largest extent"),
+              description="Typical bone length, as a fraction of the mesh's largest extent"),
+        Param("max_chain_bones", "int", 4, min=0, max=100,
+              description="Most bones per chain between branch points (0: no limit)"),
         Param("split_layers", "bool", True,
               description="Split chains whose view rays cross the mesh in separate parts (stacked legs)"),
         Param("side_view", "bool", True,
@@ -56,7 +59,7 @@ class SilhouetteMethod(RigMethod):
     )
 
     def rig(self, mesh, *, view, resolution, outline_spacing, min_hole, merge, prune, bone_angle, bone_length,
-            split_layers, side_view):
+            max_chain_bones, split_layers, side_view):
         clock = _Clock()
         vertices, triangles = mesh.vertices, mesh.triangles
         axis = choose_axis(vertices, triangles) if view == "AUTO" else AXIS_NAMES.index(view)
@@ -78,10 +81,10 @@ class SilhouetteMethod(RigMethod):
         clock.lap("side_view")
 
         islands = _islands(graph, alive, kept)
-        builder = _BoneBuilder(np.radians(bone_angle), bone_length * mesh.scale)
+        builder = _BoneBuilder(np.radians(bone_angle), bone_length * mesh.scale, max_chain_bones)
         for number, (nodes, links, size) in enumerate(islands):
-            if number and size < bone_length * mesh.scale:
-                continue  # a speck smaller than a bone: skinning gives it to the nearest bone
+            if number and size < SPECK * bone_length * mesh.scale:
+                continue  # a speck much smaller than a bone: skinning gives it to the nearest bone
             keys, island_chains = chains_of(nodes, links)
             if not island_chains:
                 builder.add_blob(sil, graph.points[nodes[0]], graph.radius[nodes[0]])
@@ -188,8 +191,8 @@ def _removed(before, after):
 class _BoneBuilder:
     """Accumulates bones island by island; the first island's trunk holds the single root bone."""
 
-    def __init__(self, bone_angle, bone_length):
-        self.bone_angle, self.bone_length = bone_angle, bone_length
+    def __init__(self, bone_angle, bone_length, max_bones):
+        self.bone_angle, self.bone_length, self.max_bones = bone_angle, bone_length, max_bones
         self.heads, self.tails, self.parents = [], [], []
         self.chain_of_bone, self.index_in_chain = [], []
         self.lines = []
@@ -198,13 +201,13 @@ class _BoneBuilder:
     def add_island(self, root_point, placed):
         """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk."""
         roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
-        trunk = max(roots, key=lambda i: placed[i][2])
+        trunk = max(roots, key=lambda i: placed[i][2].mean())
         order = [trunk] + [i for i in range(len(placed)) if i != trunk]
         attach = self._attachment(root_point)
         last_bone, first_bone = {}, {}
         for i in order:
-            line, parent, _ = placed[i]
-            joints = chain_joints(line, self.bone_angle, self.bone_length)
+            line, parent, widths = placed[i]
+            joints = chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths)
             if parent >= 0:
                 up = last_bone[parent]
             elif i == trunk:

@@ -1,32 +1,59 @@
 """Bones from 3D chains: where joints go along a chain, the bone hierarchy, and names with mirror suffixes."""
 import numpy as np
 
-MIN_BONE = 0.35  # shortest bone made at a corner, as a fraction of the longest bone
 
+def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None):
+    """Joint positions along a polyline.
 
-def chain_joints(line, bone_angle, bone_length):
-    """Joint positions along a polyline: its ends, the corners where the simplified line turns by more than
-    ``bone_angle`` radians, and evenly spaced points so that no bone is longer than ``bone_length``."""
+    ``widths`` are the half-widths of the part along the line. A chain leaving a branch point first gets a joint
+    where it leaves that point's disc (``widths[0]``): where a limb meets the body, like a hip or a shoulder. Every
+    corner where the simplified line turns by more than ``bone_angle`` radians gets a joint (an elbow, a knee), and
+    so does every bend that would take a straight bone out of the part (a snake's curves). The pieces between are
+    cut evenly into bones about ``bone_length`` long, at most ``max_bones`` in all when positive unless the corners
+    need more.
+    """
+    widths = np.zeros(len(line)) if widths is None else widths
     arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))]
-    keep = [0]
-    for corner in _corners(line, bone_angle, tolerance=0.25 * bone_length)[1:-1]:
-        # a corner too close to the previous joint or to the end would make a stub bone
-        if arc[corner] - arc[keep[-1]] >= MIN_BONE * bone_length and arc[-1] - arc[corner] >= MIN_BONE * bone_length:
-            keep.append(corner)
-    keep.append(len(line) - 1)
-    joints = [line[0]]
-    for a, b in zip(keep[:-1], keep[1:]):
-        piece = line[a:b + 1]
-        steps = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(piece, axis=0), axis=1))]
-        count = max(1, int(np.ceil(steps[-1] / bone_length - 1e-9))) if steps[-1] > 0 else 1
-        for k in range(1, count + 1):
-            at = steps[-1] * k / count
-            joints.append(np.array([np.interp(at, steps, piece[:, d]) for d in range(3)]))
-    return np.array(joints)
+    stops = [0.0]
+    reach = np.linalg.norm(line - line[0], axis=1)
+    outside = np.flatnonzero(reach > widths[0]) if widths[0] > 0 else []
+    if len(outside) and arc[outside[0]] >= 0.3 * bone_length and arc[-1] - arc[outside[0]] >= 0.5 * bone_length:
+        stops.append(arc[outside[0]])
+    sharp = _corners(line, bone_angle, np.full(len(line), 0.25 * bone_length))[1:-1]
+    bends = _simplified(line, np.maximum(0.5 * widths, 1e-12 * bone_length))[1:-1] if widths.any() else []
+    for corner in sorted(set(sharp) | set(bends)):
+        if arc[corner] - stops[-1] >= 0.35 * bone_length and arc[-1] - arc[corner] >= 0.35 * bone_length:
+            stops.append(arc[corner])
+    stops.append(arc[-1])
+    lengths = np.diff(stops)
+    wanted = max(1, int(round(arc[-1] / bone_length)))
+    if max_bones > 0:
+        wanted = min(wanted, max_bones)
+    counts = _share(lengths, max(wanted, len(lengths)))
+    at = [0.0]
+    for start, length, count in zip(stops[:-1], lengths, counts):
+        at.extend(start + length * np.arange(1, count + 1) / count)
+    return np.stack([np.interp(at, arc, line[:, d]) for d in range(3)], axis=1)
 
 
-def _corners(line, angle, tolerance):
-    """Indices of the ends and the sharp corners of ``line`` after Douglas-Peucker simplification (iterative)."""
+def _share(lengths, total):
+    """Split ``total`` bones over pieces of the given lengths, at least one each, the rest by largest remainder."""
+    counts = np.ones(len(lengths), dtype=int)
+    spare = total - len(lengths)
+    if spare > 0 and lengths.sum() > 0:
+        ideal = lengths / lengths.sum() * total - 1
+        extra = np.floor(np.clip(ideal, 0, None)).astype(int)
+        while extra.sum() > spare:
+            extra[np.argmax(extra)] -= 1
+        left = spare - extra.sum()
+        order = np.argsort(-(ideal - extra))
+        extra[order[:left]] += 1
+        counts += extra
+    return counts
+
+
+def _simplified(line, tolerance):
+    """Indices kept by Douglas-Peucker simplification (iterative) with a per-point tolerance."""
     n = len(line)
     if n <= 2:
         return [0, n - 1]
@@ -44,11 +71,19 @@ def _corners(line, angle, tolerance):
             dist = np.linalg.norm(rel - np.outer(rel @ seg / length ** 2, seg), axis=1)
         else:
             dist = np.linalg.norm(rel, axis=1)
-        far = int(np.argmax(dist))
-        if dist[far] > tolerance:
+        excess = dist - tolerance[a + 1:b]
+        far = int(np.argmax(excess))
+        if excess[far] > 0:
             keep[a + 1 + far] = True
             stack += [(a, a + 1 + far), (a + 1 + far, b)]
-    idx = np.flatnonzero(keep)
+    return list(np.flatnonzero(keep))
+
+
+def _corners(line, angle, tolerance):
+    """Indices of the ends and of the corners of the simplified ``line`` that turn by more than ``angle``."""
+    idx = _simplified(line, tolerance)
+    if len(idx) <= 2:
+        return idx
     corners = [idx[0]]
     for prev, here, nxt in zip(idx[:-2], idx[1:-1], idx[2:]):
         u, w = line[here] - line[prev], line[nxt] - line[here]

@@ -23,7 +23,7 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
         side_axis: optional ``SideAxis`` of the perpendicular view, used where the primary view is occluded.
         split: split chains that run through several separate parts along the view (else follow one).
 
-    Returns (root_point, placed) with ``placed`` a list of (polyline (k, 3), parent_index, mean half-width) —
+    Returns (root_point, placed) with ``placed`` a list of (polyline (k, 3), parent_index, half-widths (k,)) —
     parents first; a split chain yields several entries with the same parent.
     """
     used = sorted({root} | {n for c in chains for n in c.nodes})
@@ -39,7 +39,7 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
         parents = [p for p, src in origin_of.items() if src == chain.parent]
         node_layers = [layers[slot[n]] for n in chain.nodes]
         copies = _layer_count(node_layers) if split else 1
-        width = float(radius[chain.nodes].mean())
+        widths = radius[chain.nodes]
         for copy in range(copies):
             depths = _follow(node_layers, copy, copies, start_depths)
             depths = _resolve_occlusion(sil, points[chain.nodes], radius[chain.nodes], node_layers, depths, side_axis)
@@ -51,7 +51,7 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
                 parent = min(parents, key=lambda p: np.linalg.norm(placed[p][0][-1] - probe))
                 line[0] = placed[parent][0][-1]
             origin_of[len(placed)] = ci
-            placed.append((line, parent, width))
+            placed.append((line, parent, widths))
         end_depth[ci] = depths[-1]
     return sil.lift(points[[root]], [root_depth])[0], placed
 
@@ -65,46 +65,63 @@ def _depth_of(sil, point):
 
 
 def _layer_count(node_layers):
-    """How many separate parts a chain runs through: the typical interval count over its outer two thirds (the
-    part near its parent often runs into the body)."""
+    """How many separate parts a chain runs through: the most frequent interval count over its outer two thirds
+    (the part near its parent often runs into the body)."""
     counts = np.array([len(layer) for layer in node_layers])
     outer = counts[len(counts) // 3:]
     outer = outer[outer > 0]
     if not len(outer):
         return 1
-    return int(max(1, np.median(outer)))
+    return int(np.argmax(np.bincount(outer)))
 
 
 def _follow(node_layers, copy, copies, start):
-    """Depth along a chain: at nodes with exactly ``copies`` intervals take interval ``copy`` (front to back),
-    elsewhere the interval nearest the previous depth; always the interval's middle."""
-    depths = np.empty(len(node_layers))
-    previous = start
-    for i, layer in enumerate(node_layers):
-        if len(layer) == 0:
-            depths[i] = previous
-            continue
-        if len(layer) == copies:
-            chosen = layer[copy]
-        else:
-            chosen = layer[np.argmin(np.abs(0.5 * (layer[:, 0] + layer[:, 1]) - previous))]
-        depths[i] = previous = _middle(chosen)
+    """Depth along a chain, always the middle of an interval. A single chain follows, from its start, the interval
+    nearest the previous depth. Copy ``copy`` of a split chain is anchored at interval ``copy`` (front to back) of
+    the outermost node crossing exactly ``copies`` intervals, and followed from there both ways by nearest depth,
+    so it never jumps to the other part where some node sees the parts merged or an extra part."""
+    depths = np.full(len(node_layers), np.nan)
+    if copies == 1:
+        _track(node_layers, range(len(node_layers)), start, depths)
+    else:
+        anchor = max(i for i, layer in enumerate(node_layers) if len(layer) == copies)
+        depths[anchor] = _middle(node_layers[anchor][copy])
+        # towards the parent the parts often merge with each other and the body: stay on this part's side
+        _track(node_layers, range(anchor + 1, len(node_layers)), depths[anchor], depths, stay=True)
+        _track(node_layers, range(anchor - 1, -1, -1), depths[anchor], depths, stay=True)
     return depths
 
 
+def _track(node_layers, order, previous, depths, stay=False):
+    """Follow a part along its chain: at each node take the interval the previous depth lies in, else the one
+    nearest to it (distance to the interval, not to its middle, so a thick neighbour does not steal the track),
+    and centre in it — or, with ``stay``, keep the previous depth while an interval still contains it."""
+    for i in order:
+        layer = node_layers[i]
+        if len(layer):
+            gap = np.maximum(layer[:, 0] - previous, 0.0) + np.maximum(previous - layer[:, 1], 0.0)
+            best = int(np.argmin(gap))
+            if not (stay and gap[best] == 0.0):
+                previous = _middle(layer[best])
+        depths[i] = previous
+
+
 def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
+    """Where a node's interval is much thicker than its part is wide, take the depth from the side view instead,
+    choosing among the side-view candidates the one closest to the previous node's depth (so a chain never
+    hops between two legs that the side view shows at the same height)."""
     if side_axis is None:
         return depths
     out = depths.copy()
+    previous = depths[0]
     for i, layer in enumerate(node_layers):
-        if not len(layer):
-            continue
-        interval = layer[np.argmin(np.abs(0.5 * (layer[:, 0] + layer[:, 1]) - depths[i]))]
-        if interval[1] - interval[0] <= OCCLUSION_RATIO * 2 * max(radius[i], sil.cell):
-            continue
-        found = side_axis.depth_at(sil, points[i], radius[i], interval)
-        if found is not None:
-            out[i] = found
+        if len(layer):
+            interval = layer[np.argmin(np.abs(0.5 * (layer[:, 0] + layer[:, 1]) - depths[i]))]
+            if interval[1] - interval[0] > OCCLUSION_RATIO * 2 * max(radius[i], sil.cell):
+                found = side_axis.depth_at(sil, points[i], radius[i], interval, previous)
+                if found is not None:
+                    out[i] = found
+        previous = out[i]
     return out
 
 
@@ -123,8 +140,9 @@ class SideAxis:
         self.radius = radius
         self.cell = side_sil.cell
 
-    def depth_at(self, sil, point2d, radius, interval):
-        """Depth (in ``sil``'s frame) of the side-view part matching a primary node, inside ``interval``; None if
+    def depth_at(self, sil, point2d, radius, interval, previous):
+        """Depth (in ``sil``'s frame) of the side-view part matching a primary node, inside ``interval``: of the
+        side-view axis nodes at the node's height, the one nearest ``previous`` (ties to the closest width); None if
         no side-view node fits."""
         world = sil.origin + point2d[0] * sil.u + point2d[1] * sil.v
         w0 = float(world @ self.w_axis)
@@ -135,5 +153,5 @@ class SideAxis:
         if not near.any():
             return None
         candidates = np.flatnonzero(near)
-        best = candidates[np.argmin(np.abs(self.radius[candidates] - radius))]
-        return float(depth[best])
+        cost = np.abs(depth[candidates] - previous) + 0.1 * np.abs(self.radius[candidates] - radius)
+        return float(depth[candidates[np.argmin(cost)]])

@@ -111,15 +111,10 @@ def prune_spurs(points, radius, chains, prune):
                     break
         if not spurs:
             return _links_of(chains)
-        # remove at most one spur per base node per round, the shortest, so a fork never loses all its branches
-        by_base = {}
-        for i in spurs:
-            base = chains[i][0] if degree[chains[i][-1]] == 1 else chains[i][-1]
-            length = _length(points, chains[i])
-            if base not in by_base or length < by_base[base][0]:
-                by_base[base] = (length, i)
-        drop = {i for _, i in by_base.values()}
-        kept = [c for i, c in enumerate(chains) if i not in drop]
+        # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
+        kept = [c for i, c in enumerate(chains) if i not in set(spurs)]
+        if not kept:
+            return np.zeros((0, 2), dtype=np.int64)
         _, chains = chains_of(sorted({n for c in kept for n in c}), _links_of(kept))
 
 

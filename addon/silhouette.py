@@ -1,0 +1,194 @@
+"""The 3D silhouette: the outline of a mesh seen along a direction, and the mesh's depth behind every outline point.
+
+A small documented API over the bundled compiled module ``rigger._rigger_silhouette`` (``ext/silhouette.c``).
+
+Example::
+
+    from rigger import silhouette
+    sil = silhouette.trace(vertices, triangles, "Y")      # look along +Y: u = +X (right), v = +Z (up)
+    sil.loops                     # [(K, 2) float64, ...]: outer boundaries counter-clockwise, holes clockwise
+    front, back = sil.depth(sil.loops[0])                # nearest / farthest mesh depth along each ray
+    sil.layers([(0.0, 1.2)])      # [(L, 2) array of (entry, exit) depths where the ray is inside the mesh]
+    sil.lift(points, front)       # back to 3D: origin + x*u + y*v + depth*direction
+
+How it works, and why it cannot fail: the projected triangles are snapped to an integer lattice (65536 steps per
+grid cell) and every inside/outside decision is exact integer arithmetic under a symbolic perturbation, so no grid
+point ever sits on an edge and shared edges leave no cracks. Along each horizontal and vertical grid line the union
+of the triangles' cross-sections is computed exactly; the outline passes through those exact crossing points and is
+closed inside each cell by straight chords whose pairing follows from the same predicate. Loops are therefore closed,
+simple and consistently oriented by construction, and nothing recurses or uses a fixed-size buffer.
+
+Accuracy versus resolution: ``resolution`` is the number of grid cells along the longest side of the projected
+bounding box, so the cell size is ``longest side / resolution``. Because crossings are exact, a straight silhouette
+edge is reproduced exactly wherever it crosses a grid line; the outline departs from the true union only
+
+- at corners, which a chord cuts off: at most about half a cell's area each, far less for the blunt corners of a
+  smooth mesh;
+- for specks: islands or holes that cross no grid line (smaller than a cell in both directions) are dropped, and a
+  thin part crossing a grid line keeps its exact width there, so fingers, tails and antennae stay separate lobes as
+  long as the gaps between them are wider than about a cell.
+
+Measured on the project's test models (``bench/results/silhouette.md``): at the default 1024 the area IoU against
+the exact union is above 0.9995, holes and islands larger than a few cells all match; 256 still gives IoU > 0.998
+but closes gaps narrower than 1/256 of the figure. Cost grows linearly with the triangle count plus the number of
+cells crossed, about 0.1 s for a million triangles at the default.
+
+``tolerance`` then removes outline points while the outline moves by at most that fraction of a cell, never
+removing a point whose removal could make two loop segments cross; the default 0.05 keeps the IoU essentially
+unchanged while dropping the collinear runs that straight mesh edges produce.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _rigger_silhouette
+
+DEFAULT_RESOLUTION = 1024
+DEFAULT_TOLERANCE = 0.05
+AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+
+
+@dataclass(frozen=True, eq=False)
+class Silhouette:
+    """The result of :func:`trace`.
+
+    Attributes:
+        loops: list of (K, 2) float64 arrays in the (u, v) frame, closing point not repeated. Outer boundaries run
+            counter-clockwise, holes clockwise, every loop is simple and no two loops cross, so they can be passed
+            directly to ``rigger.cdt.triangulate(points, segments, mode="inside")``.
+        origin, u, v, direction: (3,) float64. A frame point (x, y) at depth d is the 3D point
+            ``origin + x*u + y*v + d*direction``; ``direction`` is the unit view direction, depth grows away from
+            the viewer, and (u, v) is what the viewer sees as (right, up).
+        cell: the grid cell size in mesh units (the outline's resolution).
+    """
+
+    loops: list
+    origin: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    direction: np.ndarray
+    cell: float
+    _trace: object = field(repr=False)
+
+    def depth(self, points):
+        """Nearest (``front``) and farthest (``back``) mesh depth along the view ray through each (P, 2) point.
+
+        Rays are cast exactly against the projected triangles (shared edges are hit exactly once). Both arrays are
+        NaN where the ray misses the mesh, i.e. outside the silhouette.
+        """
+        return self._trace.depth(_as_points(points))
+
+    def layers(self, points):
+        """Every depth interval where the view ray through each (P, 2) point is inside the mesh.
+
+        Returns a list with one (L, 2) float64 array of (entry, exit) depths per point, sorted front to back (empty
+        on a miss). Hits pair up by crossing parity within each connected part of the mesh (vertices at identical
+        positions are welded first), and overlapping intervals of different parts are merged: two legs one behind
+        the other give two intervals, an eye inside a head gives one. Where an open part is hit an odd number of
+        times, the hit whose removal leaves the thinnest pairing becomes a zero-thickness interval.
+        """
+        return self._trace.layers(_as_points(points))
+
+    def lift(self, points, depth):
+        """3D positions of (P, 2) frame points at the given depths (scalar or (P,))."""
+        pts = _as_points(points)
+        d = np.broadcast_to(np.asarray(depth, dtype=np.float64), (len(pts),))
+        return self.origin + pts[:, :1] * self.u + pts[:, 1:] * self.v + d[:, None] * self.direction
+
+
+def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
+    """Trace the silhouette of a triangle soup seen along ``direction``.
+
+    Args:
+        vertices: (N, 3) finite coordinates.
+        triangles: (M, 3) vertex indices. Any soup works: open, non-manifold, several parts, degenerate or
+            duplicate faces, inconsistent winding, inner shells.
+        direction: the view direction: ``"X"``, ``"Y"``, ``"Z"`` (optionally ``"-X"`` …, looking along the axis
+            towards its positive or negative end) or any non-zero 3D vector.
+        resolution: grid cells along the longest side of the projected bounding box (default
+            ``DEFAULT_RESOLUTION``); see the module docstring for the accuracy it buys.
+        tolerance: how far simplification may move the outline, as a fraction of a cell in [0, 1] (default
+            ``DEFAULT_TOLERANCE``; 0 keeps every traced point).
+
+    Returns:
+        A :class:`Silhouette`.
+
+    Raises:
+        ValueError: wrong shapes, NaN or infinite coordinates, out-of-range indices, an empty mesh, a bad
+            direction or resolution or tolerance, or a mesh whose projection has zero area.
+    """
+    verts = _as_array(vertices, "vertices", np.float64)
+    if verts.ndim != 2 or verts.shape[1] != 3:
+        raise ValueError(f"vertices must have shape (N, 3), got {verts.shape}")
+    if not np.isfinite(verts).all():
+        bad = int(np.flatnonzero(~np.isfinite(verts).all(axis=1))[0])
+        raise ValueError(f"vertices must be finite; vertex {bad} is {verts[bad].tolist()}")
+    tris = _as_triangles(triangles, len(verts))
+    if len(verts) == 0 or len(tris) == 0:
+        raise ValueError(f"the mesh is empty ({len(verts)} vertices, {len(tris)} triangles)")
+    view = _as_direction(direction)
+    res = DEFAULT_RESOLUTION if resolution is None else resolution
+    lo, hi = _rigger_silhouette.MIN_RESOLUTION, _rigger_silhouette.MAX_RESOLUTION
+    if isinstance(res, bool) or not isinstance(res, (int, np.integer)) or not lo <= res <= hi:
+        raise ValueError(f"resolution must be an integer in [{lo}, {hi}], got {res!r}")
+    tol = DEFAULT_TOLERANCE if tolerance is None else tolerance
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)) or not 0 <= tol <= 1:
+        raise ValueError(f"tolerance must be a number in [0, 1] (a fraction of a grid cell), got {tol!r}")
+    handle = _rigger_silhouette.trace(np.ascontiguousarray(verts), tris, view, int(res), float(tol))
+    origin, u, v, unit = handle.frame()
+    _, cell, _, _ = handle.grid()
+    return Silhouette(handle.loops(), origin, u, v, unit, cell, handle)
+
+
+def _as_direction(direction):
+    if isinstance(direction, str):
+        name = direction.strip().upper()
+        sign = -1.0 if name.startswith("-") else 1.0
+        axis = AXES.get(name.lstrip("+-"))
+        if axis is None or name.count("-") + name.count("+") > 1:
+            raise ValueError(f"direction must be 'X', 'Y', 'Z' (optionally with a sign) or a 3D vector, "
+                             f"got {direction!r}")
+        return np.array(axis) * sign
+    vec = _as_array(direction, "direction", np.float64)
+    if vec.shape != (3,):
+        raise ValueError(f"direction must be 'X', 'Y', 'Z' or a 3D vector, got shape {vec.shape}")
+    if not np.isfinite(vec).all() or not np.any(vec):
+        raise ValueError(f"direction must be finite and non-zero, got {vec.tolist()}")
+    return np.ascontiguousarray(vec)
+
+
+def _as_triangles(values, n_vertices):
+    raw = np.asarray(values)
+    if raw.size == 0:
+        return np.zeros((0, 3), np.int64)
+    if raw.dtype.kind not in "iu":
+        if raw.dtype.kind == "f" and np.isfinite(raw).all() and (raw == np.round(raw)).all():
+            raw = raw.astype(np.int64)
+        else:
+            raise ValueError(f"triangles must hold integer vertex indices, got dtype {raw.dtype}")
+    if raw.ndim != 2 or raw.shape[1] != 3:
+        raise ValueError(f"triangles must have shape (M, 3), got {raw.shape}")
+    if raw.min() < 0 or raw.max() >= n_vertices:
+        bad = int(np.flatnonzero(((raw < 0) | (raw >= n_vertices)).any(axis=1))[0])
+        raise ValueError(f"triangle {bad} {raw[bad].tolist()} indexes outside the {n_vertices} vertices")
+    return np.ascontiguousarray(raw, dtype=np.int64)
+
+
+def _as_points(values):
+    pts = _as_array(values, "points", np.float64)
+    if pts.size == 0:
+        return np.zeros((0, 2), np.float64)
+    if pts.ndim == 1 and pts.shape == (2,):
+        pts = pts[None, :]
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise ValueError(f"points must have shape (P, 2), got {pts.shape}")
+    if not np.isfinite(pts).all():
+        raise ValueError("points must be finite")
+    return np.ascontiguousarray(pts)
+
+
+def _as_array(values, name, dtype):
+    try:
+        return np.asarray(values, dtype=dtype)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a numeric array: {exc}") from None
