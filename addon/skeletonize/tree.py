@@ -5,8 +5,8 @@ A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch p
 1. Blob merging (Pan's "merge the triangles that lie within one maximal inscribed disc"): every junction, largest
    first, swallows the axis nodes it reaches without leaving its disc. A round head or belly thus becomes one node
    instead of a tree of spurious little branches.
-2. Spur pruning: a branch whose end disc pokes out of the disc it hangs on by less than ``prune`` radii is outline
-   noise, not a limb; it is removed, repeatedly, since removing one can expose another.
+2. Spur pruning: a branch that pokes out of the disc it hangs on by less than ``prune`` times its own width is a
+   bump or outline noise, not a limb; it is removed, repeatedly, since removing one can expose another.
 3. Rooting at the most central branch point (smallest largest distance to any end), then cutting every cycle (holes
    in the silhouette) where the two ways around it from the root meet.
 """
@@ -90,10 +90,12 @@ def _walk(start, first, neighbours, keys, visited):
 
 
 def prune_spurs(points, radius, chains, prune):
-    """Drop leaf chains whose end disc reaches less than ``prune`` base radii beyond the disc of the node they hang
-    on, until none does. ``chains`` are node lists; returns the surviving links.
+    """Drop leaf chains that stick out of the disc of the node they hang on by less than ``prune`` times their own
+    width, until none does. ``chains`` are node lists; returns the surviving links.
 
-    Measuring the end's disc, not just its centre, keeps short branches that end in a blob (a neck with its head).
+    A limb is long for its width (a leg, a finger, a tail) while outline noise and bumps (an ear on a round head, a
+    belly) are not, whatever their size. Measuring to the end's disc, not just its centre, keeps short branches that
+    end in a blob (a neck with its head).
     """
     chains = [list(c) for c in chains]
     while True:
@@ -106,7 +108,9 @@ def prune_spurs(points, radius, chains, prune):
             for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
                 if degree[tip] == 1 and degree[base] >= 3:
                     beyond = np.linalg.norm(points[tip] - points[base]) + radius[tip] - radius[base]
-                    if beyond <= prune * radius[base]:
+                    out = [n for n in chain if np.linalg.norm(points[n] - points[base]) > radius[base]]
+                    width = 2 * float(radius[out].mean()) if out else 2 * float(radius[tip])
+                    if beyond <= prune * width:
                         spurs.append(i)
                     break
         if not spurs:
