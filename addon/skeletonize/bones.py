@@ -94,26 +94,39 @@ def _corners(line, angle, tolerance):
     return corners
 
 
-def mirror_plane(vertices, tolerance):
+def mirror_plane(vertices, tolerance, samples=4000):
     """The axis (0, 1, 2) and offset of a plane the mesh is mirror-symmetric about, or None.
 
     Tries the planes through the bounding-box centre perpendicular to X, Y and Z; a plane fits when at least 95% of
-    the vertices have a mirror image among the vertices within ``tolerance`` (grid hashing, no KD-tree needed)."""
+    (up to ``samples``) vertices have a mirror image among the vertices within ``tolerance``: vertices are hashed to
+    a grid of that size and the mirrored ones looked up in the sorted hashes, with their 26 neighbour cells.
+    """
     low, high = vertices.min(axis=0), vertices.max(axis=0)
-    cells = np.floor(vertices / tolerance).astype(np.int64)
-    table = set(map(tuple, cells.tolist()))
-    offsets = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)]
+    origin = low - 2 * tolerance
+    span = np.floor((high - low) / tolerance).astype(np.int64) + 5
+    table = np.unique(_cell_keys(np.floor((vertices - origin) / tolerance).astype(np.int64), span))
+    step = max(1, len(vertices) // samples)
+    probe = vertices[::step]
+    offsets = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)])
     best = None
     for axis in range(3):
         centre = 0.5 * (low[axis] + high[axis])
-        mirrored = vertices.copy()
+        mirrored = probe.copy()
         mirrored[:, axis] = 2 * centre - mirrored[:, axis]
-        mcells = np.floor(mirrored / tolerance).astype(np.int64).tolist()
-        hits = sum(any((c[0] + dx, c[1] + dy, c[2] + dz) in table for dx, dy, dz in offsets) for c in mcells)
-        score = hits / len(vertices)
+        cells = np.floor((mirrored - origin) / tolerance).astype(np.int64)
+        found = np.zeros(len(probe), bool)
+        for offset in offsets:
+            keys = _cell_keys(np.clip(cells + offset, 0, span - 1), span)
+            at = np.minimum(np.searchsorted(table, keys), len(table) - 1)
+            found |= table[at] == keys
+        score = found.mean()
         if score >= 0.95 and (best is None or score > best[2]):
             best = (axis, centre, score)
     return None if best is None else best[:2]
+
+
+def _cell_keys(cells, span):
+    return (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]
 
 
 def mirror_pairs(heads, tails, plane, tolerance):
