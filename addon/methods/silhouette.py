@@ -43,9 +43,9 @@ class SilhouetteMethod(RigMethod):
                           "(gaps between parts), larger ones (an arm on the hip) are kept"),
         Param("merge", "float", 1.0, min=0.0, max=3.0,
               description="Blob merging: nodes within this many disc radii of a branch point join it"),
-        Param("prune", "float", 1.5, min=0.0, max=5.0,
-              description="Branches reaching less than (1 + prune) disc radii beyond their base are dropped; "
-                          "lower keeps finer branches such as fingers"),
+        Param("prune", "float", 1.25, min=0.0, max=5.0,
+              description="Branches sticking out of their base by less than this many times their width are "
+                          "dropped as bumps; lower keeps stubbier branches"),
         Param("bone_angle", "float", 40.0, min=1.0, max=180.0,
               description="Start a new bone where a chain turns by more than this many degrees"),
         Param("bone_length", "float", 0.1, min=0.01, max=1.0,

@@ -93,9 +93,8 @@ def prune_spurs(points, radius, chains, prune):
     """Drop leaf chains that stick out of the disc of the node they hang on by less than ``prune`` times their own
     width, until none does. ``chains`` are node lists; returns the surviving links.
 
-    A limb is long for its width (a leg, a finger, a tail) while outline noise and bumps (an ear on a round head, a
-    belly) are not, whatever their size. Measuring to the end's disc, not just its centre, keeps short branches that
-    end in a blob (a neck with its head).
+    A limb is long for its width where it leaves the base (a leg, a finger, a tail, a neck with its head) while
+    outline noise and bumps (an ear on a round head, a belly) are not, whatever their size.
     """
     chains = [list(c) for c in chains]
     while True:
@@ -108,7 +107,9 @@ def prune_spurs(points, radius, chains, prune):
             for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
                 if degree[tip] == 1 and degree[base] >= 3:
                     beyond = np.linalg.norm(points[tip] - points[base]) + radius[tip] - radius[base]
-                    out = [n for n in chain if np.linalg.norm(points[n] - points[base]) > radius[base]]
+                    # width where the branch leaves the base disc: a neck, not the head it carries
+                    out = [n for n in (chain if chain[0] == base else chain[::-1])
+                           if np.linalg.norm(points[n] - points[base]) > radius[base]][:3]
                     width = 2 * float(radius[out].mean()) if out else 2 * float(radius[tip])
                     if beyond <= prune * width:
                         spurs.append(i)
