@@ -94,7 +94,7 @@ def _corners(line, angle, tolerance):
     return corners
 
 
-def mirror_plane(vertices, tolerance, samples=4000):
+def mirror_plane(vertices, tolerance, samples=1500):
     """The axis (0, 1, 2) and offset of a plane the mesh is mirror-symmetric about, or None.
 
     Tries the planes through the bounding-box centre perpendicular to X, Y and Z; a plane fits when at least 95% of
@@ -114,12 +114,10 @@ def mirror_plane(vertices, tolerance, samples=4000):
         mirrored = probe.copy()
         mirrored[:, axis] = 2 * centre - mirrored[:, axis]
         cells = np.floor((mirrored - origin) / tolerance).astype(np.int64)
-        found = np.zeros(len(probe), bool)
-        for offset in offsets:
-            keys = _cell_keys(np.clip(cells + offset, 0, span - 1), span)
-            at = np.minimum(np.searchsorted(table, keys), len(table) - 1)
-            found |= table[at] == keys
-        score = found.mean()
+        around = np.clip(cells[:, None, :] + offsets[None], 0, span - 1).reshape(-1, 3)
+        keys = _cell_keys(around, span)
+        at = np.minimum(np.searchsorted(table, keys), len(table) - 1)
+        score = (table[at] == keys).reshape(len(probe), -1).any(axis=1).mean()
         if score >= 0.95 and (best is None or score > best[2]):
             best = (axis, centre, score)
     return None if best is None else best[:2]
