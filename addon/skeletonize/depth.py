@@ -114,10 +114,11 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
         return depths
     out = depths.copy()
     previous = depths[0]
+    typical = max(float(np.median(radius)), sil.cell)  # not the tip's vanishing radius
     for i, layer in enumerate(node_layers):
         if len(layer):
             interval = layer[np.argmin(np.abs(0.5 * (layer[:, 0] + layer[:, 1]) - depths[i]))]
-            if interval[1] - interval[0] > OCCLUSION_RATIO * 2 * max(radius[i], sil.cell):
+            if interval[1] - interval[0] > OCCLUSION_RATIO * 2 * max(radius[i], typical):
                 found = side_axis.depth_at(sil, points[i], radius[i], interval, previous)
                 if found is not None:
                     out[i] = found
