@@ -8,6 +8,7 @@ STAMP := $(VENV)/.installed
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet pip==26.3  # older pips cannot install a package_dir-mapped project editable
 	$(PY) -m pip install --quiet -r requirements.txt
 	touch $(STAMP)
 

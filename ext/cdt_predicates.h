@@ -65,20 +65,23 @@ static int rg_grow(int elen, const double *e, double b, double *h) {
     return n;
 }
 
-/* h = e + f in linear time: merge both by magnitude, then carry one running sum through (Fast-Expansion-Sum).
- * h must hold elen + flen doubles and may not alias e or f. Returns length. */
-static int rg_sum(int elen, const double *e, int flen, const double *f, double *h, double *merged) {
-    int i = 0, j = 0, k = 0, n = 0;
-    while (i < elen && j < flen) merged[k++] = (fabs(e[i]) < fabs(f[j])) ? e[i++] : f[j++];
-    while (i < elen) merged[k++] = e[i++];
-    while (j < flen) merged[k++] = f[j++];
-    if (k == 0) {
+/* h = e + f in linear time: take the components of both in order of magnitude and carry one running sum through
+ * them (Fast-Expansion-Sum). h must hold elen + flen doubles and may not alias e or f; ``unused`` is kept for the
+ * callers' buffers. Returns length. */
+static int rg_sum(int elen, const double *e, int flen, const double *f, double *h, double *unused) {
+    (void)unused;
+    int i = 0, j = 0, n = 0;
+    double q, hh, next;
+    if (elen == 0 && flen == 0) {
         h[0] = 0.0;
         return 1;
     }
-    double q = merged[0], hh;
-    for (i = 1; i < k; i++) {
-        rg_two_sum(q, merged[i], &q, &hh);
+    if (j >= flen || (i < elen && fabs(e[i]) < fabs(f[j]))) q = e[i++];
+    else q = f[j++];
+    while (i < elen || j < flen) {
+        if (j >= flen || (i < elen && fabs(e[i]) < fabs(f[j]))) next = e[i++];
+        else next = f[j++];
+        rg_two_sum(q, next, &q, &hh);
         if (hh != 0.0) h[n++] = hh;
     }
     if (q != 0.0 || n == 0) h[n++] = q;
