@@ -23,6 +23,7 @@ from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chain
 AXES = np.eye(3)
 SPECK = 0.25  # islands whose axis is shorter than this many bone lengths get no bones of their own
 SPREAD_SAMPLES = 100_000  # triangles sampled to choose the view
+MIN_BRANCH = 0.5  # branches sticking out less than this many bone lengths are dropped, however thin
 AXIS_NAMES = ("X", "Y", "Z")
 
 
@@ -70,7 +71,7 @@ class SilhouetteMethod(RigMethod):
         representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
         alive = np.unique(representative)
         _, chains = chains_of(alive.tolist(), merged)
-        kept = prune_spurs(graph.points, graph.radius, chains, prune)
+        kept = prune_spurs(graph.points, graph.radius, chains, prune, MIN_BRANCH * bone_length * mesh.scale)
         clock.lap("merge_prune")
 
         side = None

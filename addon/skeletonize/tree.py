@@ -89,9 +89,9 @@ def _walk(start, first, neighbours, keys, visited):
     return path
 
 
-def prune_spurs(points, radius, chains, prune):
+def prune_spurs(points, radius, chains, prune, min_reach=0.0):
     """Drop leaf chains that stick out of the disc of the node they hang on by less than ``prune`` times their own
-    width, until none does. ``chains`` are node lists; returns the surviving links.
+    width, or by less than ``min_reach``, until none does. ``chains`` are node lists; returns the surviving links.
 
     A limb is long for its width where it leaves the base (a leg, a finger, a tail, a neck with its head) while
     outline noise and bumps (an ear on a round head, a belly) are not, whatever their size.
@@ -111,7 +111,7 @@ def prune_spurs(points, radius, chains, prune):
                     out = [n for n in (chain if chain[0] == base else chain[::-1])
                            if np.linalg.norm(points[n] - points[base]) > radius[base]][:3]
                     width = 2 * float(radius[out].mean()) if out else 2 * float(radius[tip])
-                    if beyond <= prune * width:
+                    if beyond <= max(prune * width, min_reach):
                         spurs.append(i)
                     break
         if not spurs:
