@@ -921,7 +921,7 @@ def triangulate(points, segments, bint inside, holes):
     cdef int *tmp_order = <int *> malloc(<size_t> n * sizeof(int))
     cdef unsigned int *keys = <unsigned int *> malloc(<size_t> n * sizeof(unsigned int))
     cdef unsigned int *tmp_keys = <unsigned int *> malloc(<size_t> n * sizeof(unsigned int))
-    cdef int err = 0, collinear = 0, i
+    cdef int err = 0, i
     try:
         m.cap_v = n + 16
         m.cap_t = 2 * n + 16
@@ -939,17 +939,30 @@ def triangulate(points, segments, bint inside, holes):
                 m.VT[i] = -1
             m.nv = n
             hilbert_order(m.xy, n, order, keys, tmp_keys, tmp_order)
-            err = delaunay(&m, n, order, &vmap[0])
-            if err == 1:
-                collinear = 1
-                err = 0
-            elif err == 0 and nseg:
-                err = insert_constraints(&m, &segs[0, 0], nseg, &vmap[0])
+            # renumber the vertices in insertion order, so that the predicates read memory that is close together
+            for i in range(n):
+                m.xy[2 * i] = xy[order[i], 0]
+                m.xy[2 * i + 1] = xy[order[i], 1]
+                tmp_order[i] = i
+            err = delaunay(&m, n, tmp_order, &vmap[0])
+        if err == 1:
+            return _collinear_result(points, segments)
         if err:
             raise _ERRORS[err]
-        if collinear:
-            return _collinear_result(points, segments)
-        return _collect(&m, points, exponent, vmap_arr, inside, np.ascontiguousarray(
+        original = np.asarray(<int[:n]> order).copy()  # internal vertex -> input point
+        internal = np.empty(n, dtype=np.int32)
+        internal[original] = np.arange(n, dtype=np.int32)
+        segs_internal = np.ascontiguousarray(internal[np.asarray(segments)], dtype=np.int32)
+        if nseg:
+            segs = segs_internal
+            with nogil:
+                err = insert_constraints(&m, &segs[0, 0], nseg, &vmap[0])
+            if err:
+                raise _ERRORS[err]
+        vertex_map = np.empty(n, dtype=np.int32)
+        vertex_map[original] = original[vmap_arr]
+        to_input = np.concatenate([original, np.arange(n, m.nv, dtype=np.int32)])
+        return _collect(&m, points, exponent, vertex_map, to_input, inside, np.ascontiguousarray(
             np.ldexp(np.asarray(holes, dtype=np.float64).reshape(-1, 2), -exponent)))
     finally:
         free(order)
@@ -964,8 +977,10 @@ def triangulate(points, segments, bint inside, holes):
         free(m.stack)
 
 
-cdef object _collect(Mesh *m, object points, int exponent, object vmap_arr, bint inside, double[:, ::1] holes):
-    """Keep the wanted real triangles and build the output arrays."""
+cdef object _collect(Mesh *m, object points, int exponent, object vmap_arr, object to_input_arr, bint inside,
+                     double[:, ::1] holes):
+    """Keep the wanted real triangles and build the output arrays (vertices numbered as the input, ``to_input``)."""
+    cdef int[::1] to_input = to_input_arr
     cdef int nt = m.nt, t, k, j, h, loc, at, start, kept = 0, nb, nseg = 0, d
     removed_arr = np.zeros(nt, dtype=np.int8)
     stack_arr = np.empty(nt + 1, dtype=np.int32)
@@ -1002,7 +1017,7 @@ cdef object _collect(Mesh *m, object points, int exponent, object vmap_arr, bint
         if k < 0:
             continue
         for j in range(3):
-            tri_v[k, j] = m.V[3 * t + j]
+            tri_v[k, j] = to_input[m.V[3 * t + j]]
             # the edge opposite corner j runs from corner j+1 to corner j+2: half-edge (j + 1) % 3
             h = 3 * t + (j + 1) % 3
             tri_n[k, j] = new_index[m.N[h] // 3]
@@ -1017,8 +1032,8 @@ cdef object _collect(Mesh *m, object points, int exponent, object vmap_arr, bint
     for h in range(3 * nt):
         d = m.V[nxt(h)]
         if m.C[h] and m.V[h] >= 0 and d >= 0 and m.V[h] < d:
-            seg_v[nseg, 0] = m.V[h]
-            seg_v[nseg, 1] = d
+            seg_v[nseg, 0] = min(to_input[m.V[h]], to_input[d])
+            seg_v[nseg, 1] = max(to_input[m.V[h]], to_input[d])
             nseg += 1
     segs = segs[np.lexsort((segs[:, 1], segs[:, 0]))]
     n = len(points)
