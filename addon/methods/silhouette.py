@@ -145,8 +145,7 @@ def _variances(vertices, triangles=None):
 
 def planar_axis(vertices, triangles, direction, resolution, spacing, min_hole):
     """Silhouette along ``direction``, its constrained Delaunay triangulation and the chordal axis."""
-    # the tracer's binding wants writable buffers; Mesh arrays are read-only views
-    sil = silhouette.trace(np.array(vertices), np.array(triangles), direction, resolution=resolution)
+    sil = silhouette.trace(vertices, triangles, direction, resolution=resolution)
     points, segments = _outline(_without_small_holes(sil.loops, min_hole), spacing)
     tri = cdt.triangulate(points, segments, mode="inside")
     return sil, tri, chordal_axis(tri)
