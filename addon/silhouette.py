@@ -15,27 +15,32 @@ How it works, and why it cannot fail: the projected triangles are snapped to an 
 grid cell) and every inside/outside decision is exact integer arithmetic under a symbolic perturbation, so no grid
 point ever sits on an edge and shared edges leave no cracks. Along each horizontal and vertical grid line the union
 of the triangles' cross-sections is computed exactly; the outline passes through those exact crossing points and is
-closed inside each cell by straight chords whose pairing follows from the same predicate. Loops are therefore closed,
-simple and consistently oriented by construction, and nothing recurses or uses a fixed-size buffer.
+closed inside each cell by straight chords. A cell with more than two crossings (two features meeting, a thin strip
+passing a corner) is split into quarters along exact midlines until each part is clear, down to 1/256 of a cell.
+Loops are therefore closed, simple and consistently oriented by construction; where parts of the shape touch at a
+single point the loops are pulled a hair (1e-6 cell) apart so they stay strictly simple. Nothing recurses, buffers
+grow on the heap, and the cost is linear in the triangles plus the grid lines they cross.
 
 Accuracy versus resolution: ``resolution`` is the number of grid cells along the longest side of the projected
-bounding box, so the cell size is ``longest side / resolution``. Because crossings are exact, a straight silhouette
-edge is reproduced exactly wherever it crosses a grid line; the outline departs from the true union only
+bounding box (cell size = longest side / resolution). Because crossings are exact, a straight silhouette edge is
+reproduced exactly wherever it crosses a grid line; the outline departs from the exact union only
 
 - at corners, which a chord cuts off: at most about half a cell's area each, far less for the blunt corners of a
   smooth mesh;
-- for specks: islands or holes that cross no grid line (smaller than a cell in both directions) are dropped, and a
-  thin part crossing a grid line keeps its exact width there, so fingers, tails and antennae stay separate lobes as
-  long as the gaps between them are wider than about a cell.
+- for specks: islands or holes that cross no grid line (smaller than a cell both ways) or enclose less than 1e-4
+  square cells are dropped. A thin part that crosses grid lines keeps its exact width there, so fingers, tails and
+  antennae stay separate lobes even where the gap between them is narrower than a cell.
 
-Measured on the project's test models (``bench/results/silhouette.md``): at the default 1024 the area IoU against
-the exact union is above 0.9995, holes and islands larger than a few cells all match; 256 still gives IoU > 0.998
-but closes gaps narrower than 1/256 of the figure. Cost grows linearly with the triangle count plus the number of
-cells crossed, about 0.1 s for a million triangles at the default.
+Measured against the exact union on real models (``bench/results/silhouette.md``; front and side views): worst area
+IoU 0.9962 at resolution 128, 0.9988 at 256, 0.9996 at 512, 0.99986 at the default 1024 and 0.99995 at 2048. The
+default keeps the IoU above 0.999 on every model tried, matches every island and hole larger than a few cells, and
+traces a million triangles in about 0.2 s; a 5,000-triangle character takes about 4 ms. Lower resolutions are
+cheaper mainly for meshes of large triangles, whose cross-sections are computed on every line they cross.
 
-``tolerance`` then removes outline points while the outline moves by at most that fraction of a cell, never
-removing a point whose removal could make two loop segments cross; the default 0.05 keeps the IoU essentially
-unchanged while dropping the collinear runs that straight mesh edges produce.
+``tolerance`` then removes outline points while a bound on the distance between the traced and the simplified
+outline stays within that fraction of a cell, never removing a point whose removal could make two loop segments
+cross; the default 0.05 keeps the IoU essentially unchanged while dropping the collinear runs that straight mesh
+edges produce (about 250 points for a whole character instead of several thousand).
 """
 from dataclasses import dataclass, field
 
@@ -54,8 +59,9 @@ class Silhouette:
 
     Attributes:
         loops: list of (K, 2) float64 arrays in the (u, v) frame, closing point not repeated. Outer boundaries run
-            counter-clockwise, holes clockwise, every loop is simple and no two loops cross, so they can be passed
-            directly to ``rigger.cdt.triangulate(points, segments, mode="inside")``.
+            counter-clockwise, holes clockwise, every loop is simple and no two loops touch, so they can be passed
+            directly to ``rigger.cdt.triangulate(points, segments, mode="inside")``. Empty only when every part of
+            the projection is a speck (see the module docstring).
         origin, u, v, direction: (3,) float64. A frame point (x, y) at depth d is the 3D point
             ``origin + x*u + y*v + d*direction``; ``direction`` is the unit view direction, depth grows away from
             the viewer, and (u, v) is what the viewer sees as (right, up).
@@ -83,9 +89,11 @@ class Silhouette:
 
         Returns a list with one (L, 2) float64 array of (entry, exit) depths per point, sorted front to back (empty
         on a miss). Hits pair up by crossing parity within each connected part of the mesh (vertices at identical
-        positions are welded first), and overlapping intervals of different parts are merged: two legs one behind
-        the other give two intervals, an eye inside a head gives one. Where an open part is hit an odd number of
-        times, the hit whose removal leaves the thinnest pairing becomes a zero-thickness interval.
+        positions are welded first, as glTF seams split them), and overlapping intervals of different parts are
+        merged: two legs one behind the other give two intervals, an eye inside a head gives one. Where an open part
+        is hit an odd number of times, the hit whose removal leaves the thinnest pairing becomes a zero-thickness
+        interval. Parity also governs closed shells that overlap in 3D while sharing vertices (one part): the region
+        inside both counts as outside.
         """
         return self._trace.layers(_as_points(points))
 

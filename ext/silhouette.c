@@ -1,15 +1,17 @@
 /* The 3D silhouette tracer; see silhouette.h for the method in brief.
  *
  * Exactness. Projected vertices are snapped to integers with 2^16 steps per cell on a grid of at most 2^14 cells a
- * side, so coordinates stay below 2^30 and every orientation test below is exact in int64. Grid point (i, j) is the
- * point (i, j) * 2^16 + (e, e^2) for an infinitesimal e > 0 (simulation of simplicity): it never lies on a triangle
- * edge, two triangles sharing an edge never both or neither contain it, and the horizontal pass, the vertical pass
- * and point queries all ask that same predicate. So the corners, crossings and chords agree by construction.
+ * side, so coordinates stay below 2^30 and every orientation test below is exact in int64. A lattice point p is
+ * taken as p + (e, e^2) for an infinitesimal e > 0 (simulation of simplicity): it never lies on a triangle edge, two
+ * triangles sharing an edge never both or neither contain it, and the horizontal pass, the vertical pass, the cell
+ * refinement and point queries all ask that same predicate. So corners, crossings and chords agree by construction.
  *
- * Pipeline: frame and projection -> snap -> for each grid line family, the union of the triangles' cross-sections
- * (sweep with an active list, per-line sort, merge) -> per cell, chords pairing the boundary crossings -> loops by
- * following the chords -> optional simplification that never removes a point whose triangle holds another point.
- * Depth queries bin the triangles into a coarse grid on first use and cast exact rays against one bin.
+ * Pipeline: frame and projection -> snap -> for each family of grid lines, a sweep that keeps the triangles crossing
+ * the current line and tallies their exact cross-sections into the union's crossings -> per cell, chords pairing the
+ * crossings, with ambiguous cells (more than two crossings) split into quarters along exact midlines until each part
+ * is clear -> loops by following the chords -> parts touching at a point pulled a hair apart, specks dropped ->
+ * optional simplification that never removes a point whose triangle holds another point. Depth queries bin the
+ * triangles on first use and cast exact rays against one bin.
  */
 #include "silhouette.h"
 
@@ -24,7 +26,7 @@
 #define GRID_MARGIN 1.3819660112501051
 #define TOUCH_NUDGE 1e-6  /* cells a point that an outline visits twice moves to its inner side */
 #define SPECK 1e-4        /* loops enclosing less (square cells) are dropped: far below the resolution */
-#define SIMPLIFY_SPAN 48 /* most traced points one simplified segment may replace: bounds its length and cost */
+#define SIMPLIFY_LENGTH 64.0 /* cells: the longest simplified segment, which bounds the cost of proving it clear */
 
 typedef struct {
     int32_t block, cols, rows; /* cells per bin side, bin counts */
@@ -416,17 +418,14 @@ static void sort_spans(Span *s, int64_t n)
 
 static int add_crossing(Crossings *c, int32_t line, int32_t gap, double pos, int is_start)
 {
-    if (c->count == c->cap) {
-        int64_t cap = c->cap;
-        int rc = reserve((void **)&c->line, &cap, c->count + 1, sizeof(int32_t));
-        cap = c->cap;
-        if (rc == SIL_OK) rc = reserve((void **)&c->gap, &cap, c->count + 1, sizeof(int32_t));
-        cap = c->cap;
-        if (rc == SIL_OK) rc = reserve((void **)&c->pos, &cap, c->count + 1, sizeof(double));
-        cap = c->cap;
-        if (rc == SIL_OK) rc = reserve((void **)&c->is_start, &cap, c->count + 1, sizeof(uint8_t));
-        if (rc != SIL_OK) return rc;
-        c->cap = cap;
+    if (c->count == c->cap) { /* the four arrays share one capacity, committed once all have grown */
+        int64_t cap[4] = {c->cap, c->cap, c->cap, c->cap};
+        if (reserve((void **)&c->line, &cap[0], c->count + 1, sizeof(int32_t)) != SIL_OK ||
+            reserve((void **)&c->gap, &cap[1], c->count + 1, sizeof(int32_t)) != SIL_OK ||
+            reserve((void **)&c->pos, &cap[2], c->count + 1, sizeof(double)) != SIL_OK ||
+            reserve((void **)&c->is_start, &cap[3], c->count + 1, sizeof(uint8_t)) != SIL_OK)
+            return SIL_ERR_NOMEM;
+        c->cap = cap[0];
     }
     c->line[c->count] = line;
     c->gap[c->count] = gap;
@@ -599,7 +598,30 @@ typedef struct { /* per-gap tallies of one line's cross-sections, kept clear bet
     int64_t piece_cap, n_pieces;
     Piece *local;     /* one gap's pieces, sorted */
     int64_t local_cap;
+    uint64_t *touched; /* bit per position holding any of the above, so a line costs its spans, not its width */
 } Tally;
+
+static int lowest_bit(uint64_t x) /* x != 0 */
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_ctzll(x);
+#else
+    int n = 0;
+    while (!(x & 1u)) {
+        x >>= 1;
+        n++;
+    }
+    return n;
+#endif
+}
+
+static void touch_pair(Tally *y, int32_t position) /* position and position + 1 */
+{
+    y->touched[position / 64] |= (uint64_t)3 << (position % 64);
+    if (position % 64 == 63) y->touched[position / 64 + 1] |= 1;
+}
+
+static int touched(const Tally *y, int32_t position) { return (int)(y->touched[position / 64] >> (position % 64)) & 1; }
 
 static void sort_pieces(Piece *p, int64_t n)
 {
@@ -617,6 +639,8 @@ static void sort_pieces(Piece *p, int64_t n)
 static int tally_span(Tally *y, const Span *s)
 {
     int32_t lo = s->gap_lo + 1, hi = s->gap_hi;
+    touch_pair(y, s->gap_lo);
+    touch_pair(y, hi);
     if (lo <= hi) {
         y->points[lo]++;
         y->points[hi + 1]--;
@@ -640,60 +664,74 @@ static int tally_span(Tally *y, const Span *s)
     return SIL_OK;
 }
 
-/* Turn one line's tallies over gaps gmin..gmax into the union's crossings, in order, and clear them. A gap covered
- * whole has none; otherwise the union inside it is the piece from its left end (up to the highest end), the pieces
- * within it and the piece to its right end (from the lowest start), merged where they touch. */
+/* Turn one line's tallies over gaps gmin..gmax into the union's crossings, in order, and clear them. Only touched
+ * positions can hold a crossing (state changes only where a cross-section starts or ends). A gap covered whole has
+ * none; otherwise the union inside it is the piece from its left end (up to the highest end), the pieces within it
+ * and the piece to its right end (from the lowest start), merged where they touch. */
 static int emit_line(Tally *y, int32_t line, int32_t gmin, int32_t gmax, Crossings *c)
 {
+    const int64_t first_word = gmin / 64, last_word = (gmax + 1) / 64;
     int rc = SIL_OK;
-    for (int32_t g = gmin, points = 0, covers = 0; g <= gmax + 1; g++) {
-        points += y->points[g];
-        covers += y->covers[g];
-        y->points[g] = points;
-        y->covers[g] = covers;
-    }
-    for (int32_t g = gmin; g <= gmax && rc == SIL_OK; g++) {
-        int left = y->points[g] > 0, right = y->points[g + 1] > 0;
-        if (y->covers[g] > 0 || (!left && !right && y->bucket[g] == 0)) continue;
-        if ((left && !(y->ends[g] >= g)) || (right && !(y->starts[g] <= g + 1))) return SIL_ERR_INTERNAL;
-        if (left && right && y->ends[g] >= y->starts[g]) continue; /* covered end to end */
-        int64_t kept = 0;
-        for (int64_t i = y->bucket[g]; i != 0; i = y->pieces[i - 1].next) {
-            if ((rc = reserve((void **)&y->local, &y->local_cap, kept + 1, sizeof(Piece))) != SIL_OK) break;
-            y->local[kept++] = y->pieces[i - 1];
+    int32_t points = 0, covers = 0;
+    for (int64_t w = first_word; w <= last_word; w++) { /* running counts at the touched positions */
+        for (uint64_t bits = y->touched[w]; bits; bits &= bits - 1) {
+            int32_t g = (int32_t)(w * 64 + lowest_bit(bits));
+            points += y->points[g];
+            covers += y->covers[g];
+            y->points[g] = points;
+            y->covers[g] = covers;
         }
-        sort_pieces(y->local, kept);
-        int open = left, right_used = !right;
-        double end = left ? y->ends[g] : 0.0;
-        for (int64_t k = 0; rc == SIL_OK;) {
-            double from, to;
-            if (!right_used && (k == kept || y->starts[g] <= y->local[k].from)) {
-                from = y->starts[g];
-                to = INFINITY;
-                right_used = 1;
-            } else if (k < kept) {
-                from = y->local[k].from;
-                to = y->local[k].to;
-                k++;
-            } else {
-                break;
-            }
-            if (open && from <= end) {
-                if (to > end) end = to;
-                continue;
-            }
-            if (open && (rc = add_crossing(c, line, g, end, 0)) != SIL_OK) break;
-            if ((rc = add_crossing(c, line, g, from, 1)) != SIL_OK) break;
-            open = 1;
-            end = to;
-        }
-        if (rc == SIL_OK && open && end != INFINITY) rc = add_crossing(c, line, g, end, 0);
     }
-    for (int32_t g = gmin; g <= gmax + 1; g++) {
-        y->points[g] = y->covers[g] = 0;
-        y->starts[g] = INFINITY;
-        y->ends[g] = -INFINITY;
-        y->bucket[g] = 0;
+    for (int64_t w = first_word; w <= last_word && rc == SIL_OK; w++) {
+        for (uint64_t bits = y->touched[w]; bits && rc == SIL_OK; bits &= bits - 1) {
+            int32_t g = (int32_t)(w * 64 + lowest_bit(bits));
+            if (g > gmax) break;
+            int left = y->points[g] > 0, right = (touched(y, g + 1) ? y->points[g + 1] : y->points[g]) > 0;
+            if (y->covers[g] > 0 || (!left && !right && y->bucket[g] == 0)) continue;
+            if ((left && !(y->ends[g] >= g)) || (right && !(y->starts[g] <= g + 1))) return SIL_ERR_INTERNAL;
+            if (left && right && y->ends[g] >= y->starts[g]) continue; /* covered end to end */
+            int64_t kept = 0;
+            for (int64_t i = y->bucket[g]; i != 0; i = y->pieces[i - 1].next) {
+                if ((rc = reserve((void **)&y->local, &y->local_cap, kept + 1, sizeof(Piece))) != SIL_OK) break;
+                y->local[kept++] = y->pieces[i - 1];
+            }
+            sort_pieces(y->local, kept);
+            int open = left, right_used = !right;
+            double end = left ? y->ends[g] : 0.0;
+            for (int64_t k = 0; rc == SIL_OK;) {
+                double from, to;
+                if (!right_used && (k == kept || y->starts[g] <= y->local[k].from)) {
+                    from = y->starts[g];
+                    to = INFINITY;
+                    right_used = 1;
+                } else if (k < kept) {
+                    from = y->local[k].from;
+                    to = y->local[k].to;
+                    k++;
+                } else {
+                    break;
+                }
+                if (open && from <= end) {
+                    if (to > end) end = to;
+                    continue;
+                }
+                if (open && (rc = add_crossing(c, line, g, end, 0)) != SIL_OK) break;
+                if ((rc = add_crossing(c, line, g, from, 1)) != SIL_OK) break;
+                open = 1;
+                end = to;
+            }
+            if (rc == SIL_OK && open && end != INFINITY) rc = add_crossing(c, line, g, end, 0);
+        }
+    }
+    for (int64_t w = first_word; w <= last_word; w++) {
+        for (uint64_t bits = y->touched[w]; bits; bits &= bits - 1) {
+            int32_t g = (int32_t)(w * 64 + lowest_bit(bits));
+            y->points[g] = y->covers[g] = 0;
+            y->starts[g] = INFINITY;
+            y->ends[g] = -INFINITY;
+            y->bucket[g] = 0;
+        }
+        y->touched[w] = 0;
     }
     y->n_pieces = 0;
     return rc;
@@ -717,10 +755,11 @@ static int sweep(const SilTrace *t, int vertical, Crossings *c)
     y.starts = alloc_array((int64_t)n_gaps + 2, sizeof(double));
     y.ends = alloc_array((int64_t)n_gaps + 2, sizeof(double));
     y.bucket = zero_array((int64_t)n_gaps + 2, sizeof(int64_t));
+    y.touched = zero_array(((int64_t)n_gaps + 2) / 64 + 1, sizeof(uint64_t));
     int rc = SIL_OK;
     c->line_start = zero_array((int64_t)n_lines + 1, sizeof(int64_t));
     if (!first_start || !ordered || !first_line || !c->line_start || !y.points || !y.covers || !y.starts || !y.ends ||
-        !y.bucket) {
+        !y.bucket || !y.touched) {
         rc = SIL_ERR_NOMEM;
         goto done;
     }
@@ -789,6 +828,7 @@ done:
     free(y.starts);
     free(y.ends);
     free(y.bucket);
+    free(y.touched);
     free(y.pieces);
     free(y.local);
     return rc;
@@ -813,7 +853,7 @@ typedef struct { /* a (sub)cell waiting to be paired or split */
 } Box;
 
 typedef struct { /* state shared while linking every cell */
-    SilTrace *t;
+    const SilTrace *t;
     int64_t *next, next_cap, n_ids; /* next[id]: the crossing after id along the outline */
     double *extra;                   /* grid positions of crossings made by refinement (ids from first_extra) */
     int64_t extra_cap, first_extra;
@@ -1180,7 +1220,7 @@ done:
  * refinement), the crossing after it along the outline. */
 static int link_cells(Linker *L, const Crossings *h, const Crossings *v)
 {
-    SilTrace *t = L->t;
+    const SilTrace *t = L->t;
     const int64_t n_h = h->count;
     int64_t *row_start = zero_array((int64_t)t->height + 2, sizeof(int64_t));
     int64_t *row_ids = alloc_array(v->count, sizeof(int64_t));
@@ -1216,7 +1256,8 @@ static int link_cells(Linker *L, const Crossings *h, const Crossings *v)
             box.y0 = (int64_t)j << FIX_SHIFT;
             box.size = FIX_ONE;
             box.first[0] = L->pool_n;
-            for (; bp < be && h->gap[bp] == cell && rc == SIL_OK; bp++) rc = push_item(L, bp, h->pos[bp], h->is_start[bp]);
+            for (; bp < be && h->gap[bp] == cell && rc == SIL_OK; bp++)
+                rc = push_item(L, bp, h->pos[bp], h->is_start[bp]);
             int64_t l1 = vp;
             while (l1 < ve && v->line[row_ids[l1]] == cell) l1++;
             box.first[1] = L->pool_n;
@@ -1225,7 +1266,8 @@ static int link_cells(Linker *L, const Crossings *h, const Crossings *v)
                 rc = push_item(L, n_h + k, v->pos[k], v->is_start[k]);
             }
             box.first[2] = L->pool_n;
-            for (; tp < te && h->gap[tp] == cell && rc == SIL_OK; tp++) rc = push_item(L, tp, h->pos[tp], h->is_start[tp]);
+            for (; tp < te && h->gap[tp] == cell && rc == SIL_OK; tp++)
+                rc = push_item(L, tp, h->pos[tp], h->is_start[tp]);
             box.first[3] = L->pool_n;
             for (; vp < ve && v->line[row_ids[vp]] == cell && rc == SIL_OK; vp++) {
                 int64_t k = row_ids[vp];
@@ -1509,6 +1551,7 @@ typedef struct {
     int64_t *prev, *next, *loop;
     int64_t *alive_in_loop;
     uint8_t *alive;
+    double *drift;  /* per alive point: how far the traced outline may lie from its segment to next[] */
     double *cost;
     int64_t *heap, *slot, heap_n;
     PointIndex index;
@@ -1524,23 +1567,16 @@ static double segment_distance(double px, double py, double ax, double ay, doubl
     return sqrt(ex * ex + ey * ey);
 }
 
-/* How far the outline would move if point i went: the largest distance from the new segment prev(i)-next(i) of the
- * traced points it replaces; infinite past the span limit. */
-static double removal_cost(const Simplifier *s, int64_t i, const int64_t *loop_start)
+/* A bound on how far the traced outline would lie from the simplified one if point i went: the bounds of its two
+ * segments plus its distance from the new segment prev(i)-next(i) (the old pair of segments lies within that distance
+ * of the new one). Infinite when the new segment would be longer than SIMPLIFY_LENGTH. */
+static double removal_cost(const Simplifier *s, int64_t i)
 {
-    int64_t a = s->prev[i], b = s->next[i], l = s->loop[i];
-    int64_t first = loop_start[l], size = loop_start[l + 1] - first;
+    int64_t a = s->prev[i], b = s->next[i];
     double ax = s->xy[2 * a], ay = s->xy[2 * a + 1], bx = s->xy[2 * b], by = s->xy[2 * b + 1];
-    double worst = 0.0;
-    int64_t steps = 0;
-    for (int64_t k = a;;) {
-        k = first + (k - first + 1) % size;
-        if (k == b) break;
-        if (++steps > SIMPLIFY_SPAN) return INFINITY;
-        double d = segment_distance(s->xy[2 * k], s->xy[2 * k + 1], ax, ay, bx, by);
-        if (d > worst) worst = d;
-    }
-    return worst;
+    if ((bx - ax) * (bx - ax) + (by - ay) * (by - ay) > SIMPLIFY_LENGTH * SIMPLIFY_LENGTH) return INFINITY;
+    double drift = s->drift[a] > s->drift[i] ? s->drift[a] : s->drift[i];
+    return drift + segment_distance(s->xy[2 * i], s->xy[2 * i + 1], ax, ay, bx, by);
 }
 
 static int heap_less(const Simplifier *s, int64_t a, int64_t b)
@@ -1579,7 +1615,9 @@ static int removal_blocked(const Simplifier *s, int64_t i)
 {
     const PointIndex *ix = &s->index;
     int64_t a = s->prev[i], b = s->next[i];
-    double p[3][2] = {{s->xy[2 * a], s->xy[2 * a + 1]}, {s->xy[2 * i], s->xy[2 * i + 1]}, {s->xy[2 * b], s->xy[2 * b + 1]}};
+    double p[3][2] = {{s->xy[2 * a], s->xy[2 * a + 1]},
+                      {s->xy[2 * i], s->xy[2 * i + 1]},
+                      {s->xy[2 * b], s->xy[2 * b + 1]}};
     const double hair = 1e-9;
     double x0 = p[0][0], x1 = x0, y0 = p[0][1], y1 = y0;
     for (int c = 1; c < 3; c++) {
@@ -1659,11 +1697,12 @@ static int simplify(Loops *loops, double tolerance, int32_t width, int32_t heigh
     s.alive_in_loop = alloc_array(loops->n_loops, sizeof(int64_t));
     s.alive = alloc_array(n, 1);
     s.cost = alloc_array(n, sizeof(double));
+    s.drift = zero_array(n, sizeof(double));
     s.heap = alloc_array(n, sizeof(int64_t));
     s.slot = alloc_array(n, sizeof(int64_t));
     double *kept = NULL;
     int rc = SIL_OK;
-    if (!s.prev || !s.next || !s.loop || !s.alive_in_loop || !s.alive || !s.cost || !s.heap || !s.slot) {
+    if (!s.prev || !s.next || !s.loop || !s.alive_in_loop || !s.alive || !s.drift || !s.cost || !s.heap || !s.slot) {
         rc = SIL_ERR_NOMEM;
         goto done;
     }
@@ -1679,7 +1718,7 @@ static int simplify(Loops *loops, double tolerance, int32_t width, int32_t heigh
         }
     }
     for (int64_t i = 0; i < n; i++) {
-        s.cost[i] = removal_cost(&s, i, loops->start);
+        s.cost[i] = removal_cost(&s, i);
         s.heap[i] = i;
         s.slot[i] = i;
     }
@@ -1698,11 +1737,12 @@ static int simplify(Loops *loops, double tolerance, int32_t width, int32_t heigh
         heap_swap(&s, 0, --s.heap_n);
         heap_fix(&s, 0);
         int64_t a = s.prev[i], b = s.next[i];
+        s.drift[a] = s.cost[i];
         s.next[a] = b;
         s.prev[b] = a;
-        s.cost[a] = removal_cost(&s, a, loops->start);
+        s.cost[a] = removal_cost(&s, a);
         heap_fix(&s, s.slot[a]);
-        s.cost[b] = removal_cost(&s, b, loops->start);
+        s.cost[b] = removal_cost(&s, b);
         heap_fix(&s, s.slot[b]);
     }
     kept = alloc_array(2 * n, sizeof(double));
@@ -1732,6 +1772,7 @@ done:
     free(s.loop);
     free(s.alive_in_loop);
     free(s.alive);
+    free(s.drift);
     free(s.cost);
     free(s.heap);
     free(s.slot);
