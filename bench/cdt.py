@@ -26,6 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from benchkit import cpu_model, format_seconds
+
 RESULTS = Path(__file__).resolve().parent / "results"
 FULL_SIZES = (1_000, 10_000, 100_000, 1_000_000)
 QUICK_SIZES = FULL_SIZES[:3]
@@ -322,14 +324,6 @@ def run_all(sizes, libraries):
 # ---------------------------------------------------------------- reporting
 
 
-def format_seconds(seconds):
-    if seconds < 1e-3:
-        return f"{seconds * 1e6:.0f} µs"
-    if seconds < 1.0:
-        return f"{seconds * 1e3:.3g} ms"
-    return f"{seconds:.3g} s"
-
-
 def format_cell(results, case, n, name, with_runs=False):
     cell = results.cell(case, n, name)
     if cell.seconds is None:
@@ -398,15 +392,7 @@ def throughput(results):
 
 
 def machine_notes():
-    model = "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return model, os.cpu_count()
+    return cpu_model(), os.cpu_count()
 
 
 def markdown(results, command, started, load_before, load_after):

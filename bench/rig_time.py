@@ -36,6 +36,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
+from benchkit import cpu_model, midpoint_subdivided  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "bench" / "results"
@@ -62,22 +63,6 @@ def runs_for(vertex_count):
 
 
 # ---------------------------------------------------------------- meshes
-
-
-def midpoint_subdivided(vertices, triangles):
-    """Each triangle split into four at its edge midpoints, corners wound as the original's.
-
-    Neighbouring triangles share the midpoint of their common edge, so a closed mesh stays closed; the surface is
-    unchanged, so only the vertex count grows (about fourfold).
-    """
-    count = len(vertices)
-    a, b, c = (np.asarray(triangles[:, k], dtype=np.int64) for k in range(3))
-    starts, ends = np.concatenate([a, b, c]), np.concatenate([b, c, a])
-    keys, edge_of_side = np.unique(np.minimum(starts, ends) * count + np.maximum(starts, ends), return_inverse=True)
-    midpoints = 0.5 * (vertices[keys // count] + vertices[keys % count])
-    ab, bc, ca = (count + edge_of_side).reshape(3, -1)
-    quarters = [np.stack(corners, axis=1) for corners in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))]
-    return np.concatenate([vertices, midpoints]), np.concatenate(quarters).astype(np.int32)
 
 
 def subdivided_vertex_count(vertices, triangles):
@@ -336,12 +321,7 @@ def measurement_row(measurement, stages, first_column):
 
 
 def machine_notes():
-    model = "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as info:
-            model = next(line.split(":", 1)[1].strip() for line in info if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
+    model = cpu_model()
     try:
         commit = subprocess.run(["git", "-C", str(REPO), "describe", "--always", "--dirty"], capture_output=True,
                                 text=True, timeout=10).stdout.strip() or "unknown"

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import shapely
 
+from benchkit import cpu_model, format_seconds, midpoint_subdivided
 from rigdata import load_obj
 
 from rigger import silhouette
@@ -59,23 +60,12 @@ def runs_for(triangles):
 # ---------------------------------------------------------------- meshes
 
 
-def subdivide(vertices, triangles):
-    """Split every triangle into four at its edge midpoints; triangles sharing an edge share its midpoint."""
-    edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]), axis=1)
-    unique, index = np.unique(edges, axis=0, return_inverse=True)
-    middle = index.reshape(3, -1).T + len(vertices)
-    a, b, c = triangles.T
-    ab, bc, ca = middle.T
-    return (np.concatenate([vertices, 0.5 * (vertices[unique[:, 0]] + vertices[unique[:, 1]])]),
-            np.concatenate([np.c_[a, ab, ca], np.c_[ab, b, bc], np.c_[ca, bc, c], np.c_[ab, bc, ca]]))
-
-
 def series_meshes(path, levels, max_triangles):
     vertices, triangles = load_obj(path)
     for level in range(max(levels) + 1):
         if level in levels and len(triangles) <= max_triangles:
             yield vertices, triangles
-        vertices, triangles = subdivide(vertices, triangles)
+        vertices, triangles = midpoint_subdivided(vertices, triangles)
 
 
 # ---------------------------------------------------------------- timing
@@ -185,14 +175,6 @@ def run_accuracy():
 # ---------------------------------------------------------------- reporting
 
 
-def format_seconds(seconds):
-    if seconds < 1e-3:
-        return f"{seconds * 1e6:.0f} µs"
-    if seconds < 1.0:
-        return f"{seconds * 1e3:.3g} ms"
-    return f"{seconds:.3g} s"
-
-
 def growth(rows):
     """Per series, the slope of log time over log triangles between its smallest and largest mesh (1 = linear)."""
     slopes = {}
@@ -256,15 +238,7 @@ def plot(rows, path):
 
 
 def machine():
-    model = "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{model}, {os.cpu_count()} cores, {platform.machine()}"
+    return f"{cpu_model()}, {os.cpu_count()} cores, {platform.machine()}"
 
 
 def markdown(rows, accuracy, command, started, loads):

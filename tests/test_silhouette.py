@@ -631,3 +631,15 @@ def test_zero_area_message():
     with pytest.raises(ValueError, match="zero area"):
         silhouette.trace(flat, [[0, 1, 2]], "X")
     assert len(silhouette.trace(flat, [[0, 1, 2]], "Y").loops) == 1
+
+
+def test_read_only_arrays_are_accepted():
+    """Meshes arrive as read-only views (rigger.core.mesh.Mesh); the binding must not ask for writable buffers."""
+    vertices, triangles = box((0, 0, 0), (1, 2, 3))
+    vertices = np.array(vertices, dtype=np.float64)
+    triangles = np.array(triangles, dtype=np.int32)
+    vertices.setflags(write=False)
+    triangles.setflags(write=False)
+    sil = silhouette.trace(vertices, triangles, "X")
+    assert len(sil.loops) == 1
+    assert abs(shapely.Polygon(sil.loops[0]).area) == pytest.approx(6.0, rel=1e-3)
