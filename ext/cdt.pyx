@@ -25,6 +25,7 @@ cdef extern from "cdt_predicates.h" nogil:
 
 # Crossing constraints closer than this fraction of the bounding box to an endpoint are routed through it.
 cdef double SNAP_FRACTION = 2.0 ** -40
+RENUMBER_MIN = 16384
 
 cdef enum:
     GHOST = -1
@@ -922,6 +923,8 @@ def triangulate(points, segments, bint inside, holes):
     cdef unsigned int *keys = <unsigned int *> malloc(<size_t> n * sizeof(unsigned int))
     cdef unsigned int *tmp_keys = <unsigned int *> malloc(<size_t> n * sizeof(unsigned int))
     cdef int err = 0, i
+    # below this many points everything stays in cache anyway and renumbering only costs
+    cdef bint renumber = n >= RENUMBER_MIN
     try:
         m.cap_v = n + 16
         m.cap_t = 2 * n + 16
@@ -939,20 +942,25 @@ def triangulate(points, segments, bint inside, holes):
                 m.VT[i] = -1
             m.nv = n
             hilbert_order(m.xy, n, order, keys, tmp_keys, tmp_order)
-            # renumber the vertices in insertion order, so that the predicates read memory that is close together
-            for i in range(n):
-                m.xy[2 * i] = xy[order[i], 0]
-                m.xy[2 * i + 1] = xy[order[i], 1]
-                tmp_order[i] = i
-            err = delaunay(&m, n, tmp_order, &vmap[0])
+            if renumber:
+                # number the vertices in insertion order, so that the predicates read memory close together
+                for i in range(n):
+                    m.xy[2 * i] = xy[order[i], 0]
+                    m.xy[2 * i + 1] = xy[order[i], 1]
+                    tmp_order[i] = i
+            err = delaunay(&m, n, tmp_order if renumber else order, &vmap[0])
         if err == 1:
             return _collinear_result(points, segments)
         if err:
             raise _ERRORS[err]
-        original = np.asarray(<int[:n]> order).copy()  # internal vertex -> input point
-        internal = np.empty(n, dtype=np.int32)
-        internal[original] = np.arange(n, dtype=np.int32)
-        segs_internal = np.ascontiguousarray(internal[np.asarray(segments)], dtype=np.int32)
+        if renumber:
+            original = np.asarray(<int[:n]> order).copy()  # internal vertex -> input point
+            internal = np.empty(n, dtype=np.int32)
+            internal[original] = np.arange(n, dtype=np.int32)
+            segs_internal = np.ascontiguousarray(internal[np.asarray(segments)], dtype=np.int32)
+        else:
+            original = np.arange(n, dtype=np.int32)
+            segs_internal = np.ascontiguousarray(segments, dtype=np.int32)
         if nseg:
             segs = segs_internal
             with nogil:

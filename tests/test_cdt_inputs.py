@@ -184,3 +184,19 @@ def test_negative_zero_is_the_same_point():
     tri = triangulate(points, mode="all")
     check_triangulation(tri, points, mode="all")
     assert tri.vertex_map.tolist() == [0, 1, 2, 0, 0]
+
+
+@pytest.mark.parametrize("renumber_from", [0, 10**9])
+def test_renumbering_in_insertion_order_changes_nothing(monkeypatch, renumber_from):
+    """Large inputs are renumbered in insertion order for memory locality (small ones are not): force either path
+    on messy input (duplicates, collinear runs, crossing and overlapping segments) and check the full contract."""
+    from rigger import _rigger_cdt
+    monkeypatch.setattr(_rigger_cdt, "RENUMBER_MIN", renumber_from)
+    rng = np.random.default_rng(11)
+    points = rng.integers(0, 12, (300, 2)).astype(float) * 0.1 + 5.0
+    segments = rng.integers(0, 300, (40, 2))
+    for mode in ("all", "inside"):
+        tri = triangulate(points, segments, mode=mode)
+        check_triangulation(tri, points, segments, mode=mode)
+    reference = triangulate(points, segments, mode="all")
+    assert reference.vertex_map.tolist() == [int(np.flatnonzero((points == p).all(axis=1))[0]) for p in points]
