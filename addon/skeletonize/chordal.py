@@ -13,7 +13,6 @@ from dataclasses import dataclass
 import numpy as np
 
 TERMINAL, SLEEVE, JUNCTION, ISOLATED = 2, 1, 0, 3
-CLASS_NAMES = {TERMINAL: "terminal", SLEEVE: "sleeve", JUNCTION: "junction", ISOLATED: "isolated"}
 
 
 @dataclass

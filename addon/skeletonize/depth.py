@@ -60,10 +60,6 @@ def _middle(interval):
     return 0.5 * (interval[0] + interval[1])
 
 
-def _depth_of(sil, point):
-    return float(np.dot(point - sil.origin, sil.direction))
-
-
 def _layer_count(node_layers):
     """How many separate parts a chain runs through: the most frequent interval count over its outer two thirds
     (the part near its parent often runs into the body)."""
