@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _rigger_cdt
+from .core.arrays import index_array, numeric_array
 
 MODES = ("inside", "all")
 
@@ -91,7 +92,7 @@ def triangulate(points, segments=None, *, mode="inside", holes=None):
 
 
 def _as_points(values, name):
-    arr = _as_array(values, name, np.float64)
+    arr = numeric_array(values, name)
     if arr.size == 0:
         return np.zeros((0, 2), np.float64)
     if arr.ndim != 2 or arr.shape[1] != 2:
@@ -105,26 +106,4 @@ def _as_points(values, name):
 def _as_segments(values, n_points):
     if values is None:
         return np.zeros((0, 2), np.int32)
-    raw = np.asarray(values)
-    if raw.size == 0:
-        return np.zeros((0, 2), np.int32)
-    if raw.dtype.kind not in "iu":
-        if raw.dtype.kind == "f" and np.isfinite(raw).all() and (raw == np.round(raw)).all():
-            raw = raw.astype(np.int64)
-        else:
-            raise ValueError(f"segments must hold integer point indices, got dtype {raw.dtype}")
-    if raw.ndim != 2 or raw.shape[1] != 2:
-        raise ValueError(f"segments must have shape (M, 2), got {raw.shape}")
-    low, high = raw.min(), raw.max()
-    if low < 0 or high >= n_points:
-        bad = int(np.flatnonzero(((raw < 0) | (raw >= n_points)).any(axis=1))[0])
-        raise ValueError(f"segment {bad} {raw[bad].tolist()} indexes outside the {n_points} points")
-    return np.ascontiguousarray(raw, dtype=np.int32)
-
-
-def _as_array(values, name, dtype):
-    try:
-        arr = np.asarray(values, dtype=dtype)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a numeric array: {exc}") from None
-    return arr
+    return index_array(values, 2, n_points, name="segments", item="segment", target=("point", "points"), dtype=np.int32)

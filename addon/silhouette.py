@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _rigger_silhouette
+from .core.arrays import index_array, numeric_array
 
 DEFAULT_RESOLUTION = 1024
 DEFAULT_TOLERANCE = 0.05
@@ -125,13 +126,14 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
         ValueError: wrong shapes, NaN or infinite coordinates, out-of-range indices, an empty mesh, a bad
             direction or resolution or tolerance, or a mesh whose projection has zero area.
     """
-    verts = _as_array(vertices, "vertices", np.float64)
+    verts = numeric_array(vertices, "vertices")
     if verts.ndim != 2 or verts.shape[1] != 3:
         raise ValueError(f"vertices must have shape (N, 3), got {verts.shape}")
     if not np.isfinite(verts).all():
         bad = int(np.flatnonzero(~np.isfinite(verts).all(axis=1))[0])
         raise ValueError(f"vertices must be finite; vertex {bad} is {verts[bad].tolist()}")
-    tris = _as_triangles(triangles, len(verts))
+    tris = index_array(triangles, 3, len(verts), name="triangles", item="triangle", target=("vertex", "vertices"),
+                       dtype=np.int64)
     if len(verts) == 0 or len(tris) == 0:
         raise ValueError(f"the mesh is empty ({len(verts)} vertices, {len(tris)} triangles)")
     view = _as_direction(direction)
@@ -157,7 +159,7 @@ def _as_direction(direction):
             raise ValueError(f"direction must be 'X', 'Y', 'Z' (optionally with a sign) or a 3D vector, "
                              f"got {direction!r}")
         return np.array(axis) * sign
-    vec = _as_array(direction, "direction", np.float64)
+    vec = numeric_array(direction, "direction")
     if vec.shape != (3,):
         raise ValueError(f"direction must be 'X', 'Y', 'Z' or a 3D vector, got shape {vec.shape}")
     if not np.isfinite(vec).all() or not np.any(vec):
@@ -165,25 +167,8 @@ def _as_direction(direction):
     return np.ascontiguousarray(vec)
 
 
-def _as_triangles(values, n_vertices):
-    raw = np.asarray(values)
-    if raw.size == 0:
-        return np.zeros((0, 3), np.int64)
-    if raw.dtype.kind not in "iu":
-        if raw.dtype.kind == "f" and np.isfinite(raw).all() and (raw == np.round(raw)).all():
-            raw = raw.astype(np.int64)
-        else:
-            raise ValueError(f"triangles must hold integer vertex indices, got dtype {raw.dtype}")
-    if raw.ndim != 2 or raw.shape[1] != 3:
-        raise ValueError(f"triangles must have shape (M, 3), got {raw.shape}")
-    if raw.min() < 0 or raw.max() >= n_vertices:
-        bad = int(np.flatnonzero(((raw < 0) | (raw >= n_vertices)).any(axis=1))[0])
-        raise ValueError(f"triangle {bad} {raw[bad].tolist()} indexes outside the {n_vertices} vertices")
-    return np.ascontiguousarray(raw, dtype=np.int64)
-
-
 def _as_points(values):
-    pts = _as_array(values, "points", np.float64)
+    pts = numeric_array(values, "points")
     if pts.size == 0:
         return np.zeros((0, 2), np.float64)
     if pts.ndim == 1 and pts.shape == (2,):
@@ -193,10 +178,3 @@ def _as_points(values):
     if not np.isfinite(pts).all():
         raise ValueError("points must be finite")
     return np.ascontiguousarray(pts)
-
-
-def _as_array(values, name, dtype):
-    try:
-        return np.asarray(values, dtype=dtype)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a numeric array: {exc}") from None

@@ -23,10 +23,10 @@ from importlib import metadata
 from pathlib import Path
 
 import numpy as np
-import shapely
 
 from benchkit import cpu_model, format_seconds, midpoint_subdivided
 from rigdata import load_obj
+from union_reference import exact_union, iou, traced_region
 
 from rigger import silhouette
 
@@ -89,24 +89,6 @@ def timed(call, runs):
         walls.append(time.perf_counter() - wall)
         cpus.append(time.process_time() - cpu)
     return Timing(statistics.median(walls), statistics.median(cpus), runs), result
-
-
-def exact_union(sil, vertices, triangles):
-    offset = vertices - sil.origin
-    corners = np.c_[offset @ sil.u, offset @ sil.v][triangles]
-    polygons = shapely.polygons(np.concatenate([corners, corners[:, :1]], axis=1))
-    return shapely.union_all(polygons[shapely.area(polygons) > 0])
-
-
-def traced_region(loops):
-    region = shapely.Polygon()
-    for loop in loops:
-        region = shapely.symmetric_difference(region, shapely.Polygon(loop))
-    return region
-
-
-def iou(a, b):
-    return shapely.intersection(a, b).area / shapely.union(a, b).area
 
 
 @dataclass

@@ -15,17 +15,21 @@ Memory checks, run once outside this suite on the final C code (2026-11-21):
   a frame in rigger._rigger_silhouette (the records left are CPython's and numpy's own).
 """
 import functools
+import sys
 
 import numpy as np
 import pytest
 import shapely
-from conftest import SHARED, shared_path
+from conftest import ROOT, SHARED, shared_path
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
 from rigger import silhouette
+
+sys.path.insert(0, str(ROOT / "bench"))
+from union_reference import exact_union, frame_points, traced_region  # noqa: E402  (bench/ is no package)
 
 MIN_IOU = 0.995
 BIG_FEATURE = 8  # islands and holes above this many square cells must match
@@ -210,26 +214,6 @@ def real_model(relative):
 
 
 # ------------------------------------------------------------------------------------------------ references
-
-
-def frame_points(sil, vertices):
-    offset = np.asarray(vertices, float) - sil.origin
-    return np.c_[offset @ sil.u, offset @ sil.v]
-
-
-def exact_union(sil, vertices, triangles):
-    """The union of the projected triangles, in the silhouette's frame."""
-    corners = frame_points(sil, vertices)[np.asarray(triangles)]
-    polygons = shapely.polygons(np.concatenate([corners, corners[:, :1]], axis=1))
-    return shapely.union_all(polygons[shapely.area(polygons) > 0])
-
-
-def traced_region(loops):
-    """The region the loops bound, by the even-odd rule (valid because loops never cross)."""
-    region = shapely.Polygon()
-    for loop in loops:
-        region = shapely.symmetric_difference(region, shapely.Polygon(loop))
-    return region
 
 
 def features(geom):

@@ -1,0 +1,33 @@
+"""Input checks the geometry APIs share: numeric arrays and index arrays, with messages that say what is wrong."""
+import numpy as np
+
+
+def numeric_array(values, name, dtype=np.float64):
+    """``values`` as an array of ``dtype``; ValueError naming ``name`` when it cannot be one."""
+    try:
+        return np.asarray(values, dtype=dtype)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a numeric array: {exc}") from None
+
+
+def index_array(values, columns, count, *, name, item, target, dtype):
+    """Rows of ``columns`` indices into ``count`` things, as a contiguous ``dtype`` array ((0, columns) if empty).
+
+    Whole-valued floats are accepted; anything else non-integer, a wrong shape, or an index outside 0..count-1 is a
+    ValueError, e.g. "segment 3 [0, 9] indexes outside the 5 points" (``name`` "segments", ``item`` "segment",
+    ``target`` ("point", "points")).
+    """
+    raw = np.asarray(values)
+    if raw.size == 0:
+        return np.zeros((0, columns), dtype)
+    if raw.dtype.kind not in "iu":
+        if raw.dtype.kind == "f" and np.isfinite(raw).all() and (raw == np.round(raw)).all():
+            raw = raw.astype(np.int64)
+        else:
+            raise ValueError(f"{name} must hold integer {target[0]} indices, got dtype {raw.dtype}")
+    if raw.ndim != 2 or raw.shape[1] != columns:
+        raise ValueError(f"{name} must have shape (M, {columns}), got {raw.shape}")
+    if raw.min() < 0 or raw.max() >= count:
+        bad = int(np.flatnonzero(((raw < 0) | (raw >= count)).any(axis=1))[0])
+        raise ValueError(f"{item} {bad} {raw[bad].tolist()} indexes outside the {count} {target[1]}")
+    return np.ascontiguousarray(raw, dtype=dtype)
