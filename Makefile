@@ -32,4 +32,23 @@ bench-silhouette: build
 	$(PY) bench/silhouette.py
 
 clean:
-	rm -rf build dist out *.egg-info addon/*.so ext/cdt.c ext/silhouette_binding.c
+	rm -rf build dist out *.egg-info addon/*.so ext/cdt.c ext/silhouette_binding.c ext/skin_weights_binding.c
+
+# The offline-installable add-on zip for this platform and Python: dist/rigger-<version>-<platform>-py<XY>.zip.
+.PHONY: addon bpy42
+addon: build
+	$(PY) tools/build_addon.py --output-dir dist
+
+# Blender 4.2 LTS as a module in its own venv (inside .venv, which git ignores), for the add-on install test;
+# pip takes the wheel from its cache when it has it.
+BPY42_VENV := $(VENV)/bpy42
+BPY42_STAMP := $(BPY42_VENV)/.installed
+
+$(BPY42_STAMP): requirements-bpy42.txt
+	$(PYTHON) -m venv $(BPY42_VENV)
+	$(BPY42_VENV)/bin/python -m pip install --quiet -r requirements-bpy42.txt
+	touch $(BPY42_STAMP)
+
+bpy42: $(BPY42_STAMP)
+
+test: bpy42

@@ -18,6 +18,8 @@ EXTENSIONS = [
     Extension("rigger._rigger_cdt", ["ext/cdt.pyx"], include_dirs=["ext"], extra_compile_args=COMPILE_ARGS),
     Extension("rigger._rigger_silhouette", ["ext/silhouette_binding.pyx", "ext/silhouette.c"], include_dirs=["ext"],
               extra_compile_args=COMPILE_ARGS),
+    Extension("rigger._rigger_weights", ["ext/skin_weights_binding.pyx", "ext/skin_weights.c"], include_dirs=["ext"],
+              extra_compile_args=COMPILE_ARGS),
 ]
 
 setup(

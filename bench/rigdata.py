@@ -321,3 +321,43 @@ def inside_fraction(points, vertices, triangles):
     """Fraction of points inside the mesh: |winding number| ≥ 0.5, so open meshes and parts whose faces are
     oriented inward still count."""
     return float((np.abs(winding_numbers(points, vertices, triangles)) >= 0.5).mean())
+
+
+# --- skinning: the artist rig as an armature's bones, and which bone each artist weight belongs to ----------------
+
+MIN_BONE_LENGTH = 1e-5  # Blender deletes bones shorter than 1e-6 when leaving edit mode; keep clear of that
+
+
+def armature_skeleton(rig):
+    """The rig's bones as a ``rigger.Skeleton`` to build an armature from, and each bone's head joint (B,) int.
+
+    One bone per parent→child joint pair, as :meth:`Rig.bones`, named ``bone_000``, ``bone_001``... (joint names can
+    outgrow Blender's 63-byte bone names). Bones shorter than ``MIN_BONE_LENGTH`` (RigNet's ``root_dup_*`` joints
+    repeat the root's position) are dropped and their children re-parented to the nearest kept ancestor.
+    """
+    from rigger.core.skeleton import Skeleton
+
+    bones = rig.bones()
+    children = np.flatnonzero(rig.parents >= 0)
+    keep = np.linalg.norm(bones.tails - bones.heads, axis=1) >= MIN_BONE_LENGTH
+    parents = kept_ancestors(bones.parents, keep).astype(np.int32)
+    names = [f"bone_{index:03d}" for index in range(np.count_nonzero(keep))]
+    return Skeleton(names, bones.heads[keep], bones.tails[keep], parents), rig.parents[children][keep]
+
+
+def weight_owners(parents):
+    """For each joint, the joint whose bone its skin weight moves: itself when a bone starts there (it has children
+    or is a root), otherwise its parent, the head of the bone that ends at it."""
+    parents = np.asarray(parents)
+    starts_a_bone = parents < 0
+    starts_a_bone[parents[parents >= 0]] = True
+    return np.where(starts_a_bone, np.arange(len(parents)), parents)
+
+
+def dominant_joints(rig):
+    """(V,) the owner joint (see :func:`weight_owners`) of each vertex's largest artist weight, -1 where it has
+    none."""
+    skin = rig.skin.tocsr()
+    top = np.asarray(skin.argmax(axis=1)).ravel()
+    weighted = np.asarray(skin.max(axis=1).todense()).ravel() > 0
+    return np.where(weighted, weight_owners(rig.parents)[top], -1)

@@ -216,7 +216,7 @@ def test_the_template_method_rigs_a_chain_along_the_main_axis():
     assert skeleton.names == ("chain.000", "chain.001", "chain.002", "chain.003")
     assert list(skeleton.parents) == [-1, 0, 1, 2]
     np.testing.assert_allclose(skeleton.heads[1:], skeleton.tails[:-1])
-    np.testing.assert_allclose(abs(skeleton.stages["axis"]), [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(abs(skeleton.stages["principal_axis"]), [0, 1, 0], atol=1e-12)
     ends = sorted([skeleton.heads[0][1], skeleton.tails[-1][1]])
     np.testing.assert_allclose(ends, [0, 4])
     np.testing.assert_allclose(skeleton.heads[:, [0, 2]], 0.5)

@@ -1,10 +1,14 @@
-"""``make demo``: rig the project's own sample character and write what the pipeline produced to ``out/``.
+"""``make demo``: rig the project's own sample character in Blender and write what it produced to ``out/``.
 
-Builds the sample humanoid with Blender's Skin modifier (bpy from PyPI, headless), rigs it with the silhouette method
-and writes ``out/humanoid.obj`` (the mesh), ``out/humanoid_report.json`` (bones in the OBJ's frame, per-stage timings,
-distance to the known skeleton) and ``out/humanoid.png`` (silhouette, triangulation by class, chordal axis, bones).
+Builds the sample humanoid with Blender's Skin modifier (bpy from PyPI, headless; no third-party data), rigs and skins
+it through the add-on's Blender layer, and writes:
+- ``out/humanoid.blend``: mesh, armature, weights and the stage overlays (View3D > Sidebar > Rigger toggles them),
+- ``out/humanoid.glb``: the rigged, skinned character,
+- ``out/humanoid_report.json``: bones, timings, skinning outcome, and the distance to the known skeleton,
+- ``out/humanoid.png``: a Workbench render of the see-through mesh with the overlays and the bones.
 """
 import json
+import math
 import os
 import pathlib
 import sys
@@ -13,98 +17,108 @@ import tempfile
 import numpy as np
 
 OUT = pathlib.Path(__file__).resolve().parents[1] / "out"
-CLASS_COLOURS = {2: "#e4572e", 1: "#a8c5da", 0: "#f3a712", 3: "#6c757d"}  # terminal, sleeve, junction, isolated
-
-
-def sample_mesh(name):
-    with tempfile.TemporaryDirectory(prefix="rigger-blender-user-") as user:
-        os.environ.setdefault("BLENDER_USER_RESOURCES", user)
-        import bpy
-        from rigger.blender.samples import character_arrays
-
-        bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-        return character_arrays(name)
-
-
-def write_obj(path, vertices, triangles):
-    with open(path, "w") as out:
-        out.write("".join(f"v {x:.6f} {y:.6f} {z:.6f}\n" for x, y, z in vertices))
-        out.write("".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
-
-
-def draw(path, skeleton):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.collections import LineCollection, PolyCollection
-
-    stages = skeleton.stages
-    sil = stages["silhouette"]
-    figure, (plane, bones) = plt.subplots(1, 2, figsize=(12, 7))
-    cdt = stages["cdt"]
-    plane.add_collection(PolyCollection(cdt["vertices"][cdt["triangles"]], edgecolors="white", linewidths=0.3,
-                                        facecolors=[CLASS_COLOURS[c] for c in cdt["classes"]]))
-    for loop in sil["loops"]:
-        closed = np.vstack([loop, loop[:1]])
-        plane.plot(closed[:, 0], closed[:, 1], color="black", linewidth=1)
-    axis = stages["axis"]
-    plane.add_collection(LineCollection(axis["points"][stages["merged"]["links"]], colors="#2a9d8f", linewidths=1.5))
-    plane.add_collection(LineCollection(axis["points"][stages["pruned"]["links"]], colors="#9b2226", linewidths=1.5))
-    plane.set_title("silhouette, CDT (terminal / sleeve / junction), chordal axis (pruned in red)")
-    plane.set_aspect("equal")
-    plane.autoscale()
-    # bones seen along the same view
-    to_plane = np.stack([sil["u"], sil["v"]], axis=1)
-    heads = (skeleton.heads - sil["origin"]) @ to_plane
-    tails = (skeleton.tails - sil["origin"]) @ to_plane
-    for loop in sil["loops"]:
-        closed = np.vstack([loop, loop[:1]])
-        bones.fill(closed[:, 0], closed[:, 1], color="0.9")
-    bones.add_collection(LineCollection(np.stack([heads, tails], axis=1), colors="#264653", linewidths=2.5))
-    bones.scatter(*np.vstack([heads, tails]).T, s=14, color="#e76f51", zorder=3)
-    bones.set_title(f"{len(skeleton)} bones")
-    bones.set_aspect("equal")
-    bones.autoscale()
-    figure.tight_layout()
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
+RENDER_SIZE = (960, 1080)
+BONE_WIDTH = 0.06  # octahedral bone display: the widest section's half width, in bone lengths
+BONE_COLOUR = (0.05, 0.05, 0.05, 1.0)
+HIDDEN_IN_PICTURE = {"triangulation"}
+SKIN_COLOUR = (0.8, 0.8, 0.8, 0.2)  # Workbench draws material alpha as transparency: the skeleton shows through
 
 
 def main(name="humanoid"):
+    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="rigger-blender-user-"))
+    import bpy
+
     import rigger
     from rigger import samples
+    from rigger.blender import overlays, skinning
+    from rigger.blender.pipeline import rig_object
+    from rigger.blender.samples import build_character
+    from rigger.blender.scenefiles import rig_report, save_scene
 
     OUT.mkdir(exist_ok=True)
-    vertices, triangles = sample_mesh(name)
-    skeleton = rigger.rig_mesh(vertices, triangles)
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    rigger.register()
+    obj = build_character(name)
+    result = rig_object(obj, "silhouette")
+    outcome = skinning.skin(obj, result.armature)
+    save_scene(OUT / f"{name}.glb")
+
+    report = rig_report(result, {obj.name: outcome})
     truth = samples.ground_truth_bones(name)
-    joints, true_joints = skeleton.joints(), truth.joints()
+    joints, true_joints = result.skeleton.joints(), truth.joints()
     gaps = np.linalg.norm(joints[:, None] - true_joints[None], axis=2)
-    size = float(np.ptp(vertices, axis=0).max())
-    report = {
-        "model": name,
-        "vertices": len(vertices),
-        "triangles": len(triangles),
-        "method": "silhouette",
-        "params": skeleton.stages["params"],
-        "bones": skeleton.to_dict()["bones"],
-        "timings_seconds": skeleton.stages["timings"],
-        "joint_chamfer_to_truth": 0.5 * float(gaps.min(axis=1).mean() + gaps.min(axis=0).mean()) / size,
-    }
-    write_obj(OUT / f"{name}.obj", vertices, triangles)
-    (OUT / f"{name}_report.json").write_text(json.dumps(report, indent=2, default=_plain))
-    draw(OUT / f"{name}.png", skeleton)
-    print(f"rigged {name}: {len(skeleton)} bones in {report['timings_seconds']['total'] * 1e3:.0f} ms, "
-          f"joint distance to the true skeleton {report['joint_chamfer_to_truth']:.3f} of its size")
-    print(f"wrote {OUT / (name + '.obj')}, {OUT / (name + '_report.json')}, {OUT / (name + '.png')}")
+    size = float(np.ptp(np.array([v.co for v in obj.data.vertices]), axis=0).max())
+    report["model"] = {"name": name, "vertices": len(obj.data.vertices), "faces": len(obj.data.polygons)}
+    report["joint_chamfer_to_truth"] = 0.5 * float(gaps.min(axis=1).mean() + gaps.min(axis=0).mean()) / size
+    (OUT / f"{name}_report.json").write_text(json.dumps(report, indent=2))
+
+    overlays.build_overlays(result.skeleton.stages, obj.name)
+    save_scene(OUT / f"{name}.blend")
+    render(bpy, overlays, obj, result.skeleton, OUT / f"{name}.png")
+    print(f"rigged {name}: {len(result.skeleton)} bones in {sum(result.timings.values()) * 1e3:.0f} ms; "
+          f"{outcome.summary()}; joint distance to the true skeleton {report['joint_chamfer_to_truth']:.3f} of its "
+          f"size")
+    print("wrote " + ", ".join(str(OUT / f"{name}{suffix}") for suffix in
+                               (".blend", ".glb", "_report.json", ".png")))
 
 
-def _plain(value):
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+def render(bpy, overlays, obj, skeleton, path):
+    """A Workbench render from the front: the mesh see-through, the overlays (but the triangulation, which would
+    hide the rest from the front) and the bones as octahedra in front.
+
+    Renders leave out armatures and the overlays' default ``hide_render``, so the picture gets its own bone mesh and
+    shows the overlays; none of this is saved in the .blend (written before).
+    """
+    scene = bpy.context.scene
+    for overlay in bpy.data.collections["Rigger Overlays"].objects:
+        overlay.hide_render = overlay[overlays.KIND_KEY] in HIDDEN_IN_PICTURE
+    bones = bpy.data.objects.new("bones", _bone_mesh(bpy, skeleton))
+    material = bpy.data.materials.new("bones")
+    material.diffuse_color = BONE_COLOUR
+    bones.data.materials.append(material)
+    bones.show_in_front = True
+    scene.collection.objects.link(bones)
+    skin = bpy.data.materials.new("skin")
+    skin.diffuse_color = SKIN_COLOUR
+    obj.data.materials.append(skin)
+
+    low, high = np.array(obj.bound_box).min(axis=0), np.array(obj.bound_box).max(axis=0)
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    camera.data.type = 'ORTHO'
+    camera.data.ortho_scale = 1.1 * max(high[2] - low[2], (high[0] - low[0]) * RENDER_SIZE[1] / RENDER_SIZE[0])
+    camera.location = ((low[0] + high[0]) / 2, low[1] - 10.0, (low[2] + high[2]) / 2)
+    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+
+    scene.render.engine = 'BLENDER_WORKBENCH'
+    scene.render.resolution_x, scene.render.resolution_y = RENDER_SIZE
+    scene.render.film_transparent = False
+    shading = scene.display.shading
+    shading.light = 'FLAT'
+    shading.color_type = 'MATERIAL'
+    scene.render.filepath = str(path)
+    bpy.ops.render.render(write_still=True)
+
+
+def _bone_mesh(bpy, skeleton):
+    """Blender's octahedral bone shape for every bone: a point at head and tail, a square a tenth of the way up."""
+    vertices, faces = [], []
+    for head, tail in zip(skeleton.heads, skeleton.tails):
+        along = tail - head
+        length = np.linalg.norm(along)
+        side = np.cross(along, [0.0, 0.0, 1.0] if abs(along[2]) < 0.9 * length else [1.0, 0.0, 0.0])
+        side *= BONE_WIDTH * length / np.linalg.norm(side)
+        other = np.cross(along / length, side)
+        ring = head + 0.1 * along
+        start = len(vertices)
+        vertices += [head, tail, ring + side, ring + other, ring - side, ring - other]
+        for k in range(4):
+            a, b = start + 2 + k, start + 2 + (k + 1) % 4
+            faces += [(start, b, a), (start + 1, a, b)]
+    mesh = bpy.data.meshes.new("bones")
+    mesh.from_pydata(np.array(vertices).tolist(), [], faces)
+    return mesh
 
 
 if __name__ == "__main__":

@@ -56,7 +56,7 @@ class TemplateMethod(RigMethod):
         timings["chain"] = time.perf_counter() - start
 
         # Stages: every intermediate result, keyed by name, for the overlays, reports and debugging.
-        stages = {"axis": direction, "timings": timings}
+        stages = {"principal_axis": direction, "timings": timings}
         return Skeleton(
             names=[f"chain.{i:03d}" for i in range(bones)],
             heads=points[:-1],

@@ -1,0 +1,173 @@
+"""The operators ``rigger.rig``, ``rigger.skin``, ``rigger.rig_skin`` and ``rigger.clear_overlays``.
+
+They read their settings from ``scene.rigger``, act on the active object (a mesh, or the armature Rigger made for
+one), report problems through ``self.report`` rather than tracebacks, and show progress on the window manager.
+"""
+import traceback
+
+import bpy
+
+from ..api import method_registry
+from . import overlays, skinning
+from .pipeline import rig_object
+from .properties import ARMATURE_POINTER, NO_METHOD, SETTINGS_ATTRIBUTE, overlay_visibility, param_values
+
+
+def rig_targets(context):
+    """The meshes to rig together: the active mesh and the other selected meshes, or the meshes of the active
+    Rigger armature (rigging again); else ([], why not)."""
+    obj = context.active_object
+    if obj is None:
+        return [], "Select a mesh object"
+    if obj.type == 'MESH':
+        return [obj, *(other for other in context.selected_objects if other.type == 'MESH' and other != obj)], None
+    if obj.type == 'ARMATURE':
+        meshes = [mesh for mesh in context.scene.objects if getattr(mesh, ARMATURE_POINTER, None) == obj]
+        if meshes:
+            return meshes, None
+    return [], f"{obj.name} is not a mesh; select a mesh object"
+
+
+def skin_targets(context):
+    """(meshes, armature) to skin: the rig targets and the first one's Rigger armature (or a selected armature);
+    else ([], None, why not)."""
+    meshes, why = rig_targets(context)
+    if not meshes:
+        return [], None, why
+    armature = getattr(meshes[0], ARMATURE_POINTER, None)
+    if armature is None:
+        armature = next((obj for obj in context.selected_objects if obj.type == 'ARMATURE'), None)
+    if armature is None:
+        return [], None, f"{meshes[0].name} has no armature yet: rig it first (or select an armature with it)"
+    return meshes, armature, None
+
+
+class _RiggerOperator:
+    """Shared behaviour: Object Mode only, errors become reports, progress on the window manager."""
+
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def _check_mode(cls, context):
+        if context.mode != 'OBJECT':
+            cls.poll_message_set("Switch to Object Mode first")
+            return False
+        return True
+
+    def execute(self, context):
+        window_manager = context.window_manager
+        window_manager.progress_begin(0, 100)
+        try:
+            return self.run(context, lambda fraction: window_manager.progress_update(int(100 * fraction)))
+        except ValueError as error:  # bad mesh, method or parameters: the user can fix these
+            self.report({'ERROR'}, str(error))
+        except Exception as error:  # a bug: say so in one line; the console keeps the details for a bug report
+            traceback.print_exc()
+            self.report({'ERROR'}, f"Rigger failed: {type(error).__name__}: {error} (details in the console)")
+        finally:
+            window_manager.progress_end()
+        return {'CANCELLED'}
+
+    def rig(self, context, progress):
+        settings = getattr(context.scene, SETTINGS_ATTRIBUTE)
+        method = method_registry().lookup(settings.method)
+        params = param_values(method, getattr(settings.methods, method.name))
+        meshes, _ = rig_targets(context)
+        result = rig_object(meshes[0], method.name, params, parts=meshes[1:],
+                            show_overlays=overlay_visibility(settings), progress=progress)
+        seconds = sum(result.timings.values())
+        names = ", ".join(mesh.name for mesh in meshes)
+        replaced = " (replaced the previous rig)" if result.replaced else ""
+        self.report({'INFO'}, f"Rigged {names} with {method.label or method.name}: "
+                              f"{len(result.skeleton)} bones in {seconds:.2f} s{replaced}")
+        return meshes, result.armature
+
+    def skin(self, meshes, armature, progress):
+        outcomes = []
+        for done, mesh in enumerate(meshes, start=1):
+            outcomes.append(skinning.skin(mesh, armature))
+            progress(done / len(meshes))
+        summary = "; ".join(f"{mesh.name}: {outcome.summary()}" if len(meshes) > 1 else outcome.summary()
+                            for mesh, outcome in zip(meshes, outcomes))
+        self.report({'WARNING'} if any(outcome.warnings for outcome in outcomes) else {'INFO'}, summary)
+
+
+class RIGGER_OT_rig(_RiggerOperator, bpy.types.Operator):
+    """Build an armature for the active mesh with the chosen method (the armature stays editable before skinning)"""
+
+    bl_idname = "rigger.rig"
+    bl_label = "Rig"
+
+    @classmethod
+    def poll(cls, context):
+        if not cls._check_mode(context):
+            return False
+        if getattr(context.scene, SETTINGS_ATTRIBUTE).method == NO_METHOD:
+            cls.poll_message_set("No rigging method could be loaded (see the Rigger panel)")
+            return False
+        meshes, why = rig_targets(context)
+        if not meshes:
+            cls.poll_message_set(why)
+        return bool(meshes)
+
+    def run(self, context, progress):
+        self.rig(context, progress)
+        return {'FINISHED'}
+
+
+class RIGGER_OT_skin(_RiggerOperator, bpy.types.Operator):
+    """Bind the active mesh to its armature; every vertex gets weights (bone heat, repaired where it fails)"""
+
+    bl_idname = "rigger.skin"
+    bl_label = "Skin"
+
+    @classmethod
+    def poll(cls, context):
+        if not cls._check_mode(context):
+            return False
+        meshes, _, why = skin_targets(context)
+        if not meshes:
+            cls.poll_message_set(why)
+        return bool(meshes)
+
+    def run(self, context, progress):
+        meshes, armature, _ = skin_targets(context)
+        self.skin(meshes, armature, progress)
+        return {'FINISHED'}
+
+
+class RIGGER_OT_rig_skin(_RiggerOperator, bpy.types.Operator):
+    """Rig the active mesh, then skin it to the new armature"""
+
+    bl_idname = "rigger.rig_skin"
+    bl_label = "Rig & Skin"
+
+    poll = classmethod(RIGGER_OT_rig.poll.__func__)
+
+    def run(self, context, progress):
+        meshes, armature = self.rig(context, lambda fraction: progress(0.5 * fraction))
+        self.skin(meshes, armature, lambda fraction: progress(0.5 + 0.5 * fraction))
+        return {'FINISHED'}
+
+
+class RIGGER_OT_clear_overlays(bpy.types.Operator):
+    """Remove every Rigger overlay object with its node groups and materials"""
+
+    bl_idname = "rigger.clear_overlays"
+    bl_label = "Clear Overlays"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        if overlays.COLLECTION_NAME not in bpy.data.collections:
+            cls.poll_message_set("There are no overlays to clear")
+            return False
+        return True
+
+    def execute(self, context):
+        overlays.clear_overlays()
+        self.report({'INFO'}, "Cleared the Rigger overlays")
+        return {'FINISHED'}
+
+
+CLASSES = (RIGGER_OT_rig, RIGGER_OT_skin, RIGGER_OT_rig_skin, RIGGER_OT_clear_overlays)

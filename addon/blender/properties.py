@@ -1,0 +1,106 @@
+"""Blender properties generated from the methods' parameter declarations, and the add-on's settings on
+``scene.rigger``.
+
+Every discovered method gets a PropertyGroup with one property per :class:`~rigger.core.params.Param`, reachable as
+``scene.rigger.methods.<method name>.<param name>``; ``scene.rigger.method`` picks the method, ``show_<overlay>``
+toggle the overlays. The classes are built at register time from the registry discovered then, so a method file
+added to ``methods/`` appears after the add-on is enabled again.
+"""
+import bpy
+import numpy as np
+
+from . import overlays
+
+SETTINGS_ATTRIBUTE = "rigger"  # scene.rigger
+ARMATURE_POINTER = "rigger_armature"  # Object.rigger_armature: the armature Rigger made for this mesh
+NO_METHOD = "NONE"  # the dropdown's only item when every method failed to load
+
+
+def method_items(registry):
+    """EnumProperty items for the method dropdown, in the registry's sorted order."""
+    return [(name, method.label or name, method.description) for name, method in registry.methods.items()]
+
+
+def param_values(method, group):
+    """The parameter values held by ``method``'s generated ``group``, as plain Python values for ``rig_mesh``.
+
+    Blender stores floats in single precision; each is returned as the shortest decimal that rounds to the stored
+    value (0.01, not 0.009999999776), so a bound typed in the UI never reads as just outside the declared range.
+    """
+    values = {}
+    for param in method.params:
+        value = getattr(group, param.name)
+        if param.type == "float":
+            value = _shortest(value)
+        elif param.type == "vector":
+            value = tuple(_shortest(component) for component in value)
+        values[param.name] = value
+    return values
+
+
+def _shortest(value):
+    return float(str(np.float32(value)))
+
+
+def _property(param):
+    """The bpy property declaring ``param``: same name, label, description, default and bounds."""
+    common = {"name": param.label, "description": param.description}
+    bounds = {key: value for key, value in (("min", param.min), ("max", param.max)) if value is not None}
+    if param.type == "float":
+        return bpy.props.FloatProperty(default=param.default, precision=4, **bounds, **common)
+    if param.type == "int":
+        return bpy.props.IntProperty(default=param.default, **bounds, **common)
+    if param.type == "bool":
+        return bpy.props.BoolProperty(default=param.default, **common)
+    if param.type == "enum":
+        items = [(item, item.replace("_", " ").title(), "") for item in param.items]
+        return bpy.props.EnumProperty(items=items, default=param.default, **common)
+    return bpy.props.FloatVectorProperty(size=3, default=param.default, **bounds, **common)
+
+
+def _overlay_toggle(kind, label, description):
+    def update(settings, context):
+        overlays.set_overlay_visible(kind, getattr(settings, f"show_{kind}"))
+    return bpy.props.BoolProperty(name=label, description=description, default=True, update=update)
+
+
+def make_classes(registry):
+    """The PropertyGroup classes for ``registry``, in registration order (method groups first, settings last)."""
+    method_groups = {}
+    for name, method in registry.methods.items():
+        annotations = {param.name: _property(param) for param in method.params}
+        method_groups[name] = type(f"RIGGER_PG_method_{name}", (bpy.types.PropertyGroup,),
+                                   {"__annotations__": annotations, "__doc__": method.description})
+    methods_group = type("RIGGER_PG_methods", (bpy.types.PropertyGroup,), {
+        "__annotations__": {name: bpy.props.PointerProperty(type=group) for name, group in method_groups.items()},
+        "__doc__": "Parameters of every rigging method",
+    })
+    items = method_items(registry) or [(NO_METHOD, "No methods", "No rigging method could be loaded")]
+    settings_annotations = {
+        "method": bpy.props.EnumProperty(name="Method", description="Rigging method", items=items),
+        "methods": bpy.props.PointerProperty(type=methods_group),
+    }
+    for kind, label, description in overlays.OVERLAY_KINDS:
+        settings_annotations[f"show_{kind}"] = _overlay_toggle(kind, label, description)
+    settings = type("RIGGER_PG_settings", (bpy.types.PropertyGroup,), {
+        "__annotations__": settings_annotations, "__doc__": "Rigger settings of a scene"})
+    return [*method_groups.values(), methods_group, settings]
+
+
+def attach(settings_class):
+    """Add ``scene.rigger`` and ``Object.rigger_armature`` (after the classes are registered)."""
+    setattr(bpy.types.Scene, SETTINGS_ATTRIBUTE, bpy.props.PointerProperty(type=settings_class))
+    setattr(bpy.types.Object, ARMATURE_POINTER, bpy.props.PointerProperty(
+        type=bpy.types.Object, name="Rigger Armature", description="The armature Rigger made for this mesh",
+        poll=lambda _, obj: obj.type == 'ARMATURE'))
+
+
+def detach():
+    for owner, attribute in ((bpy.types.Scene, SETTINGS_ATTRIBUTE), (bpy.types.Object, ARMATURE_POINTER)):
+        if hasattr(owner, attribute):
+            delattr(owner, attribute)
+
+
+def overlay_visibility(settings):
+    """{overlay kind: shown?} from the scene settings."""
+    return {kind: getattr(settings, f"show_{kind}") for kind, _, _ in overlays.OVERLAY_KINDS}

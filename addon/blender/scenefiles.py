@@ -1,0 +1,127 @@
+"""Model files in and out of a headless Blender for the command line: import, rig, skin, save, report."""
+import contextlib
+import os
+import pathlib
+import tempfile
+
+import bpy
+import numpy as np
+
+from . import overlays, skinning
+from .pipeline import METHOD_PROPERTY, rig_object
+
+# Blender's OBJ and glTF importers turn the file's Y-up frame into Blender's Z-up one with this rotation (file x, y,
+# z → Blender x, -z, y), so the report maps bones back through its inverse to the file's own coordinates.
+Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+
+
+def rig_file(source, output, method, params, *, skin=True):
+    """Rig the meshes of model file ``source`` together, skin them, save the scene to ``output`` and return the
+    report (bones in the file's frame, timings, skinning outcome, warnings).
+
+    ValueError when the file holds no mesh or rigging fails; ``output`` is written only after everything succeeded
+    (through a temporary file renamed into place).
+    """
+    source, output = pathlib.Path(source), pathlib.Path(output)
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    frame = _import(source)
+    meshes = [obj for obj in _exported() if obj.type == 'MESH' and len(obj.data.polygons)]
+    if not meshes:
+        raise ValueError(f"{source}: the file holds no mesh with faces")
+    meshes.sort(key=lambda obj: -len(obj.data.vertices))
+    result = rig_object(meshes[0], method, params, parts=meshes[1:])
+    outcomes = {mesh.name: skinning.skin(mesh, result.armature) for mesh in meshes} if skin else None
+    save_scene(output)
+    return {"input": str(source), "output": str(output), **rig_report(result, outcomes, *frame)}
+
+
+def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world"):
+    """The JSON-ready report of a rig: method, parameters, bones (mapped from Blender's world into the frame named
+    ``frame`` by the inverse of ``to_world``), timings, the skinning outcome per mesh (``outcomes``: mesh name →
+    skinning report, or None when not skinned) and warnings."""
+    to_frame = np.eye(4)
+    to_frame[:3, :3] = np.linalg.inv(to_world)
+    meshes = result.meshes
+    warnings = [f"rigged {len(meshes)} mesh objects together: {', '.join(m.name for m in meshes)}"] \
+        if len(meshes) > 1 else []
+    skinning_outcome = {"summary": "not skinned", "meshes": {}}
+    if outcomes is not None:
+        skinning_outcome = {"summary": "; ".join(report.summary() for report in outcomes.values()),
+                            "meshes": {name: report.as_dict() for name, report in outcomes.items()}}
+        warnings += [warning for report in outcomes.values() for warning in report.warnings]
+    stages = result.skeleton.stages
+    return {
+        "frame": frame,
+        "method": result.armature.get(METHOD_PROPERTY),
+        "params": stages.get("params", {}),
+        "bones": result.skeleton.transformed(to_frame).to_dict()["bones"],
+        "timings": {**result.timings, **{f"method.{k}": v for k, v in stages.get("timings", {}).items()}},
+        "skinning": skinning_outcome,
+        "warnings": warnings,
+    }
+
+
+def _import(source):
+    """Import ``source`` into the empty scene; (3x3 matrix from the file's frame to Blender's world, its name)."""
+    suffix = source.suffix.lower()
+    path = str(source)
+    if suffix == ".obj":
+        bpy.ops.wm.obj_import(filepath=path, forward_axis='NEGATIVE_Z', up_axis='Y')
+        return Y_UP_TO_Z_UP, "file (the OBJ's v coordinates)"
+    if suffix in (".glb", ".gltf"):
+        bpy.ops.import_scene.gltf(filepath=path)
+        return Y_UP_TO_Z_UP, "file (glTF, Y up)"
+    if suffix == ".fbx":
+        bpy.ops.import_scene.fbx(filepath=path)
+        return np.eye(3), "blender world (FBX axes and units converted by Blender's importer)"
+    if suffix == ".blend":
+        bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
+        return np.eye(3), "blender world"
+    raise ValueError(f"{source}: unsupported file type {suffix!r}")
+
+
+def save_scene(output):
+    """Save the scene to ``output`` (.blend, .glb or .fbx) through a temporary file renamed into place; glTF and FBX
+    get the meshes and armatures only (not Rigger's overlays or other helpers)."""
+    suffix = output.suffix.lower()
+    output.parent.mkdir(parents=True, exist_ok=True)
+    # a fresh folder beside the output: the same file system for the rename, no existing file for Blender to back
+    # up as .blend1, and the usual permissions
+    with tempfile.TemporaryDirectory(prefix=f".{output.name}.", dir=output.parent) as folder:
+        name = os.path.join(folder, output.name)
+        if suffix == ".blend":
+            bpy.ops.wm.save_as_mainfile(filepath=name, copy=True)
+        elif suffix == ".glb":
+            with _selected(_exported()):
+                bpy.ops.export_scene.gltf(filepath=name, export_format='GLB', use_selection=True)
+        elif suffix == ".fbx":
+            with _selected(_exported()):
+                bpy.ops.export_scene.fbx(filepath=name, use_selection=True, object_types={'ARMATURE', 'MESH'},
+                                         add_leaf_bones=False)
+        else:
+            raise ValueError(f"{output}: unsupported output type {suffix!r}")
+        os.replace(name, output)
+
+
+def _exported():
+    """The objects a glTF or FBX file gets: meshes and armatures, not overlays."""
+    return [obj for obj in bpy.context.scene.objects
+            if obj.type in ('MESH', 'ARMATURE') and overlays.KIND_KEY not in obj]
+
+
+@contextlib.contextmanager
+def _selected(objects):
+    """Select exactly ``objects`` for an exporter's use_selection, restoring the selection afterwards."""
+    view_layer = bpy.context.view_layer
+    before = list(view_layer.objects.selected)
+    for obj in before:
+        obj.select_set(False)
+    for obj in objects:
+        obj.select_set(True)
+    try:
+        yield
+    finally:
+        for obj in objects:
+            obj.select_set(False)
+        for obj in before:
+            obj.select_set(True)

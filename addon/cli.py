@@ -1,0 +1,211 @@
+"""``python -m rigger``: rig model files from the command line (``rig``), or whole folders in parallel (``batch``).
+
+``rig`` imports an OBJ, glTF/GLB, FBX or .blend file into an empty headless Blender (the ``bpy`` module), rigs its
+mesh, skins it and saves .blend, .glb/.gltf or .fbx, plus an optional JSON report. Outputs are written to temporary
+files and renamed into place only when everything succeeded, so a failure leaves nothing behind.
+"""
+import argparse
+import concurrent.futures
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+INPUTS = (".obj", ".glb", ".gltf", ".fbx", ".blend")
+OUTPUTS = (".blend", ".glb", ".fbx")
+EXIT_FAILED = 1
+EXIT_USAGE = 2
+
+
+class CliError(Exception):
+    """A failure to tell the user in one line (missing file, no mesh, rigging failed); exits non-zero."""
+
+
+def main(argv=None):
+    parser = _parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.run(args)
+    except CliError as error:
+        print(f"rigger: error: {error}", file=sys.stderr)
+        return EXIT_FAILED
+
+
+def _parser():
+    parser = argparse.ArgumentParser(prog="python -m rigger", description=__doc__.split("\n\n")[0])
+    commands = parser.add_subparsers(dest="command", required=True)
+
+    rig = commands.add_parser("rig", help="rig one model file")
+    rig.add_argument("input", type=pathlib.Path, help=f"model file ({', '.join(INPUTS)})")
+    rig.add_argument("-o", "--output", type=pathlib.Path,
+                     help=f"where to save ({', '.join(OUTPUTS)}); default INPUT_rigged.blend beside the input")
+    rig.add_argument("--report", type=pathlib.Path, help="write a JSON report here")
+    _method_options(rig)
+    rig.set_defaults(run=_run_rig)
+
+    batch = commands.add_parser("batch", help="rig every model file of a folder in parallel processes")
+    batch.add_argument("folder", type=pathlib.Path, help="folder of model files (not searched recursively)")
+    batch.add_argument("-o", "--output", type=pathlib.Path, required=True, help="folder for the results")
+    batch.add_argument("--format", choices=[suffix[1:] for suffix in OUTPUTS], default="blend",
+                       help="output format (default blend)")
+    batch.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel processes (default: CPUs)")
+    _method_options(batch)
+    batch.set_defaults(run=_run_batch)
+
+    methods = commands.add_parser("methods", help="list the rigging methods and their parameters")
+    methods.set_defaults(run=_run_methods)
+    return parser
+
+
+def _method_options(parser):
+    parser.add_argument("--method", default="silhouette", help="rigging method (see `python -m rigger methods`)")
+    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                        help="a method parameter, e.g. --set bone_length=0.08 (repeatable)")
+    parser.add_argument("--no-skin", action="store_true", help="make the armature only, do not skin the mesh")
+
+
+def _settings(pairs):
+    values = {}
+    for pair in pairs:
+        key, separator, value = pair.partition("=")
+        if not separator or not key.strip():
+            raise CliError(f"--set expects KEY=VALUE, got {pair!r}")
+        values[key.strip()] = value
+    return values
+
+
+def _run_methods(args):
+    from .api import method_registry
+
+    registry = method_registry()
+    for name, method in registry.methods.items():
+        print(f"{name}: {method.description}")
+        for param in method.params:
+            choices = f" {{{', '.join(param.items)}}}" if param.items else ""
+            print(f"  --set {param.name}=VALUE  ({param.type}{choices}, default {param.default}) {param.description}")
+    for where, error in registry.failures.items():
+        print(f"failed to load {where}: {error}", file=sys.stderr)
+    return 0
+
+
+def _run_rig(args):
+    from .api import method_registry
+    from .core.params import resolve
+
+    source = args.input
+    if not source.is_file():
+        raise CliError(f"{source}: no such file")
+    if source.suffix.lower() not in INPUTS:
+        raise CliError(f"{source}: cannot read {source.suffix or 'files without a suffix'}; use {', '.join(INPUTS)}")
+    output = args.output or source.with_name(f"{source.stem}_rigged.blend")
+    if output.suffix.lower() not in OUTPUTS:
+        raise CliError(f"{output}: cannot write {output.suffix or 'files without a suffix'}; use {', '.join(OUTPUTS)}")
+    try:  # check the method and parameters before the slow import
+        method = method_registry().lookup(args.method)
+        params = resolve(method.params, _settings(args.settings))
+    except ValueError as error:
+        raise CliError(str(error)) from None
+
+    from . import register
+    from .blender import scenefiles
+
+    register()  # the properties the Blender layer keeps on scenes and objects
+    try:
+        report = scenefiles.rig_file(source, output, method.name, params, skin=not args.no_skin)
+    except (ValueError, RuntimeError) as error:  # RuntimeError: Blender's importers on unreadable files
+        raise CliError(str(error).strip()) from None
+    with _written(args.report) as path:
+        if path is not None:
+            path.write_text(json.dumps(report, indent=2))
+    print(f"rigged {source} → {output}: {len(report['bones'])} bones, {report['skinning']['summary']}")
+    for warning in report["warnings"]:
+        print(f"warning: {warning}", file=sys.stderr)
+    return 0
+
+
+class _written:
+    """Context manager giving a temporary path beside ``final`` (or None); renamed to ``final`` on success only."""
+
+    def __init__(self, final):
+        self.final = final
+        self.temporary = None
+
+    def __enter__(self):
+        if self.final is None:
+            return None
+        self.final.parent.mkdir(parents=True, exist_ok=True)
+        handle, name = tempfile.mkstemp(prefix=f".{self.final.name}.", dir=self.final.parent)
+        os.close(handle)
+        self.temporary = pathlib.Path(name)
+        return self.temporary
+
+    def __exit__(self, kind, error, trace):
+        if self.temporary is None:
+            return False
+        if kind is None:
+            os.replace(self.temporary, self.final)
+        else:
+            self.temporary.unlink(missing_ok=True)
+        return False
+
+
+def _run_batch(args):
+    if not args.folder.is_dir():
+        raise CliError(f"{args.folder}: no such folder")
+    if args.jobs < 1:
+        raise CliError(f"--jobs must be at least 1, got {args.jobs}")
+    sources = sorted(path for path in args.folder.iterdir() if path.suffix.lower() in INPUTS and path.is_file())
+    if not sources:
+        raise CliError(f"{args.folder}: no model files ({', '.join(INPUTS)})")
+    args.output.mkdir(parents=True, exist_ok=True)
+    extra = [f"--method={args.method}", *(f"--set={pair}" for pair in args.settings)]
+    extra += ["--no-skin"] if args.no_skin else []
+    rows = []
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        futures = [pool.submit(_rig_in_child, source, args.output, args.format, extra) for source in sources]
+        for done, future in enumerate(concurrent.futures.as_completed(futures), start=1):
+            rows.append(future.result())
+            _progress(done, len(sources))
+    rows.sort(key=lambda row: row["file"])
+    print(_summary_table(rows))
+    (args.output / "summary.json").write_text(json.dumps(rows, indent=2))
+    failed = sum(row["status"] != "ok" for row in rows)
+    return EXIT_FAILED if failed else 0
+
+
+def _rig_in_child(source, folder, suffix, extra):
+    """Rig ``source`` in a child process (each needs its own Blender); a row of the summary table."""
+    stem = source.stem if source.suffix.lower() != ".blend" or suffix != "blend" else f"{source.stem}_rigged"
+    output, report = folder / f"{stem}.{suffix}", folder / f"{stem}.json"
+    command = [sys.executable, "-m", __package__, "rig", str(source), "-o", str(output), "--report", str(report),
+               *extra]
+    start = time.perf_counter()
+    child = subprocess.run(command, capture_output=True, text=True)
+    row = {"file": source.name, "seconds": round(time.perf_counter() - start, 2)}
+    if child.returncode:
+        lines = [line for line in child.stderr.splitlines() if line.startswith("rigger: error:")]
+        message = lines[-1].removeprefix("rigger: error: ") if lines else child.stderr.strip()[-300:]
+        return {**row, "status": "failed", "bones": 0, "skinning": "", "message": message}
+    data = json.loads(report.read_text())
+    return {**row, "status": "ok", "bones": len(data["bones"]), "skinning": data["skinning"]["summary"],
+            "message": "; ".join(data["warnings"]), "output": output.name}
+
+
+def _progress(done, total, width=30):
+    filled = round(width * done / total)
+    end = "\n" if done == total else ""
+    print(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{total}", end=end, file=sys.stderr, flush=True)
+
+
+def _summary_table(rows):
+    header = ("file", "status", "bones", "seconds", "skinning / message")
+    lines = [" | ".join(header), " | ".join("---" for _ in header)]
+    for row in rows:
+        note = row["message"] if row["status"] != "ok" else row["skinning"]
+        lines.append(" | ".join(str(value) for value in (row["file"], row["status"], row["bones"], row["seconds"],
+                                                           note)))
+    ok = sum(row["status"] == "ok" for row in rows)
+    return "\n".join(lines) + f"\n{ok} of {len(rows)} rigged"

@@ -1,0 +1,318 @@
+"""The add-on inside Blender (bpy from PyPI, headless): registration, generated properties, operators, panel.
+
+Skinning and overlays have their own modules (test_skinning.py, test_overlays.py); here they are exercised through
+the operators on the project's generated characters, whose Skin-modifier construction gives the true skeleton.
+"""
+import contextlib
+import io
+
+import numpy as np
+import pytest
+
+from characters import winding_numbers
+
+bpy = pytest.importorskip("bpy")
+
+import rigger  # noqa: E402
+from rigger.blender.samples import build_character  # noqa: E402
+
+CHARACTERS = ("humanoid", "quadruped", "octopus", "tree", "snake")
+
+
+@pytest.fixture(scope="module")
+def registered():
+    rigger.register()
+    yield
+    rigger.unregister()
+
+
+@pytest.fixture
+def scene(registered):
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    return bpy.context.scene
+
+
+def activate(obj, *others):
+    for selected in bpy.context.view_layer.objects.selected:
+        selected.select_set(False)
+    for each in (obj, *others):
+        each.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+
+
+def reports_of(operator, **kwargs):
+    """(result, printed reports) of calling ``operator``: headless Blender prints reports to stdout."""
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        result = operator(**kwargs)
+    return result, printed.getvalue()
+
+
+def mesh_arrays(obj):
+    from rigger.blender.meshdata import evaluated_arrays
+    return evaluated_arrays(obj)
+
+
+def deform_weights(obj):
+    """(N, groups) weights of ``obj``'s vertices in its vertex groups."""
+    weights = np.zeros((len(obj.data.vertices), len(obj.vertex_groups)))
+    for vertex in obj.data.vertices:
+        for element in vertex.groups:
+            weights[vertex.index, element.group] = element.weight
+    return weights
+
+
+# registration
+
+
+def test_register_adds_the_operators_settings_and_panel_and_unregister_removes_them():
+    rigger.register()
+    try:
+        assert hasattr(bpy.types.Scene, "rigger")
+        assert hasattr(bpy.ops.rigger, "rig") and hasattr(bpy.ops.rigger, "clear_overlays")
+        assert "RIGGER_PT_main" in dir(bpy.types)
+        settings = bpy.context.scene.rigger
+        assert settings.method == "silhouette"
+        assert settings.methods.silhouette.resolution == 384
+    finally:
+        rigger.unregister()
+    assert not hasattr(bpy.types.Scene, "rigger")
+    assert not hasattr(bpy.types.Object, "rigger_armature")
+    assert "RIGGER_PT_main" not in dir(bpy.types)
+    rigger.register()  # and again: nothing of the first round is left over to clash with
+    rigger.unregister()
+
+
+def test_generated_properties_follow_the_declarations(registered):
+    from rigger.api import method_registry
+    method = method_registry().lookup("silhouette")
+    group = bpy.context.scene.rigger.methods.silhouette
+    for param in method.params:
+        rna = group.bl_rna.properties[param.name]
+        assert rna.name == param.label and rna.description == param.description
+        if param.type in ("float", "int"):
+            assert (rna.hard_min, rna.hard_max) == pytest.approx((param.min, param.max))
+            assert rna.default == pytest.approx(param.default)
+        if param.type == "enum":
+            assert [item.identifier for item in rna.enum_items] == list(param.items)
+
+
+def test_float_parameters_reach_the_method_as_typed_not_as_single_precision(registered):
+    from rigger.api import method_registry
+    from rigger.blender.properties import param_values
+    group = bpy.context.scene.rigger.methods.silhouette
+    group.outline_spacing = 0.1  # the declared maximum: as a float32 it reads 0.10000000149
+    values = param_values(method_registry().lookup("silhouette"), group)
+    assert values["outline_spacing"] == 0.1 and values["bone_length"] == 0.1
+
+
+# operators
+
+
+@pytest.fixture(scope="module")
+def rigged(registered):
+    """Every test character rigged and skinned through ``rigger.rig_skin``: name → (mesh object, reports)."""
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    results = {}
+    for name in CHARACTERS:
+        obj = build_character(name, subdivisions=1)
+        activate(obj)
+        results[name] = (obj, *reports_of(bpy.ops.rigger.rig_skin))
+    return results
+
+
+@pytest.mark.parametrize("name", CHARACTERS)
+def test_rig_and_skin_every_character(rigged, name):
+    obj, result, printed = rigged[name]
+    assert result == {'FINISHED'}, printed
+    armature = obj.rigger_armature
+    bones = armature.data.bones
+    assert len(bones) >= 1
+    assert sum(bone.parent is None for bone in bones) == 1  # one rooted tree
+    assert armature.matrix_world == armature.matrix_world.Identity(4)
+
+    vertices, triangles = mesh_arrays(obj)
+    points = np.concatenate([np.array([bone.head_local for bone in bones]),
+                             np.array([bone.tail_local for bone in bones])])
+    inside = winding_numbers(vertices, triangles, points) > 0.5
+    assert inside.mean() >= 0.9, f"{(~inside).sum()} of {len(points)} bone ends outside the mesh"
+
+    deforming = {bone.name for bone in bones if bone.use_deform}
+    group_is_bone = np.array([group.name in deforming for group in obj.vertex_groups])
+    weights = deform_weights(obj)[:, group_is_bone]
+    assert (weights.max(axis=1) > 0).all(), "vertices left unweighted"
+    assert any(m.type == 'ARMATURE' and m.object == armature for m in obj.modifiers)
+
+
+def test_bones_connect_where_a_head_meets_its_parents_tail(rigged):
+    obj = rigged["humanoid"][0]
+    for bone in obj.rigger_armature.data.bones:
+        if bone.parent is not None:
+            meets = (bone.head_local - bone.parent.tail_local).length < 1e-5
+            assert bone.use_connect == meets, bone.name
+
+
+def test_rolls_follow_one_rule_so_mirrored_limbs_mirror(rigged):
+    """Each bone's Z axis is world up made perpendicular to the bone (the front, -Y, for near-vertical bones): a rule
+    that commutes with mirroring in X, so left and right limbs get mirrored rolls."""
+    for bone in rigged["humanoid"][0].rigger_armature.data.bones:
+        axes = np.array(bone.matrix_local)[:3, :3]
+        along = axes[:, 1]
+        reference = np.array([0.0, -1.0, 0.0]) if abs(along[2]) > 0.95 else np.array([0.0, 0.0, 1.0])
+        expected = reference - (reference @ along) * along
+        np.testing.assert_allclose(axes[:, 2], expected / np.linalg.norm(expected), atol=1e-4, err_msg=bone.name)
+
+
+def test_the_rig_follows_the_objects_transform_and_modifiers(scene):
+    obj = build_character("humanoid", subdivisions=0)
+    obj.modifiers.new("Smooth", 'SUBSURF').levels = 1
+    obj.location = (3.0, -2.0, 1.0)
+    obj.rotation_euler = (0.0, 0.0, np.pi / 2)
+    obj.scale = (2.0, 2.0, 2.0)
+    activate(obj)
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    armature = obj.rigger_armature
+    heads = np.array([bone.head_local for bone in armature.data.bones])
+    vertices, triangles = mesh_arrays(obj)
+    assert len(vertices) > len(obj.data.vertices)  # the modifier was applied
+    assert (winding_numbers(vertices, triangles, heads) > 0.5).mean() >= 0.9
+    # the humanoid, 1.8 m tall along its own Z, is now 3.6 m tall and stands at z = 1
+    assert heads[:, 2].max() - heads[:, 2].min() > 2.0
+    assert bpy.context.view_layer.objects.active == armature
+
+
+def test_rigging_again_replaces_the_previous_rig(scene):
+    obj = build_character("snake", subdivisions=0)
+    activate(obj)
+    assert bpy.ops.rigger.rig_skin() == {'FINISHED'}
+    first_groups = len(obj.vertex_groups)
+    activate(obj)
+    scene.rigger.methods.silhouette.bone_length = 0.05
+    result, printed = reports_of(bpy.ops.rigger.rig)
+    assert result == {'FINISHED'} and "replaced the previous rig" in printed
+    assert [o.type for o in bpy.data.objects if o.type == 'ARMATURE'] == ['ARMATURE']
+    assert len(bpy.data.armatures) == 1
+    assert not any(m.type == 'ARMATURE' for m in obj.modifiers) and obj.parent is None
+    assert first_groups and len(obj.vertex_groups) == 0
+
+
+def test_the_armature_stays_editable_and_skin_uses_the_edited_bones(scene):
+    obj = build_character("snake", subdivisions=0)
+    activate(obj)
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    armature = obj.rigger_armature
+    assert bpy.context.view_layer.objects.active == armature
+    bpy.ops.object.mode_set(mode='EDIT')
+    armature.data.edit_bones[0].name = "renamed"
+    bpy.ops.object.mode_set(mode='OBJECT')
+    assert bpy.ops.rigger.skin() == {'FINISHED'}  # the active armature leads back to its mesh
+    assert "renamed" in obj.vertex_groups
+
+
+def test_several_selected_meshes_are_rigged_together_and_all_skinned(scene):
+    body = build_character("humanoid", subdivisions=0)
+    hat = build_character("snake", subdivisions=0)
+    hat.scale = (0.2, 0.2, 0.2)
+    hat.location = (0.0, 0.0, 1.9)
+    activate(body, hat)
+    assert bpy.ops.rigger.rig_skin() == {'FINISHED'}
+    assert body.rigger_armature == hat.rigger_armature
+    for obj in (body, hat):
+        assert obj.vertex_groups and any(m.type == 'ARMATURE' for m in obj.modifiers)
+
+
+def test_polls_explain_why_an_operator_cannot_run(scene):
+    assert not bpy.ops.rigger.rig.poll()
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    scene.collection.objects.link(camera)
+    activate(camera)
+    assert not bpy.ops.rigger.rig.poll() and not bpy.ops.rigger.skin.poll()
+    obj = build_character("snake", subdivisions=0)
+    activate(obj)
+    assert bpy.ops.rigger.rig.poll() and not bpy.ops.rigger.skin.poll()  # nothing to skin to yet
+    bpy.ops.object.mode_set(mode='EDIT')
+    assert not bpy.ops.rigger.rig.poll()
+    bpy.ops.object.mode_set(mode='OBJECT')
+    assert not bpy.ops.rigger.clear_overlays.poll()
+
+
+def test_a_mesh_without_faces_is_reported_not_raised(scene):
+    mesh = bpy.data.meshes.new("points")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1)], [])
+    obj = bpy.data.objects.new("points", mesh)
+    scene.collection.objects.link(obj)
+    activate(obj)
+    with pytest.raises(RuntimeError, match="has no faces"):  # bpy.ops turns an ERROR report into RuntimeError
+        bpy.ops.rigger.rig()
+    assert [o.name for o in bpy.data.objects] == ["points"]
+
+
+def test_bad_parameters_are_reported_and_create_nothing(scene):
+    obj = build_character("snake", subdivisions=0)
+    activate(obj)
+    with pytest.raises(RuntimeError, match="flat|no faces|NaN|finite"):
+        obj.data.vertices[0].co = (float("nan"), 0.0, 0.0)
+        bpy.ops.rigger.rig()
+    assert obj.rigger_armature is None and len(bpy.data.armatures) == 0
+
+
+def test_operators_are_undoable_and_scriptable_by_name(registered):
+    from rigger.blender.operators import CLASSES
+    assert sorted(cls.bl_idname for cls in CLASSES) == [
+        "rigger.clear_overlays", "rigger.rig", "rigger.rig_skin", "rigger.skin"]
+    assert all(cls.bl_options == {'REGISTER', 'UNDO'} for cls in CLASSES)
+
+
+class RecordingLayout:
+    """Stands in for bpy.types.UILayout (which only exists while Blender draws a region): records what is drawn."""
+
+    def __init__(self, log=None):
+        self.log = [] if log is None else log
+
+    def _nested(self, *args, **kwargs):
+        return RecordingLayout(self.log)
+
+    box = column = row = grid_flow = _nested
+
+    def prop(self, data, name, **kwargs):
+        self.log.append(("prop", name))
+
+    def operator(self, idname, **kwargs):
+        self.log.append(("operator", idname))
+
+    def label(self, text="", **kwargs):
+        self.log.append(("label", text))
+
+
+def test_the_panel_shows_method_parameters_actions_and_overlay_toggles(registered, scene):
+    from rigger.blender.overlays import OVERLAY_KINDS
+    from rigger.blender.panel import RIGGER_PT_main
+    assert (RIGGER_PT_main.bl_space_type, RIGGER_PT_main.bl_region_type) == ('VIEW_3D', 'UI')
+    assert RIGGER_PT_main.bl_category == "Rigger"
+    panel = type("Drawn", (), {"layout": RecordingLayout()})()
+    RIGGER_PT_main.draw(panel, bpy.context)
+    log = panel.layout.log
+    props = [name for kind, name in log if kind == "prop"]
+    assert props[0] == "method"
+    assert {"resolution", "bone_length", "view"} <= set(props)
+    assert {f"show_{kind}" for kind, _, _ in OVERLAY_KINDS} <= set(props)
+    assert [name for kind, name in log if kind == "operator"] == [
+        "rigger.rig", "rigger.skin", "rigger.rig_skin", "rigger.clear_overlays"]
+
+
+def test_a_method_draw_hook_that_raises_is_shown_in_the_panel_not_raised():
+    from rigger.blender.panel import draw_method
+    from rigger.core.registry import RigMethod
+
+    class Faulty(RigMethod):
+        name = "faulty"
+
+        def rig(self, mesh):
+            raise AssertionError
+
+        def draw(self, layout, props):
+            raise KeyError("oops")
+
+    layout = RecordingLayout()
+    draw_method(layout, Faulty, props=None)
+    assert ("label", "faulty.draw failed: KeyError: 'oops'") in layout.log

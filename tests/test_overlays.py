@@ -1,0 +1,331 @@
+"""Stage overlays (rigger.blender.overlays): the evaluated geometry-node output sits where each stage says, in the
+right materials, and building, rebuilding, hiding and clearing leave exactly the data they should."""
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+import rigger  # noqa: E402
+from rigger.blender import overlays, samples  # noqa: E402
+from rigger.methods._template import TemplateMethod  # noqa: E402
+from rigger.skeletonize.chordal import ISOLATED, JUNCTION, SLEEVE, TERMINAL  # noqa: E402
+
+KINDS = [key for key, _, _ in overlays.OVERLAY_KINDS]
+LINE_KINDS = ("silhouette", "axis", "pruned", "chains")
+ICO_VERTICES = 42  # an ico sphere of SPHERE_SUBDIVISIONS = 2
+
+
+@pytest.fixture(scope="module")
+def humanoid():
+    """(vertices, triangles, stages) of the humanoid sample rigged by the silhouette method."""
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    vertices, triangles = samples.character_arrays("humanoid", subdivisions=1)
+    return vertices, triangles, rigger.rig_mesh(vertices, triangles).stages
+
+
+@pytest.fixture(autouse=True)
+def empty_scene():
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+
+
+def lift(stages, points):
+    """Silhouette-plane points to 3D, as the stage interface defines it."""
+    frame = stages["silhouette"]
+    points = np.asarray(points)
+    return (frame["origin"] + frame["depth"] * frame["direction"] + points[:, :1] * frame["u"]
+            + points[:, 1:] * frame["v"])
+
+
+def stage_segments(stages, kind):
+    """(starts, ends) of the segments a line-like stage draws, in 3D."""
+    if kind == "silhouette":
+        loops = stages["silhouette"]["loops"]
+        starts = np.concatenate([lift(stages, loop) for loop in loops])
+        ends = np.concatenate([lift(stages, np.roll(loop, -1, axis=0)) for loop in loops])
+        return starts, ends
+    if kind == "chains":
+        return (np.concatenate([chain[:-1] for chain in stages["chains"]]),
+                np.concatenate([chain[1:] for chain in stages["chains"]]))
+    points = lift(stages, stages["axis"]["points"])
+    links = stages[kind]["links"]
+    return points[links[:, 0]], points[links[:, 1]]
+
+
+def distance_to_segments(points, starts, ends):
+    """Distance from every point to the nearest of the segments."""
+    span = ends - starts
+    length2 = np.maximum((span * span).sum(axis=1), 1e-300)
+    nearest = np.empty(len(points))
+    for chunk in np.array_split(np.arange(len(points)), max(1, len(points) // 256)):
+        offset = points[chunk, None, :] - starts
+        t = np.clip((offset * span).sum(axis=2) / length2, 0.0, 1.0)
+        nearest[chunk] = np.linalg.norm(offset - t[..., None] * span, axis=2).min(axis=1)
+    return nearest
+
+
+def evaluated(obj):
+    """Vertices (N, 3) and the material name of every face of the object's evaluated (geometry-node) mesh."""
+    mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    vertices = np.empty(3 * len(mesh.vertices))
+    mesh.vertices.foreach_get("co", vertices)
+    index = np.empty(len(mesh.polygons), dtype=np.int32)
+    mesh.polygons.foreach_get("material_index", index)
+    names = np.array([material.name if material else "" for material in mesh.materials] or [""])
+    return vertices.reshape(-1, 3), names[index]
+
+
+def default_radius(stages):
+    """LINE_SCALE times the largest extent of everything drawn."""
+    cdt = stages["cdt"]
+    axis_used = np.unique(np.concatenate([stages["axis"]["links"].ravel(), stages["pruned"]["links"].ravel()]))
+    points = np.concatenate([
+        *(lift(stages, loop) for loop in stages["silhouette"]["loops"]),
+        lift(stages, cdt["vertices"][np.unique(cdt["triangles"])]),
+        lift(stages, stages["axis"]["points"][axis_used]),
+        *stages["chains"],
+        stages["joints"],
+    ])
+    return overlays.LINE_SCALE * float(np.max(points.max(axis=0) - points.min(axis=0)))
+
+
+def data_counts():
+    return {name: len(getattr(bpy.data, name))
+            for name in ("objects", "meshes", "node_groups", "materials", "collections")}
+
+
+def test_every_stage_of_the_silhouette_method_gets_its_object(humanoid):
+    stages = humanoid[2]
+    objects = overlays.build_overlays(stages, "Body")
+    assert list(objects) == KINDS
+    collection = bpy.data.collections[overlays.COLLECTION_NAME]
+    assert collection in bpy.context.scene.collection.children_recursive
+    for kind, obj in objects.items():
+        assert obj.name == f"Rigger {kind}: Body"
+        assert obj.data.name == obj.name
+        assert list(obj.users_collection) == [collection]
+        assert obj.hide_select and obj.show_in_front and obj.hide_render
+        assert obj.visible_get()
+        assert len(obj.data.polygons) == (len(stages["cdt"]["triangles"]) if kind == "triangulation" else 0)
+        assert len(evaluated(obj)[1]) > 0, f"{kind}: the geometry nodes drew no faces"
+
+
+@pytest.mark.parametrize("kind", LINE_KINDS)
+def test_tubes_follow_the_stage_at_the_line_radius(humanoid, kind):
+    stages = humanoid[2]
+    radius = default_radius(stages)
+    obj = overlays.build_overlays(stages, "Body")[kind]
+    vertices, materials = evaluated(obj)
+    starts, ends = stage_segments(stages, kind)
+    distance = distance_to_segments(vertices, starts, ends)
+    # Tube rings lie at the radius around the line: none farther, the ends and straight runs exactly there.
+    assert distance.max() <= radius * 1.001 + 1e-6
+    assert distance.max() >= radius * 0.99
+    # Every stage point is drawn: a tube ring passes around it.
+    covered = distance_to_segments(np.concatenate([starts, ends]), vertices, vertices)
+    assert covered.max() <= radius * 1.01
+    assert set(materials) == {f"Rigger {kind}"}
+
+
+def test_plane_stages_lie_on_the_silhouette_plane_at_its_depth(humanoid):
+    stages = humanoid[2]
+    frame = stages["silhouette"]
+    radius = default_radius(stages)
+    objects = overlays.build_overlays(stages, "Body")
+    for kind in ("silhouette", "triangulation", "axis", "pruned"):
+        vertices = evaluated(objects[kind])[0]
+        depth = (vertices - frame["origin"]) @ frame["direction"]
+        assert np.abs(depth - frame["depth"]).max() <= radius * 1.001 + 1e-6, kind
+    # The chains leave the plane: they are placed in depth inside the mesh.
+    chains = np.concatenate(stages["chains"])
+    assert np.ptp((chains - frame["origin"]) @ frame["direction"]) > 10 * radius
+
+
+def test_joint_spheres_are_centred_on_the_joints(humanoid):
+    stages = humanoid[2]
+    joints = stages["joints"]
+    obj = overlays.build_overlays(stages, "Body", scale=0.01)["joints"]
+    vertices, materials = evaluated(obj)
+    assert vertices.shape == (len(joints) * ICO_VERTICES, 3)
+    spheres = vertices.reshape(len(joints), ICO_VERTICES, 3)
+    np.testing.assert_allclose(spheres.mean(axis=1), joints, atol=1e-5)
+    distance = np.linalg.norm(spheres - joints[:, None, :], axis=2)
+    np.testing.assert_allclose(distance, overlays.JOINT_SCALE * 0.01, rtol=1e-3)
+    assert set(materials) == {"Rigger joints"}
+
+
+def test_scale_sets_the_line_radius(humanoid):
+    stages = humanoid[2]
+    obj = overlays.build_overlays(stages, "Body", scale=0.02)["silhouette"]
+    distance = distance_to_segments(evaluated(obj)[0], *stage_segments(stages, "silhouette"))
+    assert 0.02 * 0.99 <= distance.max() <= 0.02 * 1.001
+
+
+def test_triangulation_materials_match_the_classes_present(humanoid):
+    stages = humanoid[2]
+    classes = stages["cdt"]["classes"]
+    present = {overlays.CLASS_NAMES[code] for code in np.unique(classes)}
+    obj = overlays.build_overlays(stages, "Body")["triangulation"]
+    _, materials = evaluated(obj)
+    assert set(materials) == {f"Rigger {name}" for name in present} | {f"Rigger {name} faces" for name in present}
+    for code, name in overlays.CLASS_NAMES.items():
+        assert np.count_nonzero(materials == f"Rigger {name} faces") == np.count_nonzero(classes == code)
+    faces = bpy.data.materials["Rigger junction faces"]
+    edges = bpy.data.materials["Rigger junction"]
+    assert faces.diffuse_color[3] == pytest.approx(overlays.FACE_ALPHA)
+    assert edges.diffuse_color[3] == 1.0
+    assert tuple(faces.diffuse_color)[:3] == pytest.approx(tuple(edges.diffuse_color)[:3])
+
+
+def test_each_edge_is_drawn_once_in_the_colour_of_its_highest_class():
+    """A junction and a sleeve share an edge (the junction draws it); a terminal and an isolated triangle stand
+    alone. Every edge is a tube of TUBE_SIDES faces per segment."""
+    stages = {
+        "silhouette": {"loops": [], "origin": np.zeros(3), "u": np.array([1.0, 0, 0]), "v": np.array([0, 1.0, 0]),
+                       "direction": np.array([0, 0, 1.0]), "depth": 0.5},
+        "cdt": {"vertices": np.array([[0, 0], [1, 0], [0, 1], [1, 1], [3, 0], [4, 0], [3, 1], [6, 0], [7, 0],
+                                      [6, 1]], dtype=float),
+                "triangles": np.array([[0, 1, 2], [1, 3, 2], [4, 5, 6], [7, 8, 9]]),
+                "classes": np.array([JUNCTION, SLEEVE, TERMINAL, ISOLATED])},
+    }
+    objects = overlays.build_overlays(stages, "Patch", scale=0.05)
+    assert list(objects) == ["triangulation"]
+    vertices, materials = evaluated(objects["triangulation"])
+    sides = overlays.TUBE_SIDES
+    expected = {"Rigger junction": 3 * sides, "Rigger sleeve": 2 * sides, "Rigger terminal": 3 * sides,
+                "Rigger isolated": 3 * sides, "Rigger junction faces": 1, "Rigger sleeve faces": 1,
+                "Rigger terminal faces": 1, "Rigger isolated faces": 1}
+    names, counts = np.unique(materials, return_counts=True)
+    assert dict(zip(names.tolist(), counts.tolist())) == expected
+    assert np.abs(vertices[:, 2] - 0.5).max() <= overlays.CDT_EDGE_SCALE * 0.05 * 1.001
+
+
+def test_graph_links_are_drawn_once_and_self_links_dropped():
+    frame = {"loops": [], "origin": np.zeros(3), "u": np.array([1.0, 0, 0]), "v": np.array([0, 1.0, 0]),
+             "direction": np.array([0, 0, 1.0]), "depth": 0.0}
+    axis = {"points": np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [9.0, 9.0]]),
+            "links": np.array([[0, 1], [1, 0], [1, 1], [1, 2]])}
+    obj = overlays.build_overlays({"silhouette": frame, "axis": axis}, "Graph", scale=0.1)["axis"]
+    assert len(obj.data.vertices) == 3  # the unused point is left out
+    assert sorted(tuple(edge.vertices) for edge in obj.data.edges) == [(0, 1), (1, 2)]
+    vertices, _ = evaluated(obj)
+    assert vertices[:, 0].min() == pytest.approx(0.0, abs=1e-6) and vertices[:, 0].max() == pytest.approx(2.0)
+
+
+def test_rebuilding_replaces_the_owners_objects_and_shares_groups_and_materials(humanoid):
+    stages = humanoid[2]
+    overlays.build_overlays(stages, "Body")
+    once = data_counts()
+    overlays.build_overlays(stages, "Body")
+    assert data_counts() == once
+    names = [data.name for kind in ("objects", "meshes", "node_groups", "materials")
+             for data in getattr(bpy.data, kind)]
+    assert not [name for name in names if name[-4:-3] == "." and name[-3:].isdigit()]
+
+    overlays.build_overlays(stages, "Other")
+    twice = data_counts()
+    assert twice["objects"] == once["objects"] + len(KINDS)
+    assert twice["meshes"] == once["meshes"] + len(KINDS)
+    assert {key: twice[key] for key in ("node_groups", "materials", "collections")} == \
+        {key: once[key] for key in ("node_groups", "materials", "collections")}
+
+    without_joints = {key: value for key, value in stages.items() if key != "joints"}
+    assert list(overlays.build_overlays(without_joints, "Body")) == KINDS[:-1]
+    assert "Rigger joints: Body" not in bpy.data.objects and "Rigger joints: Other" in bpy.data.objects
+
+
+def test_visibility_at_build_and_toggled_per_kind(humanoid):
+    stages = humanoid[2]
+    body = overlays.build_overlays(stages, "Body", visible={"axis": False})
+    other = overlays.build_overlays(stages, "Other")
+    assert not body["axis"].visible_get() and body["axis"].hide_viewport and body["axis"].hide_get()
+    assert all(obj.visible_get() for kind, obj in body.items() if kind != "axis")
+
+    overlays.set_overlay_visible("chains", False)
+    assert not body["chains"].visible_get() and not other["chains"].visible_get()
+    assert body["chains"].hide_viewport and other["chains"].hide_get()
+    overlays.set_overlay_visible("axis", True)
+    overlays.set_overlay_visible("chains", True)
+    assert all(obj.visible_get() and not obj.hide_viewport for obj in [*body.values(), *other.values()])
+    # Shown again, the object evaluates as before.
+    assert len(evaluated(body["axis"])[1]) > 0
+
+
+def test_clear_leaves_nothing_behind(humanoid):
+    before = data_counts()
+    overlays.clear_overlays()  # nothing to clear yet
+    overlays.build_overlays(humanoid[2], "Body")
+    overlays.build_overlays(humanoid[2], "Other")
+    overlays.clear_overlays()
+    assert data_counts() == before
+    leftovers = [data.name for kind in ("objects", "meshes", "node_groups", "materials", "collections")
+                 for data in getattr(bpy.data, kind) if data.name.startswith("Rigger")]
+    assert leftovers == []
+    overlays.clear_overlays()
+    assert data_counts() == before
+
+
+def test_stages_without_overlay_data_draw_nothing(humanoid):
+    vertices, triangles, stages = humanoid
+    template = rigger.rig_mesh(vertices, triangles, method=TemplateMethod).stages
+    before = data_counts()
+    assert overlays.build_overlays(template, "Body") == {}
+    assert data_counts() == before
+    # A rebuild from such stages still removes the owner's earlier overlays.
+    overlays.build_overlays(stages, "Body")
+    assert overlays.build_overlays(template, "Body") == {}
+    assert not [obj for obj in bpy.data.objects if obj.name.startswith("Rigger")]
+
+
+def _with(stages, key, value):
+    changed = dict(stages)
+    changed[key] = value
+    return changed
+
+
+MALFORMED = {
+    "loop with NaN": (lambda s: _with(s, "silhouette", {**s["silhouette"], "loops": [np.full((4, 2), np.nan)]}),
+                      {"silhouette"}),
+    "frame without u": (lambda s: _with(s, "silhouette", {k: v for k, v in s["silhouette"].items() if k != "u"}),
+                        {"silhouette", "triangulation", "axis", "pruned"}),
+    "triangle index out of range": (lambda s: _with(s, "cdt", {**s["cdt"], "triangles": s["cdt"]["triangles"] + 10**6}),
+                                    {"triangulation"}),
+    "a class per vertex": (lambda s: _with(s, "cdt", {**s["cdt"], "classes": np.zeros(len(s["cdt"]["vertices"]))}),
+                           {"triangulation"}),
+    "float axis links": (lambda s: _with(s, "axis", {**s["axis"], "links": s["axis"]["links"] + 0.5}), {"axis"}),
+    "pruned past the axis": (lambda s: _with(s, "pruned", {"links": np.array([[0, len(s["axis"]["points"])]])}),
+                             {"pruned"}),
+    "chains not a list": (lambda s: _with(s, "chains", {"a": s["chains"][0]}), {"chains"}),
+    "2D chain": (lambda s: _with(s, "chains", [chain[:, :2] for chain in s["chains"]]), {"chains"}),
+    "2D joints": (lambda s: _with(s, "joints", s["joints"][:, :2]), {"joints"}),
+    "ragged joints": (lambda s: _with(s, "joints", [[0.0, 1.0, 2.0], [1.0]]), {"joints"}),
+}
+
+
+@pytest.mark.parametrize("case", MALFORMED)
+def test_malformed_stages_are_skipped_with_a_warning(humanoid, case):
+    corrupt, skipped = MALFORMED[case]
+    with pytest.warns(RuntimeWarning) as record:
+        objects = overlays.build_overlays(corrupt(humanoid[2]), "Body")
+    assert list(objects) == [kind for kind in KINDS if kind not in skipped]
+    assert {str(warning.message).split("'")[1] for warning in record} == skipped
+
+
+@pytest.mark.parametrize("arguments", [
+    {"stages": [], "owner": "Body"},
+    {"owner": ""},
+    {"owner": 3},
+    {"scale": 0.0},
+    {"scale": float("nan")},
+    {"scale": True},
+    {"visible": {"bones": True}},
+])
+def test_bad_arguments_raise(humanoid, arguments):
+    call = {"stages": humanoid[2], "owner": "Body", **arguments}
+    with pytest.raises(ValueError):
+        overlays.build_overlays(call.pop("stages"), call.pop("owner"), **call)
+    assert not [obj for obj in bpy.data.objects if obj.name.startswith("Rigger")]
+
+
+def test_unknown_kind_cannot_be_toggled():
+    with pytest.raises(ValueError, match="unknown overlay kind"):
+        overlays.set_overlay_visible("bones", True)
