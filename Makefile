@@ -52,3 +52,8 @@ $(BPY42_STAMP): requirements-bpy42.txt
 bpy42: $(BPY42_STAMP)
 
 test: bpy42
+
+# Skinning over ../shared/models/gt with the artists' skeletons and Rigger's: bench/results/skinning.md and .png.
+.PHONY: bench-skinning
+bench-skinning: build
+	$(PY) bench/skinning.py

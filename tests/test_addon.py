@@ -193,7 +193,7 @@ def test_rigging_again_replaces_the_previous_rig(scene):
     assert [o.type for o in bpy.data.objects if o.type == 'ARMATURE'] == ['ARMATURE']
     assert len(bpy.data.armatures) == 1
     assert not any(m.type == 'ARMATURE' for m in obj.modifiers) and obj.parent is None
-    assert first_groups and len(obj.vertex_groups) == 0
+    assert first_groups and len(obj.vertex_groups) == 0 and "rigger_vertex_groups" not in obj
 
 
 def test_the_armature_stays_editable_and_skin_uses_the_edited_bones(scene):
@@ -221,19 +221,54 @@ def test_several_selected_meshes_are_rigged_together_and_all_skinned(scene):
         assert obj.vertex_groups and any(m.type == 'ARMATURE' for m in obj.modifiers)
 
 
+def test_rig_builds_the_overlays_the_panel_toggles_and_clear_removes(scene):
+    from rigger.blender.overlays import COLLECTION_NAME, KIND_KEY, OVERLAY_KINDS
+    obj = build_character("humanoid", subdivisions=0)
+    activate(obj)
+    scene.rigger.show_triangulation = False
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    made = {o[KIND_KEY]: o for o in bpy.data.collections[COLLECTION_NAME].objects}
+    assert set(made) == {kind for kind, _, _ in OVERLAY_KINDS}
+    assert made["triangulation"].hide_get() and not made["joints"].hide_get()
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    joints = made["joints"].evaluated_get(depsgraph).to_mesh()
+    assert len(joints.polygons) > 0  # the node group drew spheres
+    made["joints"].evaluated_get(depsgraph).to_mesh_clear()
+
+    scene.rigger.show_joints = False
+    assert made["joints"].hide_get()
+    scene.rigger.show_triangulation = True
+    assert not made["triangulation"].hide_get()
+    assert bpy.ops.rigger.clear_overlays() == {'FINISHED'}
+    assert COLLECTION_NAME not in bpy.data.collections
+    assert not [o for o in bpy.data.objects if KIND_KEY in o]
+    assert not bpy.ops.rigger.clear_overlays.poll()
+
+
+def poll_message(operator):
+    """The message ``operator``'s poll gives when it refuses (bpy raises it as a RuntimeError), or None."""
+    if operator.poll():
+        return None
+    with pytest.raises(RuntimeError) as refused:
+        operator()
+    return str(refused.value).split(".poll() ", 1)[1]
+
+
 def test_polls_explain_why_an_operator_cannot_run(scene):
-    assert not bpy.ops.rigger.rig.poll()
+    assert poll_message(bpy.ops.rigger.rig) == "Select a mesh object"
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     scene.collection.objects.link(camera)
     activate(camera)
-    assert not bpy.ops.rigger.rig.poll() and not bpy.ops.rigger.skin.poll()
+    assert poll_message(bpy.ops.rigger.rig) == "Camera is not a mesh; select a mesh object"
+    assert poll_message(bpy.ops.rigger.skin) == "Camera is not a mesh; select a mesh object"
     obj = build_character("snake", subdivisions=0)
     activate(obj)
-    assert bpy.ops.rigger.rig.poll() and not bpy.ops.rigger.skin.poll()  # nothing to skin to yet
+    assert poll_message(bpy.ops.rigger.rig) is None
+    assert "has no armature yet: rig it first" in poll_message(bpy.ops.rigger.skin)
     bpy.ops.object.mode_set(mode='EDIT')
-    assert not bpy.ops.rigger.rig.poll()
+    assert poll_message(bpy.ops.rigger.rig) == "Switch to Object Mode first"
     bpy.ops.object.mode_set(mode='OBJECT')
-    assert not bpy.ops.rigger.clear_overlays.poll()
+    assert poll_message(bpy.ops.rigger.clear_overlays) == "There are no overlays to clear"
 
 
 def test_a_mesh_without_faces_is_reported_not_raised(scene):
@@ -247,11 +282,11 @@ def test_a_mesh_without_faces_is_reported_not_raised(scene):
     assert [o.name for o in bpy.data.objects] == ["points"]
 
 
-def test_bad_parameters_are_reported_and_create_nothing(scene):
+def test_a_mesh_with_a_nan_vertex_is_reported_and_nothing_is_created(scene):
     obj = build_character("snake", subdivisions=0)
+    obj.data.vertices[0].co = (float("nan"), 0.0, 0.0)
     activate(obj)
-    with pytest.raises(RuntimeError, match="flat|no faces|NaN|finite"):
-        obj.data.vertices[0].co = (float("nan"), 0.0, 0.0)
+    with pytest.raises(RuntimeError, match="not finite|NaN"):
         bpy.ops.rigger.rig()
     assert obj.rigger_armature is None and len(bpy.data.armatures) == 0
 

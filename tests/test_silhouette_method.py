@@ -80,6 +80,27 @@ def test_mirror_pairs_are_named_left_and_right():
             assert skeleton.heads[i, 0] + skeleton.tails[i, 0] > 0  # Blender: the character's left is +X
 
 
+@pytest.mark.parametrize("name", ["humanoid", "quadruped"])
+def test_every_bone_off_the_mirror_plane_is_named_for_its_side(name):
+    vertices, triangles = load_character(name)
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    middle = (skeleton.heads[:, 0] + skeleton.tails[:, 0]) / 2
+    size = float(np.ptp(vertices, axis=0).max())
+    for x, bone in zip(middle, skeleton.names):
+        if abs(x) > 0.1 * size:
+            assert bone.endswith(".L" if x > 0 else ".R"), bone
+    stems = [bone[:-2] for bone in skeleton.names if bone.endswith((".L", ".R"))]
+    assert sorted(stem for stem in stems if stems.count(stem) == 1) == []  # every side bone has its twin
+
+
+def test_no_bone_is_longer_than_three_bone_lengths():
+    """A straight leg has no corner to put a knee at, but still gets one."""
+    vertices, triangles = load_character("humanoid")
+    skeleton = rigger.rig_mesh(vertices, triangles, bone_length=0.1)
+    lengths = np.linalg.norm(skeleton.tails - skeleton.heads, axis=1)
+    assert lengths.max() <= 3 * 0.1 * np.ptp(vertices, axis=0).max()
+
+
 def test_the_hole_between_arm_and_body_is_cut():
     vertices, triangles = load_character("humanoid_hips")
     skeleton = rigger.rig_mesh(vertices, triangles, view="Y")

@@ -146,9 +146,23 @@ def test_the_mesh_keeps_its_place_when_transformed_and_parented(scene):
     world = np.array(obj.matrix_world)
     skeleton = samples.ground_truth_bones("quadruped").transformed(world)  # the rig sits where the mesh is seen
     armature = build_armature(skeleton, "rig")
+    for each in scene.objects:
+        each.select_set(each == holder)
+    bpy.context.view_layer.objects.active = holder
     report = skinning.skin(obj, armature)
     bpy.context.view_layer.update()
     np.testing.assert_allclose(np.array(obj.matrix_world), world, atol=1e-5)
+    assert bpy.context.view_layer.objects.active == holder
+    assert list(bpy.context.view_layer.objects.selected) == [holder]
+    assert_skinned(obj, armature, report)
+    assert report.level == "INFO"
+
+
+def test_hidden_and_unlinked_objects_are_skinned_too(scene):
+    obj, armature = character_with_rig("snake")
+    obj.hide_viewport = True  # Blender's weight operators refuse hidden objects in their poll
+    scene.collection.objects.unlink(armature)
+    report = skinning.skin(obj, armature)
     assert_skinned(obj, armature, report)
     assert report.level == "INFO"
 

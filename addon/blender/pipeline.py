@@ -7,7 +7,7 @@ import bpy
 import numpy as np
 
 from ..api import rig_mesh
-from . import overlays
+from . import overlays, skinning
 from .armature import build_armature
 from .meshdata import combined_arrays
 from .properties import ARMATURE_POINTER
@@ -67,28 +67,15 @@ def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays
 
 def remove_rig(obj):
     """Delete the armature Rigger made for ``obj`` earlier, and unbind every mesh made with it (their Armature
-    modifiers, the vertex groups named after its bones, the parenting; meshes keep their place). True when there
-    was one."""
+    modifiers, Rigger's vertex groups, the parenting; meshes keep their place). True when there was one."""
     armature = getattr(obj, ARMATURE_POINTER, None)
     if armature is None:
         return False
-    bone_names = {bone.name for bone in armature.data.bones}
     for mesh in [o for o in bpy.data.objects if getattr(o, ARMATURE_POINTER, None) == armature]:
-        _unbind(mesh, armature, bone_names)
+        skinning.unbind(mesh, armature)
+        setattr(mesh, ARMATURE_POINTER, None)
     data = armature.data
     bpy.data.objects.remove(armature)
     if data.users == 0:
         bpy.data.armatures.remove(data)
     return True
-
-
-def _unbind(mesh, armature, bone_names):
-    for modifier in [m for m in mesh.modifiers if m.type == 'ARMATURE' and m.object == armature]:
-        mesh.modifiers.remove(modifier)
-    for group in [g for g in mesh.vertex_groups if g.name in bone_names]:
-        mesh.vertex_groups.remove(group)
-    if mesh.parent == armature:
-        world = mesh.matrix_world.copy()
-        mesh.parent = None
-        mesh.matrix_world = world
-    setattr(mesh, ARMATURE_POINTER, None)

@@ -3,9 +3,9 @@
 Blender's bone heat (``parent_set(type='ARMATURE_AUTO')``) returns FINISHED even when it prints "Bone Heat
 Weighting: failed to find solution for one or more bones" and leaves every vertex unweighted: the heat system of a
 mesh split along UV seams into many pieces, or made of loose parts, can be singular. Loose parts and inner shells can
-also leave vertices unweighted with no message (a part that sees no bone, or whose bones another part hides). With
-bpy 5.0.1 the message goes through Python's ``sys.stdout`` (nothing reaches file descriptor 1), so it is captured
-with ``contextlib.redirect_stdout``; unweighted vertices are counted directly.
+also leave vertices unweighted with no message (a part that sees no bone, or whose bones another part hides). In
+bpy 4.2 and 5.0 the message goes through Python's ``sys.stdout`` (measured: nothing reaches file descriptor 1), so it
+is captured with ``contextlib.redirect_stdout``; unweighted vertices are counted directly.
 
 :func:`skin` runs bone heat on the mesh, then repairs only what is still unweighted, stage by stage:
 
@@ -34,6 +34,7 @@ GROUPS_PROPERTY = "rigger_vertex_groups"  # mesh object property: JSON list of t
 FAILURE_MESSAGE = "Bone Heat Weighting: failed to find solution"
 WELD_DISTANCE = 1e-5  # fraction of the mesh's largest extent under which two vertices are one (UV-seam duplicates)
 TEMPORARY_NAME = "Rigger skinning"
+NORMALIZED_TOLERANCE = 1e-6  # a vertex whose weights sum this close to 1 is left as it is (weights are float32)
 
 
 @dataclass
@@ -71,11 +72,6 @@ class SkinReport:
     def messages(self):
         """Every line Blender printed while weighting, in order."""
         return [message for stage in self.stages for message in stage.messages]
-
-    @property
-    def repaired(self):
-        """True when any stage after plain bone heat had to weight vertices."""
-        return any(stage.weighted for stage in self.stages[1:])
 
     @property
     def level(self):
@@ -136,8 +132,7 @@ def skin(mesh_obj, armature_obj):
                                f"unweighted")
         _repair(mesh_obj, armature_obj, bone_names, weighted, report)
 
-    _normalize(mesh_obj)
-    report.unweighted = int((~_weighted_mask(mesh_obj, bone_names)).sum())
+    report.unweighted = int((~_normalize(mesh_obj, bone_names)).sum())
     if report.unweighted:
         report.warnings.append(f"{report.unweighted} vertices are still unweighted")
     report.seconds = time.perf_counter() - started
@@ -166,6 +161,17 @@ def _describe(value):
     return type(value).__name__
 
 
+def unbind(mesh_obj, armature_obj):
+    """Undo :func:`skin`: remove Rigger's modifier (and any Armature modifier on ``armature_obj``), the vertex groups
+    Rigger wrote or named after the armature's bones, and the parenting; the mesh stays where it is."""
+    _remove_previous_skin(mesh_obj, armature_obj, [bone.name for bone in armature_obj.data.bones])
+    mesh_obj.pop(GROUPS_PROPERTY, None)
+    if mesh_obj.parent == armature_obj:
+        world = mesh_obj.matrix_world.copy()
+        mesh_obj.parent = None
+        mesh_obj.matrix_world = world
+
+
 def _remove_previous_skin(mesh_obj, armature_obj, bone_names):
     """Drop Rigger's earlier modifier and groups, any Armature modifier on this armature, and groups named after its
     deforming bones, so that bone heat starts from nothing and no stale weight counts as a result."""
@@ -180,12 +186,17 @@ def _remove_previous_skin(mesh_obj, armature_obj, bone_names):
 
 
 def _bone_heat(obj, armature_obj):
-    """Run Blender's bone heat parenting on ``obj``: (the operator's result set, the lines it printed)."""
+    """Run Blender's bone heat parenting on ``obj``: (the operator's result set, the lines it printed). An operator
+    error is one more printed line: the repair stages take over as they do when bone heat weights nothing."""
     printed = io.StringIO()
     objects = [obj, armature_obj]
     with bpy.context.temp_override(active_object=armature_obj, object=armature_obj, selected_objects=objects,
                                    selected_editable_objects=objects), contextlib.redirect_stdout(printed):
-        result = bpy.ops.object.parent_set(type='ARMATURE_AUTO', keep_transform=True)
+        try:
+            result = bpy.ops.object.parent_set(type='ARMATURE_AUTO', keep_transform=True)
+        except RuntimeError as error:
+            result = {'CANCELLED'}
+            print(f"Bone heat parenting raised: {error}")
     return result, [line.strip() for line in printed.getvalue().splitlines() if line.strip()]
 
 
@@ -243,50 +254,62 @@ def _repair(mesh_obj, armature_obj, bone_names, weighted, report):
     world = np.array(mesh_obj.matrix_world)
     positions = local_positions @ world[:3, :3].T + world[:3, 3]
     weld_map, kept, welded_triangles = _welded(mesh_obj.data, local_positions, triangles)
-    welded_positions = positions[kept]
-    merged = len(positions) - len(kept)
-    if merged:
-        stage = SkinStage("welded bone heat", note=f"{merged} duplicate vertices merged")
-        welded_weights, stage.messages = _bone_heat_weights(welded_positions, welded_triangles, armature_obj,
-                                                            bone_names)
-        targets = np.flatnonzero(~weighted)
-        stage.weighted = _transfer(mesh_obj, bone_names, welded_weights, targets, weld_map[targets], weighted)
-        _finish_stage(stage, started, report,
-                      f"Bone heat on a welded copy ({merged} duplicate vertices merged) weighted "
-                      f"{stage.weighted} of them")
-    if weighted.all():
-        return
+    welded = (weld_map, positions[kept], welded_triangles)
+    if len(kept) < len(positions):
+        _repair_welded(mesh_obj, armature_obj, bone_names, weighted, welded, report, started)
+    if not weighted.all():
+        _repair_islands(mesh_obj, armature_obj, bone_names, weighted, welded, report)
+    if not weighted.all():
+        _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, positions, report)
 
+
+def _repair_welded(mesh_obj, armature_obj, bone_names, weighted, welded, report, started):
+    """Stage 1: bone heat on the welded copy, weights carried back through the weld map."""
+    weld_map, welded_positions, welded_triangles = welded
+    merged = len(weld_map) - len(welded_positions)
+    stage = SkinStage("welded bone heat", note=f"{merged} duplicate vertices merged")
+    entries, stage.messages = _bone_heat_weights(welded_positions, welded_triangles, armature_obj, bone_names)
+    targets = np.flatnonzero(~weighted)
+    stage.weighted = _transfer(mesh_obj, bone_names, entries, targets, weld_map[targets], weighted)
+    _finish_stage(stage, started, report, f"Bone heat on a welded copy ({merged} duplicate vertices merged) "
+                                          f"weighted {stage.weighted} of them")
+
+
+def _repair_islands(mesh_obj, armature_obj, bone_names, weighted, welded, report):
+    """Stage 2: bone heat on each loose part of the welded mesh that still holds unweighted vertices, alone (no
+    other part hides its bones, no other part makes its heat system singular)."""
     started = time.perf_counter()
-    island_of = _islands(len(kept), welded_triangles)
+    weld_map, welded_positions, welded_triangles = welded
+    island_of = _islands(len(welded_positions), welded_triangles)
     parts = int(island_of.max()) + 1
-    if parts > 1:  # with one part, the whole mesh was tried already
-        stage = SkinStage("island bone heat")
-        vertices_by_island = _grouped(island_of, parts)
-        triangles_by_island = _grouped(island_of[welded_triangles[:, 0]], parts)
-        local_index = np.empty(len(kept), dtype=np.int64)
-        for members in vertices_by_island:
-            local_index[members] = np.arange(len(members))
-        targets = np.flatnonzero(~weighted)
-        targets_by_island = _grouped(island_of[weld_map[targets]], parts)
-        tried = 0
-        for island, island_targets in enumerate(targets_by_island):
-            faces = welded_triangles[triangles_by_island[island]]
-            if not len(island_targets) or not len(faces):
-                continue
-            tried += 1
-            island_weights, messages = _bone_heat_weights(welded_positions[vertices_by_island[island]],
-                                                          local_index[faces], armature_obj, bone_names)
-            stage.messages += messages
-            vertices = targets[island_targets]
-            stage.weighted += _transfer(mesh_obj, bone_names, island_weights, vertices,
-                                        local_index[weld_map[vertices]], weighted)
-        stage.note = f"{tried} of {parts} loose parts tried"
-        _finish_stage(stage, started, report,
-                      f"Bone heat per loose part ({stage.note}) weighted {stage.weighted} more vertices")
-    if weighted.all():
+    if parts == 1:  # the whole mesh was tried already
         return
+    stage = SkinStage("island bone heat")
+    vertices_by_island = _grouped(island_of, parts)
+    triangles_by_island = _grouped(island_of[welded_triangles[:, 0]], parts)
+    local_index = np.empty(len(welded_positions), dtype=np.int64)
+    for members in vertices_by_island:
+        local_index[members] = np.arange(len(members))
+    targets = np.flatnonzero(~weighted)
+    tried = 0
+    for island, island_targets in enumerate(_grouped(island_of[weld_map[targets]], parts)):
+        faces = welded_triangles[triangles_by_island[island]]
+        if not len(island_targets) or not len(faces):
+            continue
+        tried += 1
+        entries, messages = _bone_heat_weights(welded_positions[vertices_by_island[island]], local_index[faces],
+                                               armature_obj, bone_names)
+        stage.messages += messages
+        vertices = targets[island_targets]
+        stage.weighted += _transfer(mesh_obj, bone_names, entries, vertices, local_index[weld_map[vertices]],
+                                    weighted)
+    stage.note = f"{tried} of {parts} loose parts tried"
+    _finish_stage(stage, started, report,
+                  f"Bone heat per loose part ({stage.note}) weighted {stage.weighted} more vertices")
 
+
+def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, positions, report):
+    """Stage 3: every vertex still unweighted gets its nearest bones (``rigger.weights``), which always succeeds."""
     started = time.perf_counter()
     stage = SkinStage("nearest bones")
     targets = np.flatnonzero(~weighted)
@@ -426,9 +449,14 @@ def _transfer(mesh_obj, bone_names, entries, targets, sources, weighted):
     return fixed
 
 
-def _normalize(mesh_obj):
-    """Make every vertex's deforming weights sum to 1 (Blender's bone heat leaves sums of 0.9 to 1)."""
-    objects = [mesh_obj]
-    with bpy.context.temp_override(object=mesh_obj, active_object=mesh_obj, selected_objects=objects,
-                                   selected_editable_objects=objects):
-        bpy.ops.object.vertex_group_normalize_all(group_select_mode='BONE_DEFORM', lock_active=False)
+def _normalize(mesh_obj, bone_names):
+    """Scale each vertex's deforming weights to sum to 1 (bone heat leaves sums of 0.9 to 1), in Python rather than
+    with Blender's operator, whose poll refuses hidden objects. Returns the (N,) mask of weighted vertices."""
+    vertices, bones, weights = _weight_entries(mesh_obj, bone_names)
+    sums = np.bincount(vertices, weights, minlength=len(mesh_obj.data.vertices))
+    scaled = weights / sums[vertices]
+    off = np.abs(sums[vertices] - 1.0) > NORMALIZED_TOLERANCE
+    groups = [mesh_obj.vertex_groups[name] for name in bone_names]
+    for vertex, bone, weight in zip(vertices[off].tolist(), bones[off].tolist(), scaled[off].tolist()):
+        groups[bone].add([vertex], weight, 'REPLACE')
+    return sums > 0

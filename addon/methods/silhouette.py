@@ -101,7 +101,7 @@ class SilhouetteMethod(RigMethod):
 
         plane = mirror_plane(vertices, 0.01 * mesh.scale)
         heads, tails, parents = builder.arrays()
-        names = bone_names(builder.chain_of_bone, builder.index_in_chain, heads, tails, plane, 0.05 * mesh.scale)
+        names = bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, plane, 0.05 * mesh.scale)
         clock.lap("names")
 
         stages = {

@@ -1,6 +1,8 @@
 """Bones from 3D chains: where joints go along a chain, the bone hierarchy, and names with mirror suffixes."""
 import numpy as np
 
+LONGEST = 3.0  # no bone longer than this many bone lengths, whatever max_bones says (a straight leg gets a knee)
+
 
 def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None):
     """Joint positions along a polyline.
@@ -10,7 +12,7 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None):
     corner where the simplified line turns by more than ``bone_angle`` radians gets a joint (an elbow, a knee), and
     so does every bend that would take a straight bone out of the part (a snake's curves). The pieces between are
     cut evenly into bones about ``bone_length`` long, at most ``max_bones`` in all when positive unless the corners
-    need more.
+    need more or a bone would be longer than ``LONGEST`` bone lengths.
     """
     widths = np.zeros(len(line)) if widths is None else widths
     arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))]
@@ -30,6 +32,7 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None):
     if max_bones > 0:
         wanted = min(wanted, max_bones)
     counts = _share(lengths, max(wanted, len(lengths)))
+    counts = np.maximum(counts, np.ceil(lengths / (LONGEST * bone_length)).astype(int))
     at = [0.0]
     for start, length, count in zip(stops[:-1], lengths, counts):
         at.extend(start + length * np.arange(1, count + 1) / count)
@@ -127,41 +130,53 @@ def _cell_keys(cells, span):
     return (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]
 
 
-def mirror_pairs(heads, tails, plane, tolerance):
-    """Pairs (i, j) of bones that are mirror images of each other across ``plane`` = (axis, offset)."""
+def mirror_chain_pairs(lines, plane, tolerance):
+    """Pairs (i, j) of chains (3D polylines) that are mirror images of each other across ``plane`` = (axis, offset):
+    their ends match the mirrored ends within ``tolerance``. Chains on the plane are never paired."""
     axis, offset = plane
-    mh, mt = heads.copy(), tails.copy()
-    mh[:, axis] = 2 * offset - mh[:, axis]
-    mt[:, axis] = 2 * offset - mt[:, axis]
-    pairs = []
-    taken = set()
-    for i in range(len(heads)):
-        if i in taken:
+    ends = np.array([[line[0], line[-1]] for line in lines])  # (C, 2, 3)
+    mirrored = ends.copy()
+    mirrored[:, :, axis] = 2 * offset - mirrored[:, :, axis]
+    side = np.array([_side(line, plane, tolerance) for line in lines])
+    pairs, taken = [], set()
+    for i in range(len(lines)):
+        if i in taken or side[i] == 0:
             continue
-        cost = np.linalg.norm(heads - mh[i], axis=1) + np.linalg.norm(tails - mt[i], axis=1)
-        cost[i] = np.inf
+        cost = np.linalg.norm(ends - mirrored[i], axis=2).sum(axis=1)
+        cost[(side != -side[i]) | np.isin(np.arange(len(lines)), list(taken))] = np.inf
         j = int(np.argmin(cost))
-        if cost[j] <= tolerance and j not in taken:
-            # a bone lying on the plane mirrors onto itself (or a twin on the plane): not a pair
-            if abs(heads[i, axis] + tails[i, axis] - 2 * offset) > tolerance:
-                pairs.append((i, j))
-                taken.update((i, j))
+        if cost[j] <= 2 * tolerance:
+            pairs.append((i, j))
+            taken.update((i, j))
     return pairs
 
 
-def bone_names(chain_of_bone, index_in_chain, heads, tails, plane, tolerance):
-    """Names by position in the hierarchy (``trunk.00``, ``limb03.01`` …) with ``.L``/``.R`` for mirror pairs:
-    ``.L`` on the side of the plane's positive axis, Blender's convention for a character's left."""
-    names = [("trunk" if c == 0 else f"limb{c:02d}") + f".{k:02d}" for c, k in zip(chain_of_bone, index_in_chain)]
-    if plane is None:
-        return names
+def _side(line, plane, tolerance):
+    """+1 on the plane's positive side, -1 on its negative side, 0 for a chain on the plane."""
     axis, offset = plane
-    for i, j in mirror_pairs(heads, tails, plane, tolerance):
-        base = names[min(i, j)]
-        left = i if heads[i, axis] + tails[i, axis] > 2 * offset else j
-        names[left], names[i + j - left] = base + ".L", base + ".R"
+    distance = float(np.mean(line[:, axis])) - offset
+    return 0 if abs(distance) <= tolerance else int(np.sign(distance))
+
+
+def bone_names(chain_of_bone, index_in_chain, lines, plane, tolerance):
+    """Names by chain and place in it: ``trunk.00``, ``limb03.01`` …, chains numbered in order from 1.
+
+    With a mirror ``plane``, every bone of a chain off the plane gets ``.L`` on the side of the plane's positive axis
+    (Blender's convention for a character's left) or ``.R``, and mirror-image chains share their number, so
+    ``limb02.01.L`` and ``limb02.01.R`` are a left and a right bone in the same place.
+    """
+    label = list(range(len(lines)))
+    suffix = [""] * len(lines)
+    if plane is not None:
+        for i, j in mirror_chain_pairs(lines, plane, tolerance):
+            label[j] = label[i] = min(i, j)
+        for c, line in enumerate(lines):
+            suffix[c] = {1: ".L", -1: ".R", 0: ""}[_side(line, plane, tolerance)]
+    number = {value: k for k, value in enumerate(sorted(set(label)))}  # the trunk (chain 0) keeps 0
+    base = ["trunk" if number[label[c]] == 0 else f"limb{number[label[c]]:02d}" for c in range(len(lines))]
+    names = [f"{base[c]}.{k:02d}{suffix[c]}" for c, k in zip(chain_of_bone, index_in_chain)]
     seen = {}
-    for i, name in enumerate(names):  # partial pairings can collide: keep every name unique
+    for i, name in enumerate(names):  # two unpaired chains on one side can share a label only by mistake; be safe
         if name in seen:
             names[i] = f"{name}.{i:03d}"
         seen[name] = i
