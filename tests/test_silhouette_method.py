@@ -93,6 +93,19 @@ def test_every_bone_off_the_mirror_plane_is_named_for_its_side(name):
     assert sorted(stem for stem in stems if stems.count(stem) == 1) == []  # every side bone has its twin
 
 
+def test_a_symmetric_character_gets_a_symmetric_rig():
+    vertices, triangles = load_character("humanoid")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    index = {name: i for i, name in enumerate(skeleton.names)}
+    pairs = [(i, index[name[:-2] + ".R"]) for i, name in enumerate(skeleton.names) if name.endswith(".L")]
+    assert len(pairs) >= 8
+    mirror = np.array([-1.0, 1.0, 1.0])
+    for left, right in pairs:
+        np.testing.assert_allclose(skeleton.tails[left] * mirror, skeleton.tails[right], atol=1e-3)
+        if skeleton.parents[left] != skeleton.parents[right]:  # not both on the trunk: heads mirror too
+            np.testing.assert_allclose(skeleton.heads[left] * mirror, skeleton.heads[right], atol=1e-3)
+
+
 def test_no_bone_is_longer_than_three_bone_lengths():
     """A straight leg has no corner to put a knee at, but still gets one."""
     vertices, triangles = load_character("humanoid")

@@ -15,7 +15,7 @@ from .. import cdt, silhouette
 from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
-from ..skeletonize.bones import bone_names, chain_joints, mirror_plane
+from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mirror_plane
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
 from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chains
@@ -25,6 +25,8 @@ SPECK = 0.25  # islands whose axis is shorter than this many bone lengths get no
 SPREAD_SAMPLES = 100_000  # triangles sampled to choose the view
 MIN_BRANCH = 0.5  # branches sticking out less than this many bone lengths are dropped, however thin
 AXIS_NAMES = ("X", "Y", "Z")
+MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
+SAME_SHAPE = 0.6  # ... and get mirrored joints when their shapes agree this closely (in tolerances)
 
 
 class SilhouetteMethod(RigMethod):
@@ -86,7 +88,9 @@ class SilhouetteMethod(RigMethod):
             side = SideAxis(side_graph, sil.direction)
 
         islands = _islands(graph, alive, kept)
-        builder = _BoneBuilder(np.radians(bone_angle), bone_length * mesh.scale, max_chain_bones)
+        plane = mirror_plane(vertices, 0.01 * mesh.scale)
+        builder = _BoneBuilder(np.radians(bone_angle), bone_length * mesh.scale, max_chain_bones, plane,
+                               MIRROR_TOLERANCE * mesh.scale)
         for number, (nodes, links, size) in enumerate(islands):
             if number and size < SPECK * bone_length * mesh.scale:
                 continue  # a speck much smaller than a bone: skinning gives it to the nearest bone
@@ -99,9 +103,9 @@ class SilhouetteMethod(RigMethod):
             builder.add_island(root_point, placed)
         clock.lap("depth_bones")
 
-        plane = mirror_plane(vertices, 0.01 * mesh.scale)
         heads, tails, parents = builder.arrays()
-        names = bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, plane, 0.05 * mesh.scale)
+        names = bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, plane,
+                           MIRROR_TOLERANCE * mesh.scale)
         clock.lap("names")
 
         stages = {
@@ -190,6 +194,13 @@ def _islands(graph, alive, links):
     return [(nodes, sub, size) for size, nodes, sub in result]
 
 
+def _resampled(line, count=9):
+    """``count`` points evenly spaced by arc length along a polyline."""
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))]
+    at = np.linspace(0.0, arc[-1], count)
+    return np.stack([np.interp(at, arc, line[:, d]) for d in range(3)], axis=1)
+
+
 def _removed(before, after):
     kept = set(map(tuple, np.sort(after, axis=1).tolist())) if len(after) else set()
     gone = [pair for pair in np.sort(before, axis=1).tolist() if tuple(pair) not in kept]
@@ -197,10 +208,12 @@ def _removed(before, after):
 
 
 class _BoneBuilder:
-    """Accumulates bones island by island; the first island's trunk holds the single root bone."""
+    """Accumulates bones island by island; the first island's trunk holds the single root bone. With a mirror
+    ``plane``, mirror-image chains get mirror-image joints (their average), so a symmetric mesh gets a symmetric rig."""
 
-    def __init__(self, bone_angle, bone_length, max_bones):
+    def __init__(self, bone_angle, bone_length, max_bones, plane=None, tolerance=0.0):
         self.bone_angle, self.bone_length, self.max_bones = bone_angle, bone_length, max_bones
+        self.plane, self.tolerance = plane, tolerance
         self.heads, self.tails, self.parents = [], [], []
         self.chain_of_bone, self.index_in_chain = [], []
         self.lines = []
@@ -211,11 +224,12 @@ class _BoneBuilder:
         roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
         trunk = max(roots, key=lambda i: placed[i][2].mean())
         order = [trunk] + [i for i in range(len(placed)) if i != trunk]
+        joints = self._symmetric([chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths)
+                                  for line, _, widths in placed], [line for line, _, _ in placed])
         attach = self._attachment(root_point)
         last_bone, first_bone = {}, {}
         for i in order:
-            line, parent, widths = placed[i]
-            joints = chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths)
+            line, parent, _ = placed[i]
             if parent >= 0:
                 up = last_bone[parent]
             elif i == trunk:
@@ -225,11 +239,11 @@ class _BoneBuilder:
             chain = self.chains
             self.chains += 1
             self.lines.append(line)
-            for k in range(len(joints) - 1):
-                if np.linalg.norm(joints[k + 1] - joints[k]) <= 1e-9 * self.bone_length:
+            for k in range(len(joints[i]) - 1):
+                if np.linalg.norm(joints[i][k + 1] - joints[i][k]) <= 1e-9 * self.bone_length:
                     continue
-                self.heads.append(joints[k])
-                self.tails.append(joints[k + 1])
+                self.heads.append(joints[i][k])
+                self.tails.append(joints[i][k + 1])
                 self.parents.append(up)
                 self.chain_of_bone.append(chain)
                 self.index_in_chain.append(k)
@@ -237,6 +251,31 @@ class _BoneBuilder:
                 first_bone.setdefault(i, up)
             last_bone[i] = up
             first_bone.setdefault(i, up)
+
+    def _symmetric(self, joints, lines):
+        """``joints`` per chain, with each mirror pair of chains given the average of one and the other's mirror
+        image (the one with more joints decides their count); each chain keeps its own first joint, where it
+        attaches to its parent."""
+        if self.plane is None:
+            return joints
+        axis, offset = self.plane
+        for i, j in mirror_chain_pairs(lines, self.plane, self.tolerance):
+            image_of_j = _resampled(lines[j])
+            image_of_j[:, axis] = 2 * offset - image_of_j[:, axis]
+            if np.linalg.norm(_resampled(lines[i]) - image_of_j, axis=1).max() > SAME_SHAPE * self.tolerance:
+                continue  # ends that mirror, shapes that do not (a leg stepping forward): leave both as they are
+            a, b = joints[i], joints[j]
+            mirrored = b.copy()
+            mirrored[:, axis] = 2 * offset - mirrored[:, axis]
+            if len(a) == len(b):
+                mean = (a + mirrored) / 2
+            else:
+                mean = a if len(a) > len(b) else mirrored
+            image = mean.copy()
+            image[:, axis] = 2 * offset - image[:, axis]
+            joints[i] = np.vstack([a[:1], mean[1:]])
+            joints[j] = np.vstack([b[:1], image[1:]])
+        return joints
 
     def add_blob(self, sil, point2d, radius):
         """An island whose axis is a single node (a round speck): one short bone through it, pointing up."""
