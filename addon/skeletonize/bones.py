@@ -97,7 +97,7 @@ def _corners(line, angle, tolerance):
     return corners
 
 
-def mirror_plane(vertices, tolerance, samples=1500):
+def mirror_plane(vertices, tolerance, samples=600):
     """The axis (0, 1, 2) and offset of a plane the mesh is mirror-symmetric about, or None.
 
     Tries the planes through the bounding-box centre perpendicular to X, Y and Z; a plane fits when at least 95% of

@@ -92,13 +92,13 @@ def _track(node_layers, order, previous, depths, stay=False):
     """Follow a part along its chain: at each node take the interval the previous depth lies in, else the one
     nearest to it (distance to the interval, not to its middle, so a thick neighbour does not steal the track),
     and centre in it — or, with ``stay``, keep the previous depth while an interval still contains it."""
-    for i in order:
+    for i in order:  # plain floats: the intervals are few, and numpy's per-call cost would dominate
         layer = node_layers[i]
         if len(layer):
-            gap = np.maximum(layer[:, 0] - previous, 0.0) + np.maximum(previous - layer[:, 1], 0.0)
-            best = int(np.argmin(gap))
-            if not (stay and gap[best] == 0.0):
-                previous = _middle(layer[best])
+            gap, low, high = min((max(low - previous, 0.0) + max(previous - high, 0.0), low, high)
+                                 for low, high in layer.tolist())
+            if not (stay and gap == 0.0):
+                previous = 0.5 * (low + high)
         depths[i] = previous
 
 
@@ -111,11 +111,12 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
     out = depths.copy()
     previous = depths[0]
     typical = max(float(np.median(radius)), sil.cell)  # not the tip's vanishing radius
-    for i, layer in enumerate(node_layers):
+    limits = (OCCLUSION_RATIO * 2 * np.maximum(radius, typical)).tolist()
+    for i, (layer, depth) in enumerate(zip(node_layers, depths.tolist())):
         if len(layer):
-            interval = layer[np.argmin(np.abs(0.5 * (layer[:, 0] + layer[:, 1]) - depths[i]))]
-            if interval[1] - interval[0] > OCCLUSION_RATIO * 2 * max(radius[i], typical):
-                found = side_axis.depth_at(sil, points[i], radius[i], interval, previous)
+            low, high = min(layer.tolist(), key=lambda interval: abs(0.5 * (interval[0] + interval[1]) - depth))
+            if high - low > limits[i]:
+                found = side_axis.depth_at(sil, points[i], radius[i], (low, high), previous)
                 if found is not None:
                     out[i] = found
         previous = out[i]

@@ -108,9 +108,9 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0):
                 if degree[tip] == 1 and degree[base] >= 3:
                     beyond = np.linalg.norm(points[tip] - points[base]) + radius[tip] - radius[base]
                     # width where the branch leaves the base disc: a neck, not the head it carries
-                    out = [n for n in (chain if chain[0] == base else chain[::-1])
-                           if np.linalg.norm(points[n] - points[base]) > radius[base]][:3]
-                    width = 2 * float(radius[out].mean()) if out else 2 * float(radius[tip])
+                    ordered = np.array(chain if chain[0] == base else chain[::-1])
+                    out = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]][:3]
+                    width = 2 * float(radius[out].mean()) if len(out) else 2 * float(radius[tip])
                     if beyond <= max(prune * width, min_reach):
                         spurs.append(i)
                     break
