@@ -2,15 +2,20 @@
 import json
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
 
 from characters import load_character, winding_numbers
 
-pytest.importorskip("bpy")
+bpy = pytest.importorskip("bpy")
 
 import rigger  # noqa: E402
+from rigger import cli  # noqa: E402
+from rigger.blender.armature import build_armature  # noqa: E402
+from rigger.blender.samples import build_character  # noqa: E402
+from rigger.core.skeleton import Skeleton  # noqa: E402
 
 # How Blender's OBJ importer turns the OBJ's Y-up frame into its Z-up world (file x, y, z → x, -z, y).
 Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
@@ -66,12 +71,70 @@ def test_rig_an_obj_to_glb_with_a_report_in_the_obj_frame(humanoid_obj, rigged_g
     np.testing.assert_allclose(heads, expected.heads @ Y_UP_TO_Z_UP, atol=1e-4)
 
 
-def test_a_rigged_glb_can_be_rigged_again_to_blend(rigged_glb, tmp_path):
+def glb_document(path):
+    """The JSON chunk of a binary glTF file."""
+    data = path.read_bytes()
+    assert data[:4] == b"glTF" and data[16:20] == b"JSON"
+    return json.loads(data[20:20 + int.from_bytes(data[12:16], "little")])
+
+
+def test_a_rigged_glb_rigged_again_holds_one_skin_of_its_own_mesh(rigged_glb, tmp_path):
+    """The glTF importer adds a hidden bone-shape mesh and the file's own armature: neither joins the new rig."""
     _, folder = rigged_glb
-    result = run("rig", folder / "humanoid.glb", "-o", tmp_path / "again.blend", "--report", tmp_path / "r.json")
+    result = run("rig", folder / "humanoid.glb", "-o", tmp_path / "again.glb", "--report", tmp_path / "r.json")
     assert result.returncode == 0, result.stderr
-    assert (tmp_path / "again.blend").stat().st_size > 0
-    assert json.loads((tmp_path / "r.json").read_text())["bones"]
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert list(report["skinning"]["meshes"]) == ["humanoid"]
+    assert "replaced the file's armature 'humanoid_rig'" in report["warnings"]
+    document = glb_document(tmp_path / "again.glb")
+    assert [mesh["name"] for mesh in document["meshes"]] == ["humanoid"]
+    assert len(document["skins"]) == 1 and len(document["skins"][0]["joints"]) == len(report["bones"])
+
+
+def test_a_blend_is_rigged_as_its_scene_shows_it(tmp_path):
+    """Only the meshes the scene shows are rigged (not those in excluded or hidden collections, nor other scenes);
+    an armature that already deformed them is replaced; cameras and lights stay."""
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    scene = bpy.context.scene
+    body = build_character("humanoid", subdivisions=0)
+    old = build_armature(Skeleton(["old"], [(0, 0, 0)], [(0, 0, 1)], [-1]), "OldRig")
+    body.vertex_groups.new(name="old").add(range(len(body.data.vertices)), 1.0, 'REPLACE')
+    body.modifiers.new("Armature", 'ARMATURE').object = old
+    body.parent = old
+    for name, kind in (("Excluded", "snake"), ("Hidden", "octopus")):  # both bigger than the body
+        collection = bpy.data.collections.new(name)
+        scene.collection.children.link(collection)
+        build_character(kind, subdivisions=0, collection=collection)
+    bpy.context.view_layer.layer_collection.children["Excluded"].exclude = True
+    bpy.data.collections["Hidden"].hide_viewport = True
+    build_character("tree", subdivisions=0, collection=bpy.data.scenes.new("Other").collection)
+    scene.collection.objects.link(bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera")))
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "scene.blend"))
+
+    result = run("rig", tmp_path / "scene.blend", "-o", tmp_path / "rigged.blend", "--report", tmp_path / "r.json")
+    assert result.returncode == 0, result.stderr
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert list(report["skinning"]["meshes"]) == ["humanoid"]
+    assert "replaced the file's armature 'OldRig'" in report["warnings"]
+    with bpy.data.libraries.load(str(tmp_path / "rigged.blend")) as (saved, _):
+        objects = set(saved.objects)
+    assert {"humanoid", "humanoid_rig", "Camera", "snake", "octopus", "tree"} <= objects
+    assert "OldRig" not in objects
+
+
+def test_outputs_never_overwrite_the_input_or_each_other(rigged_glb, tmp_path):
+    source = tmp_path / "model.glb"
+    source.write_bytes((rigged_glb[1] / "humanoid.glb").read_bytes())
+    (tmp_path / "taken.glb").mkdir()
+    for extra, message in [(("-o", source), "the output would overwrite the input"),
+                           (("-o", tmp_path / "out.blend", "--report", source), "the report would overwrite the input"),
+                           (("-o", tmp_path / "out.blend", "--report", tmp_path / "out.blend"),
+                            "the report would overwrite the output"),
+                           (("-o", tmp_path / "taken.glb"), "is a folder")]:
+        result = run("rig", source, *extra)
+        assert result.returncode == 1 and message in result.stderr, result.stderr
+    assert source.read_bytes() == (rigged_glb[1] / "humanoid.glb").read_bytes()
+    assert sorted(leaves_nothing(tmp_path)) == ["model.glb", "taken.glb"]
 
 
 def test_no_skin_and_fbx_output(humanoid_obj, tmp_path):
@@ -88,11 +151,12 @@ def leaves_nothing(folder):
 @pytest.mark.parametrize("case, message", [
     ("missing", "no such file"),
     ("no_mesh", "no mesh"),
-    ("flat", "flat"),
+    ("line", "on one line"),
     ("bad_set", "unknown parameter"),
     ("bad_value", "above the maximum"),
     ("bad_method", "unknown method"),
     ("bad_output", "cannot write"),
+    ("unreadable", "Blender could not import it"),
 ])
 def test_errors_exit_non_zero_with_a_message_and_write_nothing(case, message, humanoid_obj, tmp_path):
     source = humanoid_obj[0]
@@ -102,8 +166,11 @@ def test_errors_exit_non_zero_with_a_message_and_write_nothing(case, message, hu
     elif case == "no_mesh":
         source = tmp_path / "points.obj"
         source.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\n")
-    elif case == "flat":
-        source = write_obj(tmp_path / "flat.obj", [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)], [(0, 1, 2), (1, 3, 2)])
+    elif case == "line":
+        source = write_obj(tmp_path / "line.obj", [(0, 0, 0), (1, 1, 1), (2, 2, 2), (3, 3, 3)], [(0, 1, 2), (1, 3, 2)])
+    elif case == "unreadable":
+        source = tmp_path / "empty.glb"
+        source.write_bytes(b"")
     elif case == "bad_set":
         extra = ["--set", "bone_lenght=0.1"]
     elif case == "bad_value":
@@ -133,16 +200,43 @@ def test_batch_rigs_a_folder_in_parallel_and_summarises(humanoid_obj, tmp_path):
     folder.mkdir()
     vertices, triangles = load_character("snake")
     write_obj(folder / "snake.obj", vertices, triangles)
-    (folder / "a_broken.obj").write_text("v 0 0 0\n")
+    (folder / "snake.fbx").write_text("not an FBX")  # the same stem: the results must not share a name
     (folder / "notes.txt").write_text("not a model")
     out = tmp_path / "rigged"
-    result = run("batch", folder, "-o", out, "--jobs", 2, "--format", "glb")
+    result = run("batch", folder, "-o", out, "--jobs", 2, "--format", "glb", "--timeout", 300)
     assert result.returncode == 1  # one file failed
     assert "1 of 2 rigged" in result.stdout and "2/2" in result.stderr
     rows = {row["file"]: row for row in json.loads((out / "summary.json").read_text())}
     assert rows["snake.obj"]["status"] == "ok" and rows["snake.obj"]["bones"] > 0
-    assert rows["a_broken.obj"]["status"] == "failed" and "no mesh" in rows["a_broken.obj"]["message"]
-    assert sorted(leaves_nothing(out)) == ["snake.glb", "snake.json", "summary.json"]
+    assert rows["snake.obj"]["output"] == "snake_obj.glb"
+    assert rows["snake.fbx"]["status"] == "failed" and "could not import" in rows["snake.fbx"]["message"]
+    assert sorted(leaves_nothing(out)) == ["snake_obj.glb", "snake_obj.json", "summary.json"]
+
+
+def test_batch_results_written_into_the_input_folder_never_replace_an_input(tmp_path):
+    sources = [tmp_path / name for name in ("a.glb", "b.obj", "summary.obj")]
+    assert cli.output_stems(sources, "glb", in_place=True) == ["a_glb", "b", "summary_obj"]
+    assert cli.output_stems(sources, "glb", in_place=False) == ["a", "b", "summary_obj"]
+
+
+def test_a_batch_child_that_crashes_or_hangs_gives_a_failed_row(monkeypatch, tmp_path):
+    half_written = "import os, sys; os.mkdir(os.path.join(os.path.dirname(sys.argv[1]), '.crash.glb.tmp')); "
+    scripts = {"crash": half_written + "import signal; os.kill(os.getpid(), signal.SIGKILL)",
+               "hang": "import time; time.sleep(60)"}
+    monkeypatch.setattr(cli, "child_command",
+                        lambda source, output, *_: [sys.executable, "-c", scripts[source.stem], str(output)])
+
+    def row(name, timeout):
+        return cli.rig_in_child(tmp_path / f"{name}.obj", tmp_path / f"{name}.glb", tmp_path / f"{name}.json", [],
+                                timeout=timeout)
+
+    crashed = row("crash", timeout=60)
+    assert crashed["status"] == "failed" and crashed["message"] == "crashed (killed by signal 9)"
+    start = time.perf_counter()
+    hung = row("hang", timeout=1)
+    assert hung["status"] == "failed" and hung["message"] == "timed out after 1 s"
+    assert time.perf_counter() - start < 30
+    assert leaves_nothing(tmp_path) == []
 
 
 def test_batch_on_a_missing_folder_is_an_error(tmp_path):

@@ -141,6 +141,19 @@ def test_same_skeleton_when_moved_rotated_or_scaled(seed):
         assert chamfer(back, reference.joints()) / size < 0.03
 
 
+def test_a_flat_cut_out_character_is_rigged_in_its_plane():
+    """A 2D cut-out (the humanoid squashed onto its front plane) rigs like the humanoid seen from the front."""
+    vertices, triangles = load_character("humanoid")
+    flat = vertices * [1.0, 0.0, 1.0] + [0.0, 0.25, 0.0]
+    skeleton = rigger.rig_mesh(flat, triangles)
+    assert len(skeleton) >= 10
+    np.testing.assert_allclose(skeleton.joints()[:, 1], 0.25, atol=1e-9)
+    reference = rigger.rig_mesh(vertices, triangles)
+    size = np.ptp(vertices, axis=0).max()
+    drop_y = [0, 2]
+    assert chamfer(skeleton.joints()[:, drop_y], reference.joints()[:, drop_y]) / size < 0.03
+
+
 def test_rig_time_is_recorded_per_stage():
     vertices, triangles = load_character("snake")
     timings = rigger.rig_mesh(vertices, triangles).stages["timings"]
@@ -150,7 +163,7 @@ def test_rig_time_is_recorded_per_stage():
 
 @pytest.mark.parametrize("vertices, triangles, message", [
     (np.zeros((0, 3)), np.zeros((0, 3), int), "no vertices"),
-    (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]), [[0, 1, 2]], "flat"),
+    (np.array([[0, 0, 0], [1, 1, 1], [2, 2, 2.0]]), [[0, 1, 2]], "on one line"),
     (np.array([[0, 0, 0], [1, 0, 0], [0, np.nan, 0], [0, 0, 1.0]]), [[0, 1, 2], [0, 1, 3]], "finite"),
     (np.eye(3).tolist() + [[0, 0, 0]], [[0, 1, 7]], "vertex 7"),
 ])

@@ -1,7 +1,7 @@
 """A triangle mesh validated once at the door, so every method can trust its arrays.
 
-Bad input (empty, NaN, wrong shapes or dtypes, out-of-range indices, flat) raises ``ValueError`` with a message that
-says what is wrong; faces that repeat a vertex index are dropped and counted, since exporters routinely emit them.
+Bad input (empty, NaN, wrong shapes or dtypes, out-of-range indices, all on one line) raises ``ValueError`` with a
+message that says what is wrong; faces that repeat a vertex index are dropped and counted, since exporters routinely emit them.
 """
 import itertools
 from functools import cached_property
@@ -9,7 +9,7 @@ from functools import cached_property
 import numpy as np
 
 # The smallest principal variance, relative to the largest, below which the mesh has no volume to rig.
-FLAT_VARIANCE_RATIO = 1e-12
+LINE_VARIANCE_RATIO = 1e-12
 
 
 class Mesh:
@@ -27,7 +27,7 @@ class Mesh:
     def __init__(self, vertices, triangles):
         self.vertices = _validated_vertices(vertices)
         self.triangles, self.degenerate_count = _validated_triangles(triangles, len(self.vertices))
-        self._reject_flat()
+        self._reject_line()
 
     @cached_property
     def _used_points(self):
@@ -55,13 +55,15 @@ class Mesh:
     def __repr__(self):
         return f"Mesh({len(self.vertices)} vertices, {len(self.triangles)} triangles)"
 
-    def _reject_flat(self):
+    def _reject_line(self):
+        """A flat mesh is fine (a 2D cut-out character rigs in its plane); one with no extent in two directions
+        has no outline to rig."""
         centred = self._used_points - self.centroid
         variances = np.linalg.eigvalsh(centred.T @ centred)
         if variances[2] <= 0:
             raise ValueError("mesh has zero size: every vertex of its triangles is at the same point")
-        if variances[0] <= FLAT_VARIANCE_RATIO * variances[2]:
-            raise ValueError("mesh is flat: its vertices lie in one plane (or on a line); rigging needs a volume")
+        if variances[1] <= LINE_VARIANCE_RATIO * variances[2]:
+            raise ValueError("mesh is a line: its vertices lie on one line; rigging needs a surface")
 
 
 def triangulate_polygons(faces):
