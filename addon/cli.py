@@ -5,10 +5,13 @@ mesh, skins it and saves .blend, .glb/.gltf or .fbx, plus an optional JSON repor
 files and renamed into place only when everything succeeded, so a failure leaves nothing behind.
 """
 import argparse
+import collections
 import concurrent.futures
+import glob
 import json
 import os
 import pathlib
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -16,8 +19,8 @@ import time
 
 INPUTS = (".obj", ".glb", ".gltf", ".fbx", ".blend")
 OUTPUTS = (".blend", ".glb", ".fbx")
+SUMMARY = "summary.json"  # batch: the summary table as JSON, beside the results
 EXIT_FAILED = 1
-EXIT_USAGE = 2
 
 
 class CliError(Exception):
@@ -52,6 +55,8 @@ def _parser():
     batch.add_argument("--format", choices=[suffix[1:] for suffix in OUTPUTS], default="blend",
                        help="output format (default blend)")
     batch.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel processes (default: CPUs)")
+    batch.add_argument("--timeout", type=float, metavar="SECONDS",
+                       help="give up on a file after this many seconds (default: no limit)")
     _method_options(batch)
     batch.set_defaults(run=_run_batch)
 
@@ -103,6 +108,7 @@ def _run_rig(args):
     output = args.output or source.with_name(f"{source.stem}_rigged.blend")
     if output.suffix.lower() not in OUTPUTS:
         raise CliError(f"{output}: cannot write {output.suffix or 'files without a suffix'}; use {', '.join(OUTPUTS)}")
+    _check_destinations(source, output, args.report)
     try:  # check the method and parameters before the slow import
         method = method_registry().lookup(args.method)
         params = resolve(method.params, _settings(args.settings))
@@ -115,15 +121,34 @@ def _run_rig(args):
     register()  # the properties the Blender layer keeps on scenes and objects
     try:
         report = scenefiles.rig_file(source, output, method.name, params, skin=not args.no_skin)
-    except (ValueError, RuntimeError) as error:  # RuntimeError: Blender's importers on unreadable files
-        raise CliError(str(error).strip()) from None
-    with _written(args.report) as path:
-        if path is not None:
-            path.write_text(json.dumps(report, indent=2))
+        with _written(args.report) as path:
+            if path is not None:
+                path.write_text(json.dumps(report, indent=2))
+    except ValueError as error:
+        raise CliError(str(error)) from None
+    except RuntimeError as error:  # a Blender operator failed (an exporter, say)
+        raise CliError(f"{source}: {scenefiles.blender_message(error)}") from None
+    except OSError as error:  # a folder that cannot be written, a full disk
+        raise CliError(f"{error.filename or output}: {error.strerror or error}") from None
     print(f"rigged {source} → {output}: {len(report['bones'])} bones, {report['skinning']['summary']}")
     for warning in report["warnings"]:
         print(f"warning: {warning}", file=sys.stderr)
     return 0
+
+
+def _check_destinations(source, output, report):
+    """Refuse outputs that would overwrite the input or each other, or that are folders, before any slow work."""
+    named = {"the input": source, "the output": output, "the report": report}
+    seen = {}
+    for role, path in named.items():
+        if path is None:
+            continue
+        if role != "the input" and path.is_dir():
+            raise CliError(f"{path}: is a folder; {role} needs a file name")
+        key = os.path.normcase(path.resolve())
+        if key in seen:
+            raise CliError(f"{path}: {role} would overwrite {seen[key]}; choose another file name")
+        seen[key] = role
 
 
 class _written:
@@ -157,41 +182,89 @@ def _run_batch(args):
         raise CliError(f"{args.folder}: no such folder")
     if args.jobs < 1:
         raise CliError(f"--jobs must be at least 1, got {args.jobs}")
+    if args.timeout is not None and args.timeout <= 0:
+        raise CliError(f"--timeout must be a positive number of seconds, got {args.timeout}")
     sources = sorted(path for path in args.folder.iterdir() if path.suffix.lower() in INPUTS and path.is_file())
     if not sources:
         raise CliError(f"{args.folder}: no model files ({', '.join(INPUTS)})")
     args.output.mkdir(parents=True, exist_ok=True)
     extra = [f"--method={args.method}", *(f"--set={pair}" for pair in args.settings)]
     extra += ["--no-skin"] if args.no_skin else []
+    stems = output_stems(sources, args.format, args.folder.resolve() == args.output.resolve())
     rows = []
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        futures = [pool.submit(_rig_in_child, source, args.output, args.format, extra) for source in sources]
+        futures = [pool.submit(rig_in_child, source, args.output / f"{stem}.{args.format}",
+                               args.output / f"{stem}.json", extra, args.timeout)
+                   for source, stem in zip(sources, stems)]
         for done, future in enumerate(concurrent.futures.as_completed(futures), start=1):
             rows.append(future.result())
             _progress(done, len(sources))
     rows.sort(key=lambda row: row["file"])
     print(_summary_table(rows))
-    (args.output / "summary.json").write_text(json.dumps(rows, indent=2))
+    (args.output / SUMMARY).write_text(json.dumps(rows, indent=2))
     failed = sum(row["status"] != "ok" for row in rows)
     return EXIT_FAILED if failed else 0
 
 
-def _rig_in_child(source, folder, suffix, extra):
-    """Rig ``source`` in a child process (each needs its own Blender); a row of the summary table."""
-    stem = source.stem if source.suffix.lower() != ".blend" or suffix != "blend" else f"{source.stem}_rigged"
-    output, report = folder / f"{stem}.{suffix}", folder / f"{stem}.json"
-    command = [sys.executable, "-m", __package__, "rig", str(source), "-o", str(output), "--report", str(report),
-               *extra]
+def output_stems(sources, suffix, in_place):
+    """The name (without suffix) of each source's output and report: its stem, or stem_suffix where that would
+    overwrite another source's results, the summary, or (``in_place``: results written into the input folder) the
+    source itself."""
+    counts = collections.Counter(source.stem for source in sources)
+
+    def clashes(source):
+        return (counts[source.stem] > 1 or source.stem == pathlib.Path(SUMMARY).stem
+                or in_place and source.suffix.lower() == f".{suffix}")
+
+    return [f"{source.stem}_{source.suffix[1:]}" if clashes(source) else source.stem for source in sources]
+
+
+def child_command(source, output, report, extra):
+    """The command that rigs one file of a batch: this CLI's ``rig`` in a fresh Python (each needs its own Blender)."""
+    return [sys.executable, "-m", __package__, "rig", str(source), "-o", str(output), "--report", str(report), *extra]
+
+
+def rig_in_child(source, output, report, extra, timeout=None):
+    """Rig ``source`` in a child process; its row of the summary table. A child that fails, crashes or runs past
+    ``timeout`` seconds (killed then) gives a failed row saying so; it never stops the batch."""
     start = time.perf_counter()
-    child = subprocess.run(command, capture_output=True, text=True)
-    row = {"file": source.name, "seconds": round(time.perf_counter() - start, 2)}
-    if child.returncode:
-        lines = [line for line in child.stderr.splitlines() if line.startswith("rigger: error:")]
-        message = lines[-1].removeprefix("rigger: error: ") if lines else child.stderr.strip()[-300:]
-        return {**row, "status": "failed", "bones": 0, "skinning": "", "message": message}
-    data = json.loads(report.read_text())
+    try:
+        child = subprocess.run(child_command(source, output, report, extra), capture_output=True, text=True,
+                               timeout=timeout)
+    except subprocess.TimeoutExpired:
+        child = None
+    row = {"file": source.name, "seconds": round(time.perf_counter() - start, 2), "status": "failed", "bones": 0,
+           "skinning": ""}
+    if child is None or child.returncode:
+        _remove_leftovers(output, report)
+        return {**row, "message": f"timed out after {timeout:g} s" if child is None else _child_failure(child)}
+    try:
+        data = json.loads(report.read_text())
+    except (OSError, ValueError) as error:
+        return {**row, "message": f"finished without a readable report: {error}"}
     return {**row, "status": "ok", "bones": len(data["bones"]), "skinning": data["skinning"]["summary"],
             "message": "; ".join(data["warnings"]), "output": output.name}
+
+
+def _remove_leftovers(*finals):
+    """Remove what a killed child left half written: the temporary files and folders named ".<final name>.*" that
+    it renames into place only on success."""
+    for final in finals:
+        for leftover in final.parent.glob(f".{glob.escape(final.name)}.*"):
+            if leftover.is_dir():
+                shutil.rmtree(leftover)
+            else:
+                leftover.unlink()
+
+
+def _child_failure(child):
+    """What went wrong in a failed child: its ``rigger: error:`` line, else how it ended and its last output."""
+    lines = [line for line in child.stderr.splitlines() if line.startswith("rigger: error:")]
+    if lines:
+        return lines[-1].removeprefix("rigger: error: ")
+    how = f"killed by signal {-child.returncode}" if child.returncode < 0 else f"exit status {child.returncode}"
+    tail = child.stderr.strip()[-300:]
+    return f"crashed ({how})" + (f": {tail}" if tail else "")
 
 
 def _progress(done, total, width=30):

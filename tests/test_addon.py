@@ -5,6 +5,7 @@ the operators on the project's generated characters, whose Skin-modifier constru
 """
 import contextlib
 import io
+import json
 
 import numpy as np
 import pytest
@@ -181,6 +182,25 @@ def test_the_rig_follows_the_objects_transform_and_modifiers(scene):
     assert bpy.context.view_layer.objects.active == armature
 
 
+def test_the_rig_keeps_following_the_meshs_parent(scene):
+    vehicle = bpy.data.objects.new("Vehicle", None)
+    scene.collection.objects.link(vehicle)
+    vehicle.location, vehicle.rotation_euler, vehicle.scale = (5.0, 0.0, 0.0), (0.0, 0.0, 0.5), (2.0, 2.0, 2.0)
+    obj = build_character("snake", subdivisions=0)
+    obj.parent = vehicle
+    bpy.context.view_layer.update()
+    before, _ = mesh_arrays(obj)
+    for _ in range(2):  # rigging again too
+        activate(obj)
+        assert bpy.ops.rigger.rig_skin() == {'FINISHED'}
+        armature = obj.rigger_armature
+        assert armature.parent == vehicle and obj.parent == armature
+        np.testing.assert_allclose(np.array(armature.matrix_world), np.eye(4), atol=1e-6)
+    vehicle.location.x += 10.0
+    bpy.context.view_layer.update()
+    np.testing.assert_allclose(mesh_arrays(obj)[0], before + (10.0, 0.0, 0.0), atol=1e-4)
+
+
 def test_rigging_again_replaces_the_previous_rig(scene):
     obj = build_character("snake", subdivisions=0)
     activate(obj)
@@ -194,6 +214,23 @@ def test_rigging_again_replaces_the_previous_rig(scene):
     assert len(bpy.data.armatures) == 1
     assert not any(m.type == 'ARMATURE' for m in obj.modifiers) and obj.parent is None
     assert first_groups and len(obj.vertex_groups) == 0 and "rigger_vertex_groups" not in obj
+
+
+def test_rigging_a_posed_rig_again_fits_the_mesh_at_rest(scene):
+    from mathutils import Matrix
+    obj = build_character("humanoid", subdivisions=0)
+    activate(obj)
+    assert bpy.ops.rigger.rig_skin() == {'FINISHED'}
+    first = {bone.name: np.array(bone.head_local) for bone in obj.rigger_armature.data.bones}
+    for pose_bone in obj.rigger_armature.pose.bones:  # the user poses the character 2 m up
+        if pose_bone.parent is None:
+            pose_bone.matrix = Matrix.Translation((0.0, 0.0, 2.0)) @ pose_bone.matrix
+    bpy.context.view_layer.update()
+    activate(obj)
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    again = {bone.name: np.array(bone.head_local) for bone in obj.rigger_armature.data.bones}
+    assert again.keys() == first.keys()  # the same mesh at rest: the same skeleton
+    np.testing.assert_allclose([again[name] for name in first], list(first.values()), atol=1e-4)
 
 
 def test_the_armature_stays_editable_and_skin_uses_the_edited_bones(scene):
@@ -289,6 +326,85 @@ def test_a_mesh_with_a_nan_vertex_is_reported_and_nothing_is_created(scene):
     with pytest.raises(RuntimeError, match="not finite|NaN"):
         bpy.ops.rigger.rig()
     assert obj.rigger_armature is None and len(bpy.data.armatures) == 0
+
+
+def test_registering_again_replaces_the_registration_instead_of_breaking_it(registered):
+    rigger.register()  # a script registering while the add-on is enabled
+    assert hasattr(bpy.types.Scene, "rigger") and hasattr(bpy.types.Object, "rigger_armature")
+    assert "RIGGER_OT_rig" in dir(bpy.types) and "RIGGER_PT_main" in dir(bpy.types)
+    assert bpy.context.scene.rigger.method == "silhouette"
+
+
+def test_skin_refuses_an_armature_the_user_deleted_and_rigging_again_makes_a_new_one(scene):
+    obj = build_character("snake", subdivisions=0)
+    activate(obj)
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    activate(obj.rigger_armature)
+    assert bpy.ops.object.delete() == {'FINISHED'}  # out of the scene, yet kept alive by the mesh's pointer
+    activate(obj)
+    assert "has no armature yet: rig it first" in poll_message(bpy.ops.rigger.skin)
+    assert bpy.ops.rigger.rig_skin() == {'FINISHED'}
+    assert [o for o in bpy.data.objects if o.type == 'ARMATURE'] == [obj.rigger_armature]
+    assert obj.parent == obj.rigger_armature and obj.rigger_armature.name in scene.objects
+
+
+def test_the_armature_goes_into_a_collection_the_view_layer_shows(scene):
+    from rigger.blender.armature import build_armature
+    from rigger.core.skeleton import Skeleton
+    excluded, shown = (bpy.data.collections.new(name) for name in ("Excluded", "Shown"))
+    for collection in (excluded, shown):
+        scene.collection.children.link(collection)
+    obj = build_character("snake", subdivisions=0, collection=excluded)  # the mesh's first collection...
+    shown.objects.link(obj)
+    bpy.context.view_layer.layer_collection.children["Excluded"].exclude = True  # ...is excluded from the view
+    activate(obj)
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    assert list(obj.rigger_armature.users_collection) == [shown]
+
+    # an armature that cannot be made is not left behind half made
+    with pytest.raises(RuntimeError):
+        build_armature(Skeleton(["bone"], [(0, 0, 0)], [(0, 0, 1)], [-1]), "stray", collection=excluded)
+    assert "stray" not in bpy.data.objects and "stray" not in bpy.data.armatures
+
+
+def test_linked_duplicates_rigged_together_each_follow_their_own_bones(scene):
+    left = build_character("snake", subdivisions=0)
+    right = left.copy()  # a linked duplicate: the same mesh data, so the same vertex weights
+    scene.collection.objects.link(right)
+    right.location.x += 3.0
+    activate(left, right)
+    result, printed = reports_of(bpy.ops.rigger.rig_skin)
+    assert result == {'FINISHED'} and "got its own copy" in printed
+    assert left.data != right.data
+    middles = {bone.name: (bone.head_local + bone.tail_local) / 2 for bone in left.rigger_armature.data.bones}
+    for obj in (left, right):
+        vertices = np.array([obj.matrix_world @ vertex.co for vertex in obj.data.vertices])
+        strongest = [obj.vertex_groups[max(vertex.groups, key=lambda element: element.weight).group].name
+                     for vertex in obj.data.vertices]
+        bones = np.array([middles[name] for name in strongest])
+        # each vertex's strongest bone lies in its own copy, not 3 m away in the other one
+        assert np.abs(bones[:, 0] - vertices[:, 0]).max() < 1.5, obj.name
+
+
+def test_the_report_is_plain_json_whatever_numbers_a_method_records(scene):
+    from rigger.blender.pipeline import rig_object
+    from rigger.blender.scenefiles import rig_report
+    from rigger.core.registry import RigMethod
+    from rigger.core.skeleton import Skeleton
+
+    class NumpyTimed(RigMethod):
+        name = "numpy_timed"
+
+        def rig(self, mesh):
+            low, high = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+            skeleton = Skeleton(["spine"], [low], [high], [-1])
+            skeleton.stages["timings"] = {"think": np.float32(0.5), "count": np.int64(3)}
+            return skeleton
+
+    result = rig_object(build_character("snake", subdivisions=0), NumpyTimed)
+    report = json.loads(json.dumps(rig_report(result, None)))
+    assert report["timings"]["method.think"] == 0.5 and report["timings"]["method.count"] == 3.0
+    assert report["method"] == "numpy_timed" and [bone["name"] for bone in report["bones"]] == ["spine"]
 
 
 def test_operators_are_undoable_and_scriptable_by_name(registered):

@@ -14,15 +14,33 @@ def build_armature(skeleton, name, collection=None, frame=None):
     rule for every bone: the bone's Z axis points as close to the character's up as the bone allows (to its front,
     -Y, for near-vertical bones), so mirrored limbs get mirrored rolls. ``frame`` is a 3x3 matrix whose columns are
     the character's X, Y, Z axes in world space (the rigged object's rotation; default the world axes). Returns the
-    object, in Object Mode, linked into ``collection`` (default: the scene's) and made active.
+    object, in Object Mode, linked into ``collection`` (default: the scene's) and made active. If that fails, the
+    half-made armature is removed again before the error propagates.
     """
     data = bpy.data.armatures.new(name)
     obj = bpy.data.objects.new(name, data)
     obj.show_in_front = True
-    (collection or bpy.context.scene.collection).objects.link(obj)
+    try:
+        (collection or bpy.context.scene.collection).objects.link(obj)
+        _edit_bones(obj, skeleton, np.eye(3) if frame is None else _orthonormal(frame))
+    except Exception:
+        delete_armature(obj)
+        raise
+    return obj
+
+
+def delete_armature(obj):
+    """Remove armature object ``obj``, and its armature data unless another object uses it too."""
+    data = obj.data
+    bpy.data.objects.remove(obj)
+    if data.users == 0:
+        bpy.data.armatures.remove(data)
+
+
+def _edit_bones(obj, skeleton, frame):
+    """Make ``obj`` the only selected and active object and add the bones in Edit Mode, back in Object Mode after."""
     view_layer = bpy.context.view_layer
-    previous_mode = bpy.context.mode
-    if previous_mode != 'OBJECT':
+    if bpy.context.mode != 'OBJECT':
         bpy.ops.object.mode_set(mode='OBJECT')
     for other in view_layer.objects.selected:
         other.select_set(False)
@@ -30,10 +48,9 @@ def build_armature(skeleton, name, collection=None, frame=None):
     obj.select_set(True)
     bpy.ops.object.mode_set(mode='EDIT')
     try:
-        _add_bones(data, skeleton, np.eye(3) if frame is None else _orthonormal(frame))
+        _add_bones(obj.data, skeleton, frame)
     finally:
         bpy.ops.object.mode_set(mode='OBJECT')
-    return obj
 
 
 def _add_bones(data, skeleton, frame):

@@ -8,8 +8,8 @@ import traceback
 import bpy
 
 from ..api import method_registry
-from . import overlays, skinning
-from .pipeline import rig_object
+from . import overlays
+from .pipeline import rig_object, skin_meshes
 from .properties import ARMATURE_POINTER, NO_METHOD, SETTINGS_ATTRIBUTE, overlay_visibility, param_values
 
 
@@ -30,11 +30,17 @@ def rig_targets(context):
 
 def skin_targets(context):
     """(meshes, armature) to skin: the rig targets and the first one's Rigger armature (or a selected armature);
-    else ([], None, why not)."""
+    else ([], None, why not).
+
+    A Rigger armature the user deleted is no armature: deleting it takes it out of the scene, but the mesh's pointer
+    keeps it alive in the file, where skinning to it would bind the mesh to something nobody can see.
+    """
     meshes, why = rig_targets(context)
     if not meshes:
         return [], None, why
     armature = getattr(meshes[0], ARMATURE_POINTER, None)
+    if armature is not None and context.scene.objects.get(armature.name) != armature:
+        armature = None
     if armature is None:
         armature = next((obj for obj in context.selected_objects if obj.type == 'ARMATURE'), None)
     if armature is None:
@@ -83,13 +89,11 @@ class _RiggerOperator:
         return meshes, result.armature
 
     def skin(self, meshes, armature, progress):
-        outcomes = []
-        for done, mesh in enumerate(meshes, start=1):
-            outcomes.append(skinning.skin(mesh, armature))
-            progress(done / len(meshes))
-        summary = "; ".join(f"{mesh.name}: {outcome.summary()}" if len(meshes) > 1 else outcome.summary()
-                            for mesh, outcome in zip(meshes, outcomes))
-        self.report({'WARNING'} if any(outcome.warnings for outcome in outcomes) else {'INFO'}, summary)
+        outcomes, warnings = skin_meshes(meshes, armature, progress)
+        summary = "; ".join(f"{name}: {outcome.summary()}" if len(meshes) > 1 else outcome.summary()
+                            for name, outcome in outcomes.items())
+        warned = warnings or any(outcome.warnings for outcome in outcomes.values())
+        self.report({'WARNING'} if warned else {'INFO'}, "; ".join([*warnings, summary]))
 
 
 class RIGGER_OT_rig(_RiggerOperator, bpy.types.Operator):

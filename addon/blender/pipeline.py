@@ -1,5 +1,6 @@
 """Rigging a Blender mesh object: evaluated mesh → method → skeleton → armature (+ overlays), shared by the
 operators and the command line so both do exactly the same thing."""
+import contextlib
 import time
 from dataclasses import dataclass, field
 
@@ -8,7 +9,7 @@ import numpy as np
 
 from ..api import rig_mesh
 from . import overlays, skinning
-from .armature import build_armature
+from .armature import build_armature, delete_armature
 from .meshdata import combined_arrays
 from .properties import ARMATURE_POINTER
 
@@ -32,26 +33,32 @@ def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays
     """Rig mesh object ``obj`` (together with the mesh objects ``parts``, e.g. a character's separate clothes) with
     ``method`` and return a :class:`RigResult`.
 
-    The meshes are read as evaluated (modifiers applied) in world space; the new armature ("<mesh>_rig", identity
-    matrix) goes into the mesh's first collection and becomes ``rigger_armature`` of every mesh, replacing (deleting)
-    the armatures Rigger made for them before. ``show_overlays`` maps overlay kinds to visibility (None: build none);
-    ``progress(fraction)`` is called between steps. ValueError for bad meshes, methods or parameters; nothing is
-    created when rigging fails.
+    The meshes are read as evaluated (modifiers applied, Rigger's previous armatures at rest) in world space. The new
+    armature ("<mesh>_rig", identity world matrix, parented to ``obj``'s parent if it has one) goes into the first of
+    the mesh's collections shown in the view layer and becomes ``rigger_armature`` of every mesh, replacing
+    (deleting) the armatures Rigger made for them before. ``show_overlays`` maps overlay kinds to visibility (None:
+    build none); ``progress(fraction)`` is called between steps. ValueError for bad meshes, methods or parameters;
+    nothing is created when rigging fails.
     """
     report = progress or (lambda fraction: None)
     timings = {}
     start = time.perf_counter()
     meshes = [obj, *(part for part in parts if part != obj)]
-    vertices, triangles = combined_arrays(meshes)
+    with _previous_rigs_at_rest(meshes):
+        vertices, triangles = combined_arrays(meshes)
     timings["read_mesh"] = time.perf_counter() - start
     report(0.1)
     skeleton = rig_mesh(vertices, triangles, method, **(params or {}))
     timings["rig"] = time.perf_counter() - start - sum(timings.values())
     report(0.7)
+    parent = _rig_parent(obj)
     replaced = any([remove_rig(mesh) for mesh in meshes])
-    collection = obj.users_collection[0] if obj.users_collection else bpy.context.scene.collection
+    collection = shown_collection(obj, bpy.context.view_layer)
     frame = np.array(obj.matrix_world, dtype=np.float64)[:3, :3]
     armature = build_armature(skeleton, f"{obj.name}_rig", collection, frame=frame)
+    if parent is not None:  # skinning makes the mesh the armature's child: the rig keeps following what moved it
+        armature.parent = parent
+        armature.matrix_parent_inverse = parent.matrix_world.inverted_safe()
     armature[METHOD_PROPERTY] = method if isinstance(method, str) else method.name
     for mesh in meshes:
         setattr(mesh, ARMATURE_POINTER, armature)
@@ -65,6 +72,63 @@ def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays
     return RigResult(armature, meshes, skeleton, made, replaced, timings)
 
 
+@contextlib.contextmanager
+def _previous_rigs_at_rest(meshes):
+    """Put the armatures Rigger made for ``meshes`` in their rest position meanwhile: a mesh is rigged as it rests,
+    not as the old rig posed it (rigging again removes the old rig, and the pose with it)."""
+    armatures = {armature.name_full: armature for armature in (getattr(mesh, ARMATURE_POINTER, None)
+                                                               for mesh in meshes) if armature is not None}
+    positions = [(armature.data, armature.data.pose_position) for armature in armatures.values()]
+    for data, _ in positions:
+        data.pose_position = 'REST'
+    try:
+        yield
+    finally:
+        for data, position in positions:
+            data.pose_position = position
+
+
+def _rig_parent(obj):
+    """The object the new armature hangs from: the mesh's parent, or the parent of the Rigger armature the mesh is
+    bound to (about to be replaced)."""
+    parent = obj.parent
+    if parent is not None and parent == getattr(obj, ARMATURE_POINTER, None):
+        parent = parent.parent
+    return parent
+
+
+def shown_collection(obj, view_layer):
+    """The first of ``obj``'s collections that ``view_layer`` shows, else the scene's own: an armature put into an
+    excluded collection could not be made active for editing, and one in a hidden collection would be invisible."""
+    shown = []
+    layers = [view_layer.layer_collection]
+    while layers:
+        layer = layers.pop()
+        if layer.is_visible:
+            shown.append(layer.collection)
+            layers.extend(layer.children)
+    return next((collection for collection in obj.users_collection if collection in shown),
+                bpy.context.scene.collection)
+
+
+def skin_meshes(meshes, armature, progress=None):
+    """Skin every mesh of ``meshes`` to ``armature``: {mesh name: skinning report}, and warnings of our own.
+
+    Weights live in the mesh data, so a mesh object sharing its data with other objects (a linked duplicate) first
+    gets its own copy: otherwise skinning one copy would rewrite the weights of the others.
+    """
+    outcomes, warnings = {}, []
+    for done, mesh in enumerate(meshes, start=1):
+        if mesh.data.users > 1:
+            warnings.append(f"{mesh.name} shared its mesh data {mesh.data.name!r} with other objects; it got its own "
+                            f"copy so that its weights are its own")
+            mesh.data = mesh.data.copy()
+        outcomes[mesh.name] = skinning.skin(mesh, armature)
+        if progress is not None:
+            progress(done / len(meshes))
+    return outcomes, warnings
+
+
 def remove_rig(obj):
     """Delete the armature Rigger made for ``obj`` earlier, and unbind every mesh made with it (their Armature
     modifiers, Rigger's vertex groups, the parenting; meshes keep their place). True when there was one."""
@@ -74,8 +138,5 @@ def remove_rig(obj):
     for mesh in [o for o in bpy.data.objects if getattr(o, ARMATURE_POINTER, None) == armature]:
         skinning.unbind(mesh, armature)
         setattr(mesh, ARMATURE_POINTER, None)
-    data = armature.data
-    bpy.data.objects.remove(armature)
-    if data.users == 0:
-        bpy.data.armatures.remove(data)
+    delete_armature(armature)
     return True

@@ -10,9 +10,13 @@ _registered = []
 def register():
     """Register everything for the methods found now (so a method file added since the last enable appears).
 
-    A method that fails to load is printed to the console and listed in the panel; the others work. If registering
-    fails part way, what was registered is unregistered again before the error propagates.
+    A method that fails to load is printed to the console and listed in the panel; the others work. Registering
+    again (a script calling ``rigger.register()`` while the add-on is enabled) replaces the earlier registration
+    rather than failing half way. If registering fails part way, what was registered is unregistered again before
+    the error propagates.
     """
+    if _registered:
+        unregister()
     registry = method_registry(refresh=True)
     for where, error in registry.failures.items():
         print(f"Rigger: skipped method {where}: {error}")

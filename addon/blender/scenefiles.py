@@ -8,7 +8,9 @@ import bpy
 import numpy as np
 
 from . import overlays, skinning
-from .pipeline import METHOD_PROPERTY, rig_object
+from .armature import delete_armature
+from .pipeline import METHOD_PROPERTY, rig_object, skin_meshes
+from .properties import ARMATURE_POINTER
 
 # Blender's OBJ and glTF importers turn the file's Y-up frame into Blender's Z-up one with this rotation (file x, y,
 # z → Blender x, -z, y), so the report maps bones back through its inverse to the file's own coordinates.
@@ -16,46 +18,100 @@ Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
 
 
 def rig_file(source, output, method, params, *, skin=True):
-    """Rig the meshes of model file ``source`` together, skin them, save the scene to ``output`` and return the
-    report (bones in the file's frame, timings, skinning outcome, warnings).
+    """Rig the meshes of model file ``source`` together, skin them, save them with their armature to ``output`` and
+    return the report (bones in the file's frame, timings, skinning outcome, warnings).
 
-    ValueError when the file holds no mesh or rigging fails; ``output`` is written only after everything succeeded
-    (through a temporary file renamed into place).
+    The meshes are those the file's scene shows: importers' hidden helpers (glTF's bone shapes) and excluded
+    collections are left alone. Armatures the file already deformed them with are replaced: unbound, and deleted
+    when they deform nothing else, so the output holds one rig. ValueError when the file cannot be imported, holds
+    no mesh or rigging fails; ``output`` is written only after everything succeeded (through a temporary file
+    renamed into place).
     """
     source, output = pathlib.Path(source), pathlib.Path(output)
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-    frame = _import(source)
-    meshes = [obj for obj in _exported() if obj.type == 'MESH' and len(obj.data.polygons)]
+    try:
+        frame = _import(source)
+    except RuntimeError as error:
+        raise ValueError(f"{source}: Blender could not import it: {blender_message(error)}") from None
+    meshes = shown_meshes(bpy.context.view_layer)
     if not meshes:
-        raise ValueError(f"{source}: the file holds no mesh with faces")
+        raise ValueError(f"{source}: the file holds no mesh with faces that its scene shows")
     meshes.sort(key=lambda obj: -len(obj.data.vertices))
+    warnings = release_from_armatures(meshes)
     result = rig_object(meshes[0], method, params, parts=meshes[1:])
-    outcomes = {mesh.name: skinning.skin(mesh, result.armature) for mesh in meshes} if skin else None
-    save_scene(output)
-    return {"input": str(source), "output": str(output), **rig_report(result, outcomes, *frame)}
+    outcomes = None
+    if skin:
+        outcomes, skin_warnings = skin_meshes(meshes, result.armature)
+        warnings += skin_warnings
+    save_scene(output, [*meshes, result.armature])
+    return {"input": str(source), "output": str(output), **rig_report(result, outcomes, *frame, warnings=warnings)}
 
 
-def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world"):
+def shown_meshes(view_layer):
+    """The mesh objects with faces that ``view_layer`` shows, Rigger's overlays aside."""
+    return [obj for obj in view_layer.objects if obj.type == 'MESH' and len(obj.data.polygons)
+            and obj.visible_get(view_layer=view_layer) and overlays.KIND_KEY not in obj]
+
+
+def release_from_armatures(meshes):
+    """Unbind ``meshes`` from every armature that deforms them, deleting each such armature that then drives
+    nothing else (a glTF or FBX mesh has one skin: the output must hold ours alone); a warning per armature.
+    Rigger's own earlier armatures are left to :func:`rig_object`, which replaces them where they hang."""
+    armatures = {}
+    for mesh in meshes:
+        for modifier in mesh.modifiers:
+            if modifier.type == 'ARMATURE' and modifier.object not in (None, getattr(mesh, ARMATURE_POINTER, None)):
+                armatures[modifier.object.name] = modifier.object
+    warnings = []
+    for name, armature in armatures.items():
+        for mesh in meshes:
+            skinning.unbind(mesh, armature)
+        if _drives_something(armature):
+            warnings.append(f"unbound the rigged meshes from the file's armature {name!r}, which stays for the "
+                            f"objects it still drives")
+            continue
+        delete_armature(armature)
+        warnings.append(f"replaced the file's armature {name!r}")
+    return warnings
+
+
+def _drives_something(armature):
+    return any(obj.parent == armature or any(modifier.type == 'ARMATURE' and modifier.object == armature
+                                             for modifier in obj.modifiers)
+               for obj in bpy.data.objects)
+
+
+def blender_message(error):
+    """A Blender operator's error as one clause: its text without the "Error:" prefix bpy puts before it."""
+    return str(error).strip().removeprefix("Error:").strip()
+
+
+def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warnings=()):
     """The JSON-ready report of a rig: method, parameters, bones (mapped from Blender's world into the frame named
     ``frame`` by the inverse of ``to_world``), timings, the skinning outcome per mesh (``outcomes``: mesh name →
-    skinning report, or None when not skinned) and warnings."""
+    skinning report, or None when not skinned) and warnings (``warnings`` first).
+
+    Timings are plain floats whatever number type the method recorded (numpy scalars are not JSON).
+    """
     to_frame = np.eye(4)
     to_frame[:3, :3] = np.linalg.inv(to_world)
     meshes = result.meshes
-    warnings = [f"rigged {len(meshes)} mesh objects together: {', '.join(m.name for m in meshes)}"] \
-        if len(meshes) > 1 else []
+    warnings = list(warnings)
+    if len(meshes) > 1:
+        warnings.append(f"rigged {len(meshes)} mesh objects together: {', '.join(m.name for m in meshes)}")
     skinning_outcome = {"summary": "not skinned", "meshes": {}}
     if outcomes is not None:
         skinning_outcome = {"summary": "; ".join(report.summary() for report in outcomes.values()),
                             "meshes": {name: report.as_dict() for name, report in outcomes.items()}}
         warnings += [warning for report in outcomes.values() for warning in report.warnings]
     stages = result.skeleton.stages
+    timings = {**result.timings, **{f"method.{k}": v for k, v in stages.get("timings", {}).items()}}
     return {
         "frame": frame,
         "method": result.armature.get(METHOD_PROPERTY),
         "params": stages.get("params", {}),
         "bones": result.skeleton.transformed(to_frame).to_dict()["bones"],
-        "timings": {**result.timings, **{f"method.{k}": v for k, v in stages.get("timings", {}).items()}},
+        "timings": {name: float(seconds) for name, seconds in timings.items()},
         "skinning": skinning_outcome,
         "warnings": warnings,
     }
@@ -80,10 +136,11 @@ def _import(source):
     raise ValueError(f"{source}: unsupported file type {suffix!r}")
 
 
-def save_scene(output):
-    """Save the scene to ``output`` (.blend, .glb or .fbx) through a temporary file renamed into place; glTF and FBX
-    get the meshes and armatures only (not Rigger's overlays or other helpers)."""
+def save_scene(output, objects=None):
+    """Save the scene to ``output`` (.blend, .glb or .fbx) through a temporary file renamed into place. glTF and FBX
+    get ``objects`` (default: the scene's meshes and armatures, not Rigger's overlays or other helpers)."""
     suffix = output.suffix.lower()
+    exported = _exported() if objects is None else objects
     output.parent.mkdir(parents=True, exist_ok=True)
     # a fresh folder beside the output: the same file system for the rename, no existing file for Blender to back
     # up as .blend1, and the usual permissions
@@ -92,10 +149,10 @@ def save_scene(output):
         if suffix == ".blend":
             bpy.ops.wm.save_as_mainfile(filepath=name, copy=True)
         elif suffix == ".glb":
-            with _selected(_exported()):
+            with _selected(exported):
                 bpy.ops.export_scene.gltf(filepath=name, export_format='GLB', use_selection=True)
         elif suffix == ".fbx":
-            with _selected(_exported()):
+            with _selected(exported):
                 bpy.ops.export_scene.fbx(filepath=name, use_selection=True, object_types={'ARMATURE', 'MESH'},
                                          add_leaf_bones=False)
         else:
@@ -104,7 +161,7 @@ def save_scene(output):
 
 
 def _exported():
-    """The objects a glTF or FBX file gets: meshes and armatures, not overlays."""
+    """The objects a glTF or FBX file gets by default: meshes and armatures, not overlays."""
     return [obj for obj in bpy.context.scene.objects
             if obj.type in ('MESH', 'ARMATURE') and overlays.KIND_KEY not in obj]
 
