@@ -154,6 +154,37 @@ def test_a_flat_cut_out_character_is_rigged_in_its_plane():
     assert chamfer(skeleton.joints()[:, drop_y], reference.joints()[:, drop_y]) / size < 0.03
 
 
+def uv_sphere(rings=16, segments=32):
+    theta = np.linspace(0, np.pi, rings + 1)[1:-1]
+    phi = np.linspace(0, 2 * np.pi, segments, endpoint=False)
+    ring = np.stack([np.outer(np.sin(theta), np.cos(phi)), np.outer(np.sin(theta), np.sin(phi)),
+                     np.repeat(np.cos(theta)[:, None], segments, axis=1)], axis=2).reshape(-1, 3)
+    vertices = np.vstack([ring, [(0, 0, 1), (0, 0, -1)]])
+    top, bottom = len(ring), len(ring) + 1
+    triangles = []
+    for r in range(rings - 2):
+        for k in range(segments):
+            a, b = r * segments + k, r * segments + (k + 1) % segments
+            triangles += [(a, b + segments, b), (a, a + segments, b + segments)]
+    for k in range(segments):
+        triangles += [(top, k, (k + 1) % segments)]
+        last = (rings - 2) * segments
+        triangles += [(bottom, last + (k + 1) % segments, last + k)]
+    return vertices, np.array(triangles)
+
+
+@pytest.mark.parametrize("shape", ["sphere", "square"])
+def test_a_round_blob_gets_one_root_bone_through_its_middle(shape):
+    if shape == "sphere":
+        vertices, triangles = uv_sphere()
+    else:
+        vertices, triangles = np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0.0)]) - [0.5, 0.5, 0], [(0, 1, 2), (1, 3, 2)]
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert len(skeleton) == 1 and skeleton.roots == (0,) and skeleton.names == ("trunk.00",)
+    middle = (skeleton.heads[0] + skeleton.tails[0]) / 2
+    np.testing.assert_allclose(middle, 0.0, atol=0.02)
+
+
 def test_rig_time_is_recorded_per_stage():
     vertices, triangles = load_character("snake")
     timings = rigger.rig_mesh(vertices, triangles).stages["timings"]

@@ -96,7 +96,8 @@ class SilhouetteMethod(RigMethod):
                 continue  # a speck much smaller than a bone: skinning gives it to the nearest bone
             keys, island_chains = chains_of(nodes, links)
             if not island_chains:
-                builder.add_blob(sil, graph.points[nodes[0]], graph.radius[nodes[0]])
+                widest = nodes[int(np.argmax(graph.radius[nodes]))]
+                builder.add_blob(sil, graph.points[widest], graph.radius[widest])
                 continue
             root, rooted = rooted_chains(graph.points, keys, island_chains, graph.radius)
             root_point, placed = place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers)
@@ -283,9 +284,10 @@ class _BoneBuilder:
         depth = 0.5 * (layers[0, 0] + layers[-1, 1]) if len(layers) else 0.0
         centre = sil.lift(point2d[None], [depth])[0]
         half = max(radius, sil.cell) * sil.v
+        attach = self._attachment(centre)
         self.heads.append(centre - half)
         self.tails.append(centre + half)
-        self.parents.append(self._attachment(centre))
+        self.parents.append(attach)
         self.chain_of_bone.append(self.chains)
         self.index_in_chain.append(0)
         self.lines.append(np.array([centre - half, centre + half]))
