@@ -1,6 +1,8 @@
 """The silhouette rigging method on the project's generated characters (exact ground truth) and on bad input."""
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import rigger
 from characters import load_character, winding_numbers
@@ -207,3 +209,21 @@ def test_unknown_parameter_is_rejected():
     vertices, triangles = load_character("snake")
     with pytest.raises(ValueError, match="bone_lenght"):
         rigger.rig_mesh(vertices, triangles, bone_lenght=0.2)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**32 - 1), count=st.integers(1, 60), flat=st.booleans())
+def test_any_triangle_soup_gives_a_valid_tree_or_a_clear_error(seed, count, flat):
+    """Random soups (overlapping, intersecting, flat or not): a rooted tree of bones, or a ValueError."""
+    rng = np.random.default_rng(seed)
+    vertices = rng.normal(size=(3 * count, 3)) * rng.uniform(0.1, 3.0, size=3)
+    if flat:
+        vertices[:, 2] = 0.0
+    triangles = np.arange(3 * count).reshape(-1, 3)
+    try:
+        skeleton = rigger.rig_mesh(vertices, triangles)
+    except ValueError as error:
+        assert str(error)
+        return
+    assert len(skeleton.roots) == 1
+    assert np.isfinite(skeleton.heads).all() and np.isfinite(skeleton.tails).all()
