@@ -467,3 +467,14 @@ def test_a_method_draw_hook_that_raises_is_shown_in_the_panel_not_raised():
     layout = RecordingLayout()
     draw_method(layout, Faulty, props=None)
     assert ("label", "faulty.draw failed: KeyError: 'oops'") in layout.log
+
+
+def test_the_problem_panel_registers_once_however_often_it_is_asked():
+    from rigger.blender import problem
+    problem.register("first")
+    problem.register("second")
+    try:
+        assert problem.RIGGER_PT_problem.is_registered and problem.RIGGER_PT_problem.message == "second"
+    finally:
+        assert problem.unregister() is True
+    assert problem.unregister() is False

@@ -32,7 +32,8 @@ class RIGGER_PT_problem(bpy.types.Panel):
 def register(message):
     """Show ``message`` in the sidebar (and once on the console) in place of Rigger's UI."""
     RIGGER_PT_problem.message = message
-    bpy.utils.register_class(RIGGER_PT_problem)
+    if not RIGGER_PT_problem.is_registered:  # registering again (the add-on enabled twice) just updates the text
+        bpy.utils.register_class(RIGGER_PT_problem)
     print(f"Rigger: {message}", file=sys.stderr)
 
 
