@@ -42,12 +42,12 @@ class SilhouetteMethod(RigMethod):
               description="Silhouette grid cells along the longest side; higher keeps thinner gaps apart"),
         Param("outline_spacing", "float", 0.01, min=0.001, max=0.1,
               description="Longest outline edge fed to the triangulation, as a fraction of the silhouette size"),
-        Param("min_hole", "float", 0.005, min=0.0, max=0.5,
+        Param("min_hole", "float", 0.01, min=0.0, max=0.5,
               description="Holes in the silhouette smaller than this fraction of its area are filled "
                           "(gaps between parts), larger ones (an arm on the hip) are kept"),
         Param("merge", "float", 1.0, min=0.0, max=3.0,
               description="Blob merging: nodes within this many disc radii of a branch point join it"),
-        Param("prune", "float", 1.25, min=0.0, max=5.0,
+        Param("prune", "float", 1.35, min=0.0, max=5.0,
               description="Branches sticking out of their base by less than this many times their width are "
                           "dropped as bumps; lower keeps stubbier branches"),
         Param("bone_angle", "float", 40.0, min=1.0, max=180.0,
