@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _rigger_cdt
-from .core.arrays import index_array, numeric_array
+from .core.arrays import index_array, point_array
 
 MODES = ("inside", "all")
 
@@ -81,26 +81,14 @@ def triangulate(points, segments=None, *, mode="inside", holes=None):
     """
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, not {mode!r}")
-    pts = _as_points(points, "points")
+    pts = point_array(points, 2, "points")
     segs = _as_segments(segments, len(pts))
-    seeds = np.zeros((0, 2)) if holes is None else _as_points(holes, "holes")
+    seeds = np.zeros((0, 2)) if holes is None else point_array(holes, 2, "holes")
     if mode == "inside" and len(segs) == 0:
         raise ValueError("mode='inside' needs constraint segments that enclose a region; use mode='all' for the "
                          "convex hull of the points")
     raw = _rigger_cdt.triangulate(pts, segs, mode == "inside", seeds)
     return Triangulation(**raw)
-
-
-def _as_points(values, name):
-    arr = numeric_array(values, name)
-    if arr.size == 0:
-        return np.zeros((0, 2), np.float64)
-    if arr.ndim != 2 or arr.shape[1] != 2:
-        raise ValueError(f"{name} must have shape (N, 2), got {arr.shape}")
-    if not np.isfinite(arr).all():
-        bad = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
-        raise ValueError(f"{name} must be finite; row {bad} is {arr[bad].tolist()}")
-    return np.ascontiguousarray(arr)
 
 
 def _as_segments(values, n_points):

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _rigger_weights
-from .core.arrays import numeric_array
+from .core.arrays import point_array
 
 DEFAULT_BONES_PER_POINT = 4
 DEFAULT_POWER = 4.0
@@ -82,9 +82,9 @@ def bone_weights(points, heads, tails, normals=None, *, bones_per_point=DEFAULT_
     Raises:
         ValueError: wrong shapes, NaN or infinite coordinates, no bones, or a parameter out of range.
     """
-    point_array = _coordinates(points, "points")
-    head_array = _coordinates(heads, "heads")
-    tail_array = _coordinates(tails, "tails")
+    point_rows = point_array(points, 3, "points")
+    head_array = point_array(heads, 3, "heads")
+    tail_array = point_array(tails, 3, "tails")
     if len(head_array) == 0:
         raise ValueError("bone weights need at least one bone (heads and tails are empty)")
     if len(head_array) > MAX_BONES:
@@ -93,9 +93,9 @@ def bone_weights(points, heads, tails, normals=None, *, bones_per_point=DEFAULT_
         raise ValueError(f"heads and tails must have the same shape, got {head_array.shape} and {tail_array.shape}")
     normal_array = None
     if normals is not None:
-        normal_array = _coordinates(normals, "normals")
-        if normal_array.shape != point_array.shape:
-            raise ValueError(f"normals must match points' shape {point_array.shape}, got {normal_array.shape}")
+        normal_array = point_array(normals, 3, "normals")
+        if normal_array.shape != point_rows.shape:
+            raise ValueError(f"normals must match points' shape {point_rows.shape}, got {normal_array.shape}")
     if isinstance(bones_per_point, bool) or not isinstance(bones_per_point, (int, np.integer)) \
             or not 1 <= bones_per_point <= 1024:
         raise ValueError(f"bones_per_point must be an integer from 1 to 1024, got {bones_per_point!r}")
@@ -105,23 +105,9 @@ def bone_weights(points, heads, tails, normals=None, *, bones_per_point=DEFAULT_
     penalty_value = _number(facing_penalty, "facing_penalty")
     if not penalty_value >= 0:
         raise ValueError(f"facing_penalty must be a finite number >= 0, got {facing_penalty!r}")
-    bones, weights = _rigger_weights.bone_weights(point_array, normal_array, head_array, tail_array,
+    bones, weights = _rigger_weights.bone_weights(point_rows, normal_array, head_array, tail_array,
                                                   int(bones_per_point), power_value, penalty_value)
     return BoneWeights(bones, weights)
-
-
-def _coordinates(values, name):
-    """``values`` as a C-contiguous (N, 3) float64 array of finite numbers; (0, 3) when empty."""
-    array = numeric_array(values, name)
-    if array.size == 0:
-        return np.zeros((0, 3), np.float64)
-    if array.ndim != 2 or array.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (N, 3), got {array.shape}")
-    finite = np.isfinite(array).all(axis=1)
-    if not finite.all():
-        bad = int(np.flatnonzero(~finite)[0])
-        raise ValueError(f"{name} must be finite; row {bad} is {array[bad].tolist()}")
-    return np.ascontiguousarray(array)
 
 
 def _number(value, name):

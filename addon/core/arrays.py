@@ -10,6 +10,21 @@ def numeric_array(values, name, dtype=np.float64):
         raise ValueError(f"{name} must be a numeric array: {exc}") from None
 
 
+def point_array(values, columns, name):
+    """``values`` as a C-contiguous (N, ``columns``) float64 array of finite numbers ((0, columns) when empty);
+    ValueError naming ``name`` and the first bad row otherwise."""
+    array = numeric_array(values, name)
+    if array.size == 0:
+        return np.zeros((0, columns), np.float64)
+    if array.ndim != 2 or array.shape[1] != columns:
+        raise ValueError(f"{name} must have shape (N, {columns}), got {array.shape}")
+    finite = np.isfinite(array).all(axis=1)
+    if not finite.all():
+        bad = int(np.flatnonzero(~finite)[0])
+        raise ValueError(f"{name} must be finite; row {bad} is {array[bad].tolist()}")
+    return np.ascontiguousarray(array)
+
+
 def index_array(values, columns, count, *, name, item, target, dtype):
     """Rows of ``columns`` indices into ``count`` things, as a contiguous ``dtype`` array ((0, columns) if empty).
 
