@@ -3,17 +3,18 @@
 
 Incremental Delaunay insertion in Hilbert-curve order with Lawson flips, on a half-edge triangle structure closed by
 "ghost" triangles that share one vertex at infinity (so the convex hull grows without a super-triangle and without its
-precision problems). Constraint segments are then inserted one by one: the triangles the segment crosses are
-retriangulated by flipping the crossed edges (Sloan 1993) and Delaunay-ness is restored by Lawson flips that never
-cross a constraint. Crossing constraints are split at a new Steiner vertex; vertices lying on a segment split it.
+precision problems). Each point is located by a walk from the last inserted vertex or, when closer, from an inserted
+vertex a few segments away (outlines). Constraint segments are then inserted one by one: the triangles the segment
+crosses are retriangulated by flipping the crossed edges (Sloan 1993) and Delaunay-ness is restored by Lawson flips
+that never cross a constraint. Crossing constraints are split at a new Steiner vertex; vertices lying on a segment split it.
 Every decision is made by the exact predicates of ``cdt_predicates.h``.
 
 Half-edge ``h`` is corner ``h % 3`` of triangle ``h // 3`` and runs from ``V[h]`` to ``V[nxt(h)]``; ``N[h]`` is its twin
 and ``C[h]`` how many input segments cover it (0: unconstrained).
 """
 from libc.stdlib cimport malloc, realloc, free
-from libc.string cimport memset
-from libc.math cimport fabs, sqrt
+from libc.string cimport memcpy, memset
+from libc.math cimport fabs, sqrt, frexp, ldexp
 
 ctypedef unsigned char npy_bool
 
@@ -26,6 +27,8 @@ cdef extern from "cdt_predicates.h" nogil:
 # Crossing constraints closer than this fraction of the bounding box to an endpoint are routed through it.
 cdef double SNAP_FRACTION = 2.0 ** -40
 RENUMBER_MIN = 16384
+# How far along its chain of segment neighbours a point looks for an inserted one to start locating from.
+cdef int LINK_HOPS = 8
 
 cdef enum:
     GHOST = -1
@@ -382,18 +385,54 @@ cdef int insert_at(Mesh *m, int p, int loc, int h) noexcept nogil:
 
 # ---------------------------------------------------------------------------------------------------- Delaunay
 
-cdef void hilbert_order(const double *xy, int n, int *order, unsigned int *keys, unsigned int *tmp_keys,
-                        int *tmp_order) noexcept nogil:
+cdef int scale_exponent(const double *xy, int n) noexcept nogil:
+    """The binary exponent e of the largest coordinate magnitude (0 when all are zero): scaled by 2^-e, |x| < 1."""
+    cdef double peak = 0.0
+    cdef int i, e
+    for i in range(2 * n):
+        if fabs(xy[i]) > peak:
+            peak = fabs(xy[i])
+    frexp(peak, &e)
+    return e
+
+
+cdef void power_factors(int exponent, double *up, double *up_rest) noexcept nogil:
+    """2^-exponent as the product of two doubles, multiplied in turn: one when scaling down (a single rounding, as in
+    ldexp), two exact factors when scaling up by more than 2^1023."""
+    if exponent > 0:
+        up[0] = ldexp(1.0, -exponent)
+        up_rest[0] = 1.0
+    else:
+        up[0] = ldexp(1.0, min(-exponent, 1023))
+        up_rest[0] = ldexp(1.0, -exponent - min(-exponent, 1023))
+
+
+cdef double hilbert_order(const double *xy, int n, int *order, unsigned int *keys, unsigned int *tmp_keys,
+                          int *tmp_order) noexcept nogil:
     """Biased randomised insertion order (BRIO): random rounds of doubling size, each sorted along a Hilbert curve.
+    Returns the size of the points' bounding box (its longer side), which the curve is fitted to.
 
     Pure Hilbert order makes points on a smooth outline see long hull chains and flip quadratically often; random
     rounds keep the expected work O(n log n) while the curve keeps the walks short. The round of a point comes from a
-    hash of its Hilbert key, so exact duplicates share a round and (the sorts being stable) keep index order.
+    hash of its coordinates, so exact duplicates share a round and (the sorts being stable) keep index order, while
+    distinct points in one cell of the curve (dense outlines) still get independent rounds.
     """
     cdef double x0 = xy[0], x1 = xy[0], y0 = xy[1], y1 = xy[1], sx, sy
-    cdef int i, pass_, shift
-    cdef unsigned int qx, qy, s, rx, ry, d, t
+    cdef int i, shift, levels = 1
+    cdef unsigned int qx, qy, d, state, rx, ry, sw, fl, top
     cdef int counts[2049]
+    cdef unsigned char step[16]
+    # one level of the curve as a table: (state, x bit, y bit) -> digit | next state << 2, where the state records
+    # whether the cell's frame is swapped (bit 0) and mirrored (bit 1) relative to the square
+    for state in range(16):
+        sw = (state >> 2) & 1
+        fl = state >> 3
+        rx = ((state & 1) if sw else (state >> 1) & 1) ^ fl
+        ry = (((state >> 1) & 1) if sw else (state & 1)) ^ fl
+        if ry == 0:
+            fl ^= rx
+            sw ^= 1
+        step[state] = ((3 * rx) ^ ry) | ((sw | (fl << 1)) << 2)
     for i in range(n):
         if xy[2 * i] < x0:
             x0 = xy[2 * i]
@@ -403,33 +442,28 @@ cdef void hilbert_order(const double *xy, int n, int *order, unsigned int *keys,
             y0 = xy[2 * i + 1]
         if xy[2 * i + 1] > y1:
             y1 = xy[2 * i + 1]
-    sx = 65535.0 / (x1 - x0) if x1 > x0 else 0.0
-    sy = 65535.0 / (y1 - y0) if y1 > y0 else 0.0
+    # a grid of about 16 cells per point (at most 2^16 a side): finer only costs levels, coarser loses locality
+    while levels < 16 and (1 << (2 * levels)) < 16 * <long long> n:
+        levels += 1
+    top = (1u << levels) - 1
+    sx = top / (x1 - x0) if x1 > x0 else 0.0
+    sy = top / (y1 - y0) if y1 > y0 else 0.0
     for i in range(n):
         qx = <unsigned int> ((xy[2 * i] - x0) * sx)
         qy = <unsigned int> ((xy[2 * i + 1] - y0) * sy)
-        if qx > 65535:
-            qx = 65535
-        if qy > 65535:
-            qy = 65535
+        if qx > top:
+            qx = top
+        if qy > top:
+            qy = top
         d = 0
-        s = 32768
-        while s > 0:
-            rx = 1 if (qx & s) else 0
-            ry = 1 if (qy & s) else 0
-            d += s * s * ((3 * rx) ^ ry)
-            if ry == 0:
-                if rx == 1:
-                    qx = 65535 - qx
-                    qy = 65535 - qy
-                t = qx
-                qx = qy
-                qy = t
-            s >>= 1
+        state = 0
+        for shift in range(levels - 1, -1, -1):
+            state = step[(state << 2) | (((qx >> shift) & 1) << 1) | ((qy >> shift) & 1)]
+            d = (d << 2) | (state & 3)
+            state >>= 2
         keys[i] = d
         order[i] = i
-    for pass_ in range(3):
-        shift = 11 * pass_
+    for shift in range(0, 2 * levels, 11):
         memset(counts, 0, sizeof(counts))
         for i in range(n):
             counts[((keys[i] >> shift) & 0x7FF) + 1] += 1
@@ -446,7 +480,7 @@ cdef void hilbert_order(const double *xy, int n, int *order, unsigned int *keys,
     # stable counting sort by round, the rarest (smallest) round first
     memset(counts, 0, sizeof(counts))
     for i in range(n):
-        keys[i] = 31 - brio_round(keys[i])
+        keys[i] = 31 - brio_round(xy[2 * order[i]], xy[2 * order[i] + 1])
         counts[keys[i] + 1] += 1
     for i in range(32):
         counts[i + 1] += counts[i]
@@ -455,11 +489,18 @@ cdef void hilbert_order(const double *xy, int n, int *order, unsigned int *keys,
         counts[keys[i]] += 1
     for i in range(n):
         order[i] = tmp_order[i]
+    return max(x1 - x0, y1 - y0)
 
 
-cdef inline unsigned int brio_round(unsigned int key) noexcept nogil:
-    """Round 31 - k with probability 2^-(k+1): the trailing zeros of a well-mixed hash of the key."""
-    cdef unsigned int x = key * 0x9E3779B1u
+cdef inline unsigned int brio_round(double px, double py) noexcept nogil:
+    """Round 31 - k with probability 2^-(k+1): the trailing zeros of a well-mixed hash of the point's coordinates."""
+    cdef unsigned long long bx, by, mixed
+    px += 0.0  # -0.0 and 0.0 are the same coordinate
+    py += 0.0
+    memcpy(&bx, &px, sizeof(double))
+    memcpy(&by, &py, sizeof(double))
+    mixed = (bx ^ (bx >> 29)) * 0x9E3779B97F4A7C15ull + (by ^ (by >> 31)) * 0xC2B2AE3D27D4EB4Full
+    cdef unsigned int x = <unsigned int> (mixed ^ (mixed >> 32))
     x ^= x >> 16
     x *= 0x85EBCA6Bu
     x ^= x >> 13
@@ -491,9 +532,45 @@ cdef int seed_triangle(Mesh *m, int a, int b, int c) noexcept nogil:
     return 0
 
 
-cdef int delaunay(Mesh *m, int n, const int *order, int *vmap) noexcept nogil:
-    """Insert points 0..n-1 in the given order. Returns 1 when they are all collinear (no triangle), 0 when done."""
-    cdef int i, k, p, a, b = -1, c = -1, loc, h, err, start = -1
+cdef inline double distance2(Mesh *m, int u, int w) noexcept nogil:
+    cdef double dx = m.xy[2 * u] - m.xy[2 * w], dy = m.xy[2 * u + 1] - m.xy[2 * w + 1]
+    return dx * dx + dy * dy
+
+
+cdef void link_segment_ends(const int *seg_v, int nseg, int n, int *linked) noexcept nogil:
+    """``linked[v]``: one vertex sharing a segment with v, or -1 (chained, these lead along an outline)."""
+    cdef int i, a, b
+    for i in range(n):
+        linked[i] = -1
+    for i in range(nseg):
+        a = seg_v[2 * i]
+        b = seg_v[2 * i + 1]
+        if a != b:
+            if linked[a] < 0:
+                linked[a] = b
+            if linked[b] < 0:
+                linked[b] = a
+
+
+cdef int walk_start(Mesh *m, int p, int last, const int *linked) noexcept nogil:
+    """The triangle to start locating p from: at the last inserted vertex, or at the first inserted vertex along p's
+    chain of segment neighbours when that one is closer. Hilbert order jumps between cells; along an outline such a
+    jump crosses a fan of thin triangles, while a segment neighbour sits a few vertices away."""
+    cdef int q, hops = LINK_HOPS
+    if linked != NULL:
+        q = linked[p]
+        while q >= 0 and m.VT[q] < 0 and hops > 0:
+            q = linked[q]
+            hops -= 1
+        if q >= 0 and m.VT[q] >= 0 and distance2(m, q, p) < distance2(m, last, p):
+            return m.VT[q] // 3
+    return m.VT[last] // 3
+
+
+cdef int delaunay(Mesh *m, int n, const int *order, int *vmap, const int *linked) noexcept nogil:
+    """Insert points 0..n-1 in the given order. Returns 1 when they are all collinear (no triangle), 0 when done.
+    ``linked`` (or NULL) gives each point one segment neighbour, or -1, to start the point location from."""
+    cdef int i, k, p, a, b = -1, c = -1, loc, h, err, last
     a = order[0]
     for k in range(1, n):
         p = order[k]
@@ -512,12 +589,12 @@ cdef int delaunay(Mesh *m, int n, const int *order, int *vmap) noexcept nogil:
     err = seed_triangle(m, a, b, c) if orient_v(m, a, b, c) > 0 else seed_triangle(m, a, c, b)
     if err:
         return err
-    start = 0
+    last = a
     for k in range(n):
         p = order[k]
         if p == a or p == b or p == c:
             continue
-        loc = locate(m, m.xy[2 * p], m.xy[2 * p + 1], start, &h)
+        loc = locate(m, m.xy[2 * p], m.xy[2 * p + 1], walk_start(m, p, last, linked), &h)
         if loc < 0:
             return loc
         if loc == LOC_VERTEX:
@@ -526,7 +603,7 @@ cdef int delaunay(Mesh *m, int n, const int *order, int *vmap) noexcept nogil:
         err = insert_at(m, p, loc, h)
         if err:
             return err
-        start = m.VT[p] // 3
+        last = p
     return 0
 
 
@@ -903,21 +980,22 @@ def triangulate(points, segments, bint inside, holes):
     """Triangulate validated arrays; see ``rigger.cdt.triangulate`` for the contract."""
     points = np.ascontiguousarray(points, dtype=np.float64)
     cdef int n = points.shape[0], nseg = segments.shape[0]
-    # scale by a power of two (exact) so that products in the predicates neither overflow nor underflow
-    peak = float(np.abs(points).max()) if n else 0.0
-    exponent = int(np.frexp(peak)[1]) if peak > 0 else 0
-    scaled = np.ldexp(points, -exponent)
     vmap_arr = np.arange(n, dtype=np.int32)
     if n < 3:
         return _collinear_result(points, segments)
-    cdef double[:, ::1] xy = scaled
+    cdef const double[:, ::1] xy = points
     cdef int[::1] vmap = vmap_arr
     cdef const int[:, ::1] segs = np.ascontiguousarray(segments, dtype=np.int32)
+    cdef int exponent
+    cdef double up, up_rest
+    # scale by a power of two (exact) so that products in the predicates neither overflow nor underflow
+    with nogil:
+        exponent = scale_exponent(&xy[0, 0], n)
+        power_factors(exponent, &up, &up_rest)
     cdef Mesh m
     memset(&m, 0, sizeof(Mesh))
     m.rng = 12345
     m.budget = 2000 * (<long long> n + nseg) + 10000000
-    m.snap = SNAP_FRACTION * float(np.ptp(scaled, axis=0).max()) if n else 0.0
     cdef int *order = <int *> malloc(<size_t> n * sizeof(int))
     cdef int *tmp_order = <int *> malloc(<size_t> n * sizeof(int))
     cdef unsigned int *keys = <unsigned int *> malloc(<size_t> n * sizeof(unsigned int))
@@ -925,6 +1003,9 @@ def triangulate(points, segments, bint inside, holes):
     cdef int err = 0, i
     # below this many points everything stays in cache anyway and renumbering only costs
     cdef bint renumber = n >= RENUMBER_MIN
+    cdef int *internal = <int *> malloc(<size_t> n * sizeof(int)) if renumber else NULL  # input point -> vertex
+    cdef int *seg_v = <int *> malloc(<size_t> (2 * nseg + 1) * sizeof(int))  # segment ends as vertices
+    cdef int *linked = <int *> malloc(<size_t> n * sizeof(int)) if nseg else NULL
     try:
         m.cap_v = n + 16
         m.cap_t = 2 * n + 16
@@ -933,38 +1014,37 @@ def triangulate(points, segments, bint inside, holes):
         m.V = <int *> malloc(<size_t> m.cap_t * 3 * sizeof(int))
         m.N = <int *> malloc(<size_t> m.cap_t * 3 * sizeof(int))
         m.C = <int *> malloc(<size_t> m.cap_t * 3 * sizeof(int))
-        if not (order and tmp_order and keys and tmp_keys and m.xy and m.VT and m.V and m.N and m.C):
+        if not (order and tmp_order and keys and tmp_keys and m.xy and m.VT and m.V and m.N and m.C and seg_v and
+                (internal or not renumber) and (linked or not nseg)):
             raise MemoryError("out of memory while triangulating")
         with nogil:
             for i in range(n):
-                m.xy[2 * i] = xy[i, 0]
-                m.xy[2 * i + 1] = xy[i, 1]
+                m.xy[2 * i] = xy[i, 0] * up * up_rest
+                m.xy[2 * i + 1] = xy[i, 1] * up * up_rest
                 m.VT[i] = -1
             m.nv = n
-            hilbert_order(m.xy, n, order, keys, tmp_keys, tmp_order)
+            m.snap = SNAP_FRACTION * hilbert_order(m.xy, n, order, keys, tmp_keys, tmp_order)
             if renumber:
                 # number the vertices in insertion order, so that the predicates read memory close together
                 for i in range(n):
-                    m.xy[2 * i] = xy[order[i], 0]
-                    m.xy[2 * i + 1] = xy[order[i], 1]
+                    m.xy[2 * i] = xy[order[i], 0] * up * up_rest
+                    m.xy[2 * i + 1] = xy[order[i], 1] * up * up_rest
                     tmp_order[i] = i
-            err = delaunay(&m, n, tmp_order if renumber else order, &vmap[0])
+                    internal[order[i]] = i
+            for i in range(2 * nseg):
+                seg_v[i] = internal[segs[i // 2, i % 2]] if renumber else segs[i // 2, i % 2]
+            if nseg:
+                link_segment_ends(seg_v, nseg, n, linked)
+            err = delaunay(&m, n, tmp_order if renumber else order, &vmap[0], linked)
         if err == 1:
             return _collinear_result(points, segments)
         if err:
             raise _ERRORS[err]
-        if renumber:
-            original = np.asarray(<int[:n]> order).copy()  # internal vertex -> input point
-            internal = np.empty(n, dtype=np.int32)
-            internal[original] = np.arange(n, dtype=np.int32)
-            segs_internal = np.ascontiguousarray(internal[np.asarray(segments)], dtype=np.int32)
-        else:
-            original = np.arange(n, dtype=np.int32)
-            segs_internal = np.ascontiguousarray(segments, dtype=np.int32)
+        # internal vertex -> input point
+        original = np.asarray(<int[:n]> order).copy() if renumber else np.arange(n, dtype=np.int32)
         if nseg:
-            segs = segs_internal
             with nogil:
-                err = insert_constraints(&m, &segs[0, 0], nseg, &vmap[0])
+                err = insert_constraints(&m, seg_v, nseg, &vmap[0])
             if err:
                 raise _ERRORS[err]
         vertex_map = np.empty(n, dtype=np.int32)
@@ -977,6 +1057,9 @@ def triangulate(points, segments, bint inside, holes):
         free(tmp_order)
         free(keys)
         free(tmp_keys)
+        free(internal)
+        free(seg_v)
+        free(linked)
         free(m.xy)
         free(m.VT)
         free(m.V)

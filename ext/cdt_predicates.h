@@ -2,9 +2,12 @@
  *
  * Each predicate first evaluates the determinant in plain double arithmetic with a forward error bound
  * (Shewchuk, "Adaptive Precision Floating-Point Arithmetic and Fast Robust Geometric Predicates", 1997); only when
- * the result is too close to zero to trust its sign does it recompute the determinant exactly with floating-point
- * expansions. The exact path expands the determinants from the raw coordinates (no rounded differences), which is
- * slower than Shewchuk's staged adaptive version but short and easy to check; it runs on a tiny fraction of calls.
+ * the result is too close to zero to trust its sign does it go on. Orientation then follows Shewchuk's stages: the
+ * determinant of the rounded differences as an exact expansion, then corrected for the differences' rounding to first
+ * order. In-circle gets that corrected estimate far more cheaply, from the rounded differences in double-double
+ * arithmetic with its own error bound: symmetric outlines make near-cocircular tests common, and a double-double
+ * estimate settles nearly all of them. The last resort expands the determinant exactly from the raw coordinates
+ * (short and easy to check, and slow; it runs on a tiny fraction of calls).
  *
  * Requires IEEE double arithmetic with round-to-nearest and no fused multiply-add contraction (setup.py passes
  * -ffp-contract=off). Exactness holds while no product overflows or underflows; cdt.pyx scales the input by a power of
@@ -19,13 +22,17 @@
 #define RIGGER_SPLITTER 134217729.0       /* 2^27 + 1 */
 static const double rigger_ccw_bound = (3.0 + 16.0 * RIGGER_EPS) * RIGGER_EPS;
 static const double rigger_icc_bound = (10.0 + 96.0 * RIGGER_EPS) * RIGGER_EPS;
-/* second-stage bounds (Shewchuk): the determinant computed exactly from rounded differences is off by at most this */
+/* second-stage bound (Shewchuk): the determinant computed exactly from rounded differences is off by at most this */
 static const double rigger_ccw_bound_b = (2.0 + 12.0 * RIGGER_EPS) * RIGGER_EPS;
-static const double rigger_icc_bound_b = (4.0 + 48.0 * RIGGER_EPS) * RIGGER_EPS;
 /* third stage: first-order corrections for the rounding of the differences, then these bounds */
 static const double rigger_ccw_bound_c = (9.0 + 64.0 * RIGGER_EPS) * RIGGER_EPS * RIGGER_EPS;
-static const double rigger_icc_bound_c = (44.0 + 576.0 * RIGGER_EPS) * RIGGER_EPS * RIGGER_EPS;
 static const double rigger_result_bound = (3.0 + 8.0 * RIGGER_EPS) * RIGGER_EPS;
+/* The in-circle third stage evaluates the determinant of the rounded differences in double-double arithmetic instead
+ * of exactly: that adds less than 50 u^2 * permanent (see rg_incircle_dd), a rounding of that estimate (u times it,
+ * below u |det| + 4.01 u^2 * permanent since the corrections stay below 4.01 u * permanent) and one more rounding
+ * (u |det|) to Shewchuk's stage-C bounds (44 + 576 u) u^2 * permanent + (3 + 8 u) u |det|. These keep a wide margin. */
+static const double rigger_icc_bound_dd = (44.0 + 128.0 + 576.0 * RIGGER_EPS) * RIGGER_EPS * RIGGER_EPS;
+static const double rigger_result_bound_dd = (6.0 + 8.0 * RIGGER_EPS) * RIGGER_EPS;
 
 /* a + b = x + y exactly, |y| <= ulp(x)/2 */
 static inline void rg_two_sum(double a, double b, double *x, double *y) {
@@ -212,7 +219,8 @@ static int rg_incircle_exact(double ax, double ay, double bx, double by, double 
         int idx[3], m = 0;
         for (int j = 0; j < 4; j++) if (j != i) idx[m++] = j;
         double minor[12], lift[4], prod[96], mulscratch[2 * 96];
-        int mn = rg_orient_exact_expansion(px[idx[0]], py[idx[0]], px[idx[1]], py[idx[1]], px[idx[2]], py[idx[2]], minor);
+        int mn = rg_orient_exact_expansion(px[idx[0]], py[idx[0]], px[idx[1]], py[idx[1]], px[idx[2]], py[idx[2]],
+                                           minor);
         int ln = rg_lift(px[i], py[i], lift);
         int pn = rg_mul(mn, minor, ln, lift, prod, mulscratch);
         if (i & 1) for (int k = 0; k < pn; k++) prod[k] = -prod[k];
@@ -233,6 +241,79 @@ static int rg_lifted_minor(double x, double y, double p, double q, double r, dou
     return rg_sum(n1, xxm, n2, yym, out, merged);
 }
 
+/* One row l * m of the translated in-circle determinant, l = x^2 + y^2 and m = p*q - r*s, as hi + lo in double-double
+ * arithmetic (u = 2^-53, T = |pq| + |rs|): with l = lh + l' (|l'| <= 2.01 u lh) and m = mh + m' (|m'| <= 2.01 u T),
+ * computed l' is within 4.01 u^2 lh and m' within 5.01 u^2 T; lh m' and l' mh are rounded once more and l' m' is
+ * dropped, and lo sums three terms of size <= 2.02 u lh T. In all |hi + lo - l m| <= 25.2 u^2 lh T. */
+static inline void rg_dd_row(double x, double y, double p, double q, double r, double s, double *hi, double *lo) {
+    double xx, xx0, yy, yy0, lh, le, pq, pq0, rs, rs0, mh, me, prod0;
+    rg_two_product(x, x, &xx, &xx0);
+    rg_two_product(y, y, &yy, &yy0);
+    rg_two_sum(xx, yy, &lh, &le);
+    double ll = (le + xx0) + yy0;
+    rg_two_product(p, q, &pq, &pq0);
+    rg_two_product(r, s, &rs, &rs0);
+    rg_two_diff(pq, rs, &mh, &me);
+    double ml = (me + pq0) - rs0;
+    rg_two_product(lh, mh, hi, &prod0);
+    *lo = (prod0 + lh * ml) + ll * mh;
+}
+
+/* The determinant of the rounded differences within 50 u^2 * permanent (plus the rounding of the result): the rows'
+ * his are summed exactly by two-sums, and the five small parts (each row's lo <= 5.05 u of its share of the
+ * permanent, the two two-sum errors together <= 2.01 u * permanent) are added in plain arithmetic; the rounding of
+ * those four additions is below u times the sum of the partial sums, < 23.2 u^2 * permanent, on top of the rows'
+ * 25.2 u^2. */
+static inline double rg_incircle_dd(double adx, double ady, double bdx, double bdy, double cdx, double cdy) {
+    double ha, la, hb, lb, hc, lc, s1, e1, s2, e2;
+    rg_dd_row(adx, ady, bdx, cdy, cdx, bdy, &ha, &la);
+    rg_dd_row(bdx, bdy, cdx, ady, adx, cdy, &hb, &lb);
+    rg_dd_row(cdx, cdy, adx, bdy, bdx, ady, &hc, &lc);
+    rg_two_sum(ha, hb, &s1, &e1);
+    rg_two_sum(s1, hc, &s2, &e2);
+    return s2 + ((((e1 + e2) + la) + lb) + lc);
+}
+
+/* Exact determinant of the rounded differences as an expansion, for when they are exact (t = 0) but the double-double
+ * estimate was too close to zero. */
+static int rg_incircle_expansion(double adx, double ady, double bdx, double bdy, double cdx, double cdy, double *all) {
+    double ra[32], rb[32], rc[32], ab[64], merged[96];
+    int na = rg_lifted_minor(adx, ady, bdx, cdy, cdx, bdy, ra);
+    int nb = rg_lifted_minor(bdx, bdy, cdx, ady, adx, cdy, rb);
+    int nc = rg_lifted_minor(cdx, cdy, adx, bdy, bdx, ady, rc);
+    int nab = rg_sum(na, ra, nb, rb, ab, merged);
+    return rg_sum(nab, ab, nc, rc, all, merged);
+}
+
+/* In-circle sign once the plain filter failed (near-cocircular): the determinant of the rounded differences in
+ * double-double arithmetic, plus the first-order effect of the differences' tails, d(L_a M_a) = dL_a M_a + L_a dM_a
+ * summed over the rows (Shewchuk's stage C); exact expansions when even that is too close to zero. */
+static int rg_incircle_adapt(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy,
+                             double permanent) {
+    double adx = ax - dx, ady = ay - dy, bdx = bx - dx, bdy = by - dy, cdx = cx - dx, cdy = cy - dy;
+    double alift = adx * adx + ady * ady, blift = bdx * bdx + bdy * bdy, clift = cdx * cdx + cdy * cdy;
+    double t[6], x;
+    rg_two_diff(ax, dx, &x, &t[0]);
+    rg_two_diff(ay, dy, &x, &t[1]);
+    rg_two_diff(bx, dx, &x, &t[2]);
+    rg_two_diff(by, dy, &x, &t[3]);
+    rg_two_diff(cx, dx, &x, &t[4]);
+    rg_two_diff(cy, dy, &x, &t[5]);
+    double est = rg_incircle_dd(adx, ady, bdx, bdy, cdx, cdy);
+    est += (alift * ((bdx * t[5] + cdy * t[2]) - (bdy * t[4] + cdx * t[3])) +
+            2.0 * (adx * t[0] + ady * t[1]) * (bdx * cdy - bdy * cdx)) +
+           (blift * ((cdx * t[1] + ady * t[4]) - (cdy * t[0] + adx * t[5])) +
+            2.0 * (bdx * t[2] + bdy * t[3]) * (cdx * ady - cdy * adx)) +
+           (clift * ((adx * t[3] + bdy * t[0]) - (ady * t[2] + bdx * t[1])) +
+            2.0 * (cdx * t[4] + cdy * t[5]) * (adx * bdy - ady * bdx));
+    if (fabs(est) >= rigger_icc_bound_dd * permanent + rigger_result_bound_dd * fabs(est)) return rg_sign(est);
+    if (t[0] == 0.0 && t[1] == 0.0 && t[2] == 0.0 && t[3] == 0.0 && t[4] == 0.0 && t[5] == 0.0) {
+        double all[96];
+        return rg_sign_of(rg_incircle_expansion(adx, ady, bdx, bdy, cdx, cdy, all), all);
+    }
+    return rg_incircle_exact(ax, ay, bx, by, cx, cy, dx, dy);
+}
+
 /* Sign of incircle(a, b, c, d): +1 when d lies strictly inside the circle through counter-clockwise a, b, c. */
 static inline int rg_incircle(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy) {
     double adx = ax - dx, ady = ay - dy, bdx = bx - dx, bdy = by - dy, cdx = cx - dx, cdy = cy - dy;
@@ -245,35 +326,7 @@ static inline int rg_incircle(double ax, double ay, double bx, double by, double
     double bound = rigger_icc_bound * permanent;
     if (det > bound) return 1;
     if (-det > bound) return -1;
-    /* The determinant of the rounded differences, expanded exactly, decides when the differences were exact
-     * (nearby points) or when it clears the second-stage bound; otherwise expand from the raw coordinates. */
-    double t[6], x;
-    rg_two_diff(ax, dx, &x, &t[0]);
-    rg_two_diff(ay, dy, &x, &t[1]);
-    rg_two_diff(bx, dx, &x, &t[2]);
-    rg_two_diff(by, dy, &x, &t[3]);
-    rg_two_diff(cx, dx, &x, &t[4]);
-    rg_two_diff(cy, dy, &x, &t[5]);
-    double ra[32], rb[32], rc[32], ab[64], all[96], merged[96];
-    int na = rg_lifted_minor(adx, ady, bdx, cdy, cdx, bdy, ra);
-    int nb = rg_lifted_minor(bdx, bdy, cdx, ady, adx, cdy, rb);
-    int nc = rg_lifted_minor(cdx, cdy, adx, bdy, bdx, ady, rc);
-    int nab = rg_sum(na, ra, nb, rb, ab, merged);
-    int n = rg_sum(nab, ab, nc, rc, all, merged);
-    if (t[0] == 0.0 && t[1] == 0.0 && t[2] == 0.0 && t[3] == 0.0 && t[4] == 0.0 && t[5] == 0.0)
-        return rg_sign_of(n, all);
-    double est = rg_estimate(n, all);
-    if (fabs(est) >= rigger_icc_bound_b * permanent) return rg_sign(est);
-    /* first-order effect of the differences' tails: d(L_a M_a) = dL_a M_a + L_a dM_a, summed over the rows */
-    bound = rigger_icc_bound_c * permanent + rigger_result_bound * fabs(est);
-    est += (alift * ((bdx * t[5] + cdy * t[2]) - (bdy * t[4] + cdx * t[3])) +
-            2.0 * (adx * t[0] + ady * t[1]) * (bdx * cdy - bdy * cdx)) +
-           (blift * ((cdx * t[1] + ady * t[4]) - (cdy * t[0] + adx * t[5])) +
-            2.0 * (bdx * t[2] + bdy * t[3]) * (cdx * ady - cdy * adx)) +
-           (clift * ((adx * t[3] + bdy * t[0]) - (ady * t[2] + bdx * t[1])) +
-            2.0 * (cdx * t[4] + cdy * t[5]) * (adx * bdy - ady * bdx));
-    if (fabs(est) >= bound) return rg_sign(est);
-    return rg_incircle_exact(ax, ay, bx, by, cx, cy, dx, dy);
+    return rg_incircle_adapt(ax, ay, bx, by, cx, cy, dx, dy, permanent);
 }
 
 #endif

@@ -180,7 +180,8 @@ def test_a_round_blob_gets_one_root_bone_through_its_middle(shape):
     if shape == "sphere":
         vertices, triangles = uv_sphere()
     else:
-        vertices, triangles = np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0.0)]) - [0.5, 0.5, 0], [(0, 1, 2), (1, 3, 2)]
+        vertices = np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0.0)]) - [0.5, 0.5, 0]
+        triangles = [(0, 1, 2), (1, 3, 2)]
     skeleton = rigger.rig_mesh(vertices, triangles)
     assert len(skeleton) == 1 and skeleton.roots == (0,) and skeleton.names == ("trunk.00",)
     middle = (skeleton.heads[0] + skeleton.tails[0]) / 2

@@ -1,7 +1,8 @@
 """A triangle mesh validated once at the door, so every method can trust its arrays.
 
 Bad input (empty, NaN, wrong shapes or dtypes, out-of-range indices, all on one line) raises ``ValueError`` with a
-message that says what is wrong; faces that repeat a vertex index are dropped and counted, since exporters routinely emit them.
+message that says what is wrong; faces that repeat a vertex index are dropped and counted, since exporters routinely
+emit them.
 """
 import itertools
 from functools import cached_property
