@@ -173,10 +173,10 @@ def measure(mesh, runs):
         if len(mesh.vertices) <= 20_000:
             rigger.rig_mesh(mesh.vertices, mesh.triangles)
         for _ in range(runs):
-            wall, cpu = time.perf_counter(), time.process_time()
+            wall, cpu = time.perf_counter(), time.thread_time()
             skeleton = rigger.rig_mesh(mesh.vertices, mesh.triangles)
             walls.append(time.perf_counter() - wall)
-            cpus.append(time.process_time() - cpu)
+            cpus.append(time.thread_time() - cpu)
             timings = dict(skeleton.stages["timings"])
             total = timings.pop("total")
             timings["other"] = total - sum(timings.values())
@@ -342,7 +342,9 @@ def markdown(measurements, summary, profiles, notes, run):
         "",
         f"- Machine: {model}, {cores} cores, shared with other agents: load average (1, 5, 15 min) "
         f"{load(run['load_before'])} before, {load(run['load_after'])} after. With the load above the core count, "
-        "wall-clock times include waiting for a core; CPU time (this process only) does not.",
+        "wall-clock times include waiting for a core; CPU time does not. CPU time is the calling thread's: the rig "
+        "runs in one thread, and OpenBLAS's idle worker threads spin-wait, which would double a process-wide count "
+        "without doing any of the work.",
         f"- Python {platform.python_version()}, numpy {np.__version__}, {platform.system()} {platform.release()}.",
         "- The call: `rigger.rig_mesh(vertices, triangles)` with the silhouette method's defaults, input checks "
         "included, no skinning; vertices float64, triangles int32 (as Blender hands them over). Each time is the "
