@@ -175,6 +175,29 @@ def uv_sphere(rings=16, segments=32):
     return vertices, np.array(triangles)
 
 
+def bird():
+    """Ellipsoid parts, each a closed mesh: a body, wings spread along X (so the view from above, along Y, shows the
+    bird widest) and two legs hanging below the body, hidden behind it in that view."""
+    sphere, sphere_triangles = uv_sphere()
+    parts = [((0.0, 0.0, 0.0), (0.15, 0.15, 0.4)),                      # body, along Z
+             ((0.6, 0.05, 0.0), (0.5, 0.03, 0.2)), ((-0.6, 0.05, 0.0), (0.5, 0.03, 0.2)),  # wings
+             ((0.08, -0.3, 0.0), (0.03, 0.25, 0.03)), ((-0.08, -0.3, 0.0), (0.03, 0.25, 0.03))]  # legs
+    vertices = np.vstack([sphere * size + centre for centre, size in parts])
+    triangles = np.vstack([sphere_triangles + k * len(sphere) for k in range(len(parts))])
+    return vertices, triangles
+
+
+def test_legs_hidden_under_the_body_come_from_the_perpendicular_view():
+    vertices, triangles = bird()
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    np.testing.assert_allclose(np.abs(skeleton.stages["view"]), [0, 1, 0])  # seen from above: legs hidden
+    joints = skeleton.joints()
+    for foot in ((0.08, -0.55, 0.0), (-0.08, -0.55, 0.0)):
+        assert np.linalg.norm(joints - foot, axis=1).min() < 0.1, f"no joint near the foot at {foot}"
+    inside = winding_numbers(vertices, triangles, bone_samples(skeleton)) > 0.5
+    assert inside.mean() >= 0.9
+
+
 @pytest.mark.parametrize("shape", ["sphere", "square"])
 def test_a_round_blob_gets_one_root_bone_through_its_middle(shape):
     if shape == "sphere":

@@ -5,7 +5,8 @@ chordal axis of the triangles, merge round blobs and prune outline-noise spurs, 
 branch point and cut the loops holes make, put every axis point inside the mesh in depth (splitting chains that run
 through several stacked parts, and asking the perpendicular view where the primary one is occluded), then cut the
 chains into bones at sharp turns and at a maximum length. Islands of the silhouette each get their own bones, parented
-to the nearest bone of the largest island.
+to the nearest bone of the largest island. Last, limbs the primary view hides behind the body (a bird's legs under
+its spread wings) are taken from the perpendicular view's tree and hung from the nearest bone.
 """
 import time
 
@@ -18,6 +19,7 @@ from ..core.skeleton import Skeleton
 from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mirror_plane
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
+from ..skeletonize.second_view import uncovered, uncovered_limbs
 from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chains
 
 AXES = np.eye(3)
@@ -27,6 +29,7 @@ MIN_BRANCH = 0.5  # branches sticking out less than this many bone lengths are d
 AXIS_NAMES = ("X", "Y", "Z")
 MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
 SAME_SHAPE = 0.6  # ... and get mirrored joints when their shapes agree this closely (in tolerances)
+HIDDEN_REACH = 1.0  # side-view limb tips this many bone lengths off the skeleton (seen from the side) are missing
 
 
 class SilhouetteMethod(RigMethod):
@@ -59,7 +62,8 @@ class SilhouetteMethod(RigMethod):
         Param("split_layers", "bool", True,
               description="Split chains whose view rays cross the mesh in separate parts (stacked legs)"),
         Param("side_view", "bool", True,
-              description="Use the perpendicular silhouette for depth where the primary view is occluded"),
+              description="Use the perpendicular silhouette for depth where the primary view is occluded, and "
+                          "for the limbs it hides"),
     )
 
     def rig(self, mesh, *, view, resolution, outline_spacing, min_hole, merge, prune, bone_angle, bone_length,
@@ -70,38 +74,29 @@ class SilhouetteMethod(RigMethod):
         sil, tri, graph = planar_axis(vertices, triangles, AXES[axis], resolution, outline_spacing, min_hole)
         clock.lap("silhouette_cdt_axis")
 
-        representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
-        alive = np.unique(representative)
-        _, chains = chains_of(alive.tolist(), merged)
-        kept = prune_spurs(graph.points, graph.radius, chains, prune, MIN_BRANCH * bone_length * mesh.scale)
+        alive, merged, kept = _pruned_tree(graph, merge, prune, MIN_BRANCH * bone_length * mesh.scale)
         clock.lap("merge_prune")
 
-        side = None
+        side = side_sil = side_graph = None
+        side_view = side_view and np.ptp(vertices @ sil.direction) > 0  # a flat mesh has nothing to hide in depth
         if side_view:
             spread = _variances(vertices)
             side_axis = max((a for a in range(3) if a != axis), key=lambda a: spread.sum() - spread[a])
-
-            def side_graph():
-                side_sil, _, graph2 = planar_axis(vertices, triangles, AXES[side_axis], resolution, outline_spacing,
+            side_sil, _, side_graph = planar_axis(vertices, triangles, AXES[side_axis], resolution, outline_spacing,
                                                   min_hole)
-                return side_sil, graph2.points, graph2.radius
-            side = SideAxis(side_graph, sil.direction)
+            side = SideAxis(lambda: (side_sil, side_graph.points, side_graph.radius), sil.direction)
 
-        islands = _islands(graph, alive, kept)
         plane = mirror_plane(vertices, 0.01 * mesh.scale)
         builder = _BoneBuilder(np.radians(bone_angle), bone_length * mesh.scale, max_chain_bones, plane,
                                MIRROR_TOLERANCE * mesh.scale)
-        for number, (nodes, links, size) in enumerate(islands):
-            if number and size < SPECK * bone_length * mesh.scale:
-                continue  # a speck much smaller than a bone: skinning gives it to the nearest bone
-            keys, island_chains = chains_of(nodes, links)
-            if not island_chains:
-                widest = nodes[int(np.argmax(graph.radius[nodes]))]
-                builder.add_blob(sil, graph.points[widest], graph.radius[widest])
-                continue
-            root, rooted = rooted_chains(graph.points, keys, island_chains, graph.radius)
-            root_point, placed = place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers)
-            builder.add_island(root_point, placed)
+        for placed in _placed_islands(sil, graph, alive, kept, SPECK * bone_length * mesh.scale, side, split_layers):
+            if placed[0] == "blob":
+                builder.add_blob(sil, *placed[1:])
+            else:
+                builder.add_island(*placed[1:])
+        if side_view:
+            builder.add_limbs(_hidden_limbs(sil, side_sil, side_graph, builder.lines, merge, prune,
+                                            bone_length * mesh.scale, split_layers))
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()
@@ -123,6 +118,46 @@ class SilhouetteMethod(RigMethod):
             "timings": clock.laps,
         }
         return Skeleton(names, heads, tails, parents, stages=stages)
+
+
+def _pruned_tree(graph, merge, prune, min_reach):
+    """Blob merging and spur pruning of a chordal axis: (alive nodes, merged links, kept links)."""
+    representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
+    alive = np.unique(representative)
+    _, chains = chains_of(alive.tolist(), merged)
+    return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, min_reach)
+
+
+def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):
+    """Per island of the pruned axis, largest first: ("island", root point, placed chains) in 3D, or ("blob", point,
+    radius) for an island that is a single node; islands other than the largest and smaller than ``speck`` are
+    skipped (skinning gives them to the nearest bone)."""
+    for number, (nodes, links, size) in enumerate(_islands(graph, alive, kept)):
+        if number and size < speck:
+            continue
+        keys, island_chains = chains_of(nodes, links)
+        if not island_chains:
+            widest = nodes[int(np.argmax(graph.radius[nodes]))]
+            yield "blob", graph.points[widest], graph.radius[widest]
+            continue
+        root, rooted = rooted_chains(graph.points, keys, island_chains, graph.radius)
+        yield ("island",) + place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers)
+
+
+def _hidden_limbs(sil, side_sil, side_graph, lines, merge, prune, bone_length, split_layers):
+    """Limbs the primary view hides behind the body, from the perpendicular view's pruned tree (see
+    ``second_view``); its chains are placed in depth only when a leaf tip lies off the primary skeleton."""
+    reach, min_length = HIDDEN_REACH * bone_length, MIN_BRANCH * bone_length
+    alive, _, kept = _pruned_tree(side_graph, merge, prune, min_length)
+    ends, count = np.unique(kept, return_counts=True)
+    tips = side_graph.points[ends[count == 1]]
+    if not uncovered(side_sil.lift(tips, 0.0), lines, side_sil.direction, reach).any():
+        return []  # every leaf tip is on the primary skeleton: no need to place the side chains in depth
+    limbs = []
+    for kind, _, placed in _placed_islands(side_sil, side_graph, alive, kept, SPECK * bone_length, None, split_layers):
+        if kind == "island":
+            limbs += uncovered_limbs(placed, lines, sil, side_sil.direction, reach, min_length)
+    return limbs
 
 
 def choose_axis(vertices, triangles):
@@ -237,21 +272,36 @@ class _BoneBuilder:
                 up = attach
             else:
                 up = first_bone[trunk]
-            chain = self.chains
-            self.chains += 1
-            self.lines.append(line)
-            for k in range(len(joints[i]) - 1):
-                if np.linalg.norm(joints[i][k + 1] - joints[i][k]) <= 1e-9 * self.bone_length:
-                    continue
-                self.heads.append(joints[i][k])
-                self.tails.append(joints[i][k + 1])
-                self.parents.append(up)
-                self.chain_of_bone.append(chain)
-                self.index_in_chain.append(k)
-                up = len(self.heads) - 1
-                first_bone.setdefault(i, up)
-            last_bone[i] = up
-            first_bone.setdefault(i, up)
+            added = self._add_chain(line, joints[i], up)
+            first_bone[i], last_bone[i] = (added[0], added[-1]) if added else (up, up)
+
+    def add_limbs(self, limbs):
+        """Bones along extra chains, (polyline, half-widths) each, hung from the bone nearest their start."""
+        if not limbs:
+            return
+        joints = self._symmetric([chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths)
+                                  for line, widths in limbs], [line for line, _ in limbs])
+        for (line, _), along in zip(limbs, joints):
+            self._add_chain(line, along, self._attachment(line[0]))
+
+    def _add_chain(self, line, joints, up):
+        """Bones between consecutive ``joints`` of one chain, the first hanging from bone ``up``; returns the
+        indices of the bones added (none where the joints coincide)."""
+        chain = self.chains
+        self.chains += 1
+        self.lines.append(line)
+        added = []
+        for k in range(len(joints) - 1):
+            if np.linalg.norm(joints[k + 1] - joints[k]) <= 1e-9 * self.bone_length:
+                continue
+            self.heads.append(joints[k])
+            self.tails.append(joints[k + 1])
+            self.parents.append(up)
+            self.chain_of_bone.append(chain)
+            self.index_in_chain.append(k)
+            up = len(self.heads) - 1
+            added.append(up)
+        return added
 
     def _symmetric(self, joints, lines):
         """``joints`` per chain, with each mirror pair of chains given the average of one and the other's mirror

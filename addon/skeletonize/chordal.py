@@ -105,20 +105,19 @@ def _inside_triangle(p, a, b, c):
 
 
 def _components(count, links):
-    """Connected component label of every node (union-find, iterative)."""
+    """Connected component label of every node: hook every link's larger root onto its smaller one, then shortcut
+    every node to its root, until no link joins two roots (a few vectorised rounds instead of a Python loop)."""
     parent = np.arange(count)
-
-    def find(i):
-        root = i
-        while parent[root] != root:
-            root = parent[root]
-        while parent[i] != root:
-            parent[i], i = root, parent[i]
-        return root
-
-    for a, b in links.tolist():
-        ra, rb = find(a), find(b)
-        if ra != rb:
-            parent[max(ra, rb)] = min(ra, rb)
-    roots = np.array([find(i) for i in range(count)], dtype=np.int64)
-    return np.unique(roots, return_inverse=True)[1] if count else roots
+    a, b = links[:, 0], links[:, 1]
+    while True:
+        ra, rb = parent[a], parent[b]
+        apart = ra != rb
+        if not apart.any():
+            break
+        np.minimum.at(parent, np.maximum(ra[apart], rb[apart]), np.minimum(ra[apart], rb[apart]))
+        while True:
+            grand = parent[parent]
+            if (grand == parent).all():
+                break
+            parent = grand
+    return np.unique(parent, return_inverse=True)[1] if count else parent

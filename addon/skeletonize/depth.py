@@ -124,8 +124,8 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
 
 
 class SideAxis:
-    """The chordal axis of the perpendicular silhouette, indexed for depth look-ups; traced on first use only, since
-    most meshes never need it.
+    """The chordal axis of the perpendicular silhouette, indexed for depth look-ups on first use only, since most
+    meshes never need it.
 
     The two views share the axis ``w`` perpendicular to both directions. A primary node at height ``w`` is matched
     with side-view axis nodes at the same ``w``; their coordinate along the primary direction is the depth.

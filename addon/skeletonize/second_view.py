@@ -1,0 +1,81 @@
+"""Limbs the primary view hides: leaf chains of the perpendicular view that the primary skeleton does not reach.
+
+The primary view shows the mesh widest, which can hide limbs behind the body (a bird's legs under its spread wings,
+seen from above; a fish's side fins, seen from the side). The perpendicular view shows them. Its placed chains are
+compared with the primary skeleton in the perpendicular view's own plane: a leaf chain whose tip lies farther than
+``reach`` from every primary chain there is a limb the primary skeleton lacks; its part beyond the last point the
+primary skeleton comes within ``reach`` of is added. Parts both views show (a wing seen edge-on) are never doubled.
+"""
+import numpy as np
+
+from .depth import OCCLUSION_RATIO
+
+
+def uncovered_limbs(placed, primary_lines, primary_sil, direction, reach, min_length):
+    """The outer parts of the leaf chains in ``placed`` that the primary skeleton does not cover.
+
+    Args:
+        placed: the perpendicular view's chains, as ``depth.place_chains`` gives them: (polyline (k, 3), parent,
+            half-widths (k,)).
+        primary_lines: the primary skeleton's chains, 3D polylines.
+        primary_sil: the primary ``Silhouette``: a limb counts only where it is hidden there, its tip's ray running
+            through the mesh for much longer than the limb is wide (a foot under a body); a tip the primary view
+            shows plainly (the edge of a thin sheet) was seen there and judged no limb.
+        direction: the perpendicular view's direction (unit); both are compared projected along it.
+        reach: how near (in projection) a primary chain must pass to cover a point.
+        min_length: shorter uncovered parts are dropped.
+
+    Returns a list of (polyline, half-widths), each starting where the primary skeleton stops covering the limb.
+    """
+    starts, ends = _segments(primary_lines, direction)
+    parents = {parent for _, parent, _ in placed}
+    limbs = []
+    for index, (line, _, widths) in enumerate(placed):
+        if index in parents or len(line) < 2:
+            continue
+        if _distance_to_segments(_flattened(line[-1:], direction), starts, ends)[0] <= reach:
+            continue
+        if not hidden(primary_sil, line[-1:], 2 * OCCLUSION_RATIO * float(np.median(widths)))[0]:
+            continue
+        covered = np.flatnonzero(_distance_to_segments(_flattened(line, direction), starts, ends) <= reach)
+        first = int(covered[-1]) if len(covered) else 0
+        part = line[first:]
+        if len(part) >= 2 and np.linalg.norm(np.diff(part, axis=0), axis=1).sum() >= min_length:
+            limbs.append((part, widths[first:]))
+    return limbs
+
+
+def uncovered(points, primary_lines, direction, reach):
+    """Which 3D ``points`` lie farther than ``reach`` from every primary chain, both projected along ``direction``."""
+    starts, ends = _segments(primary_lines, direction)
+    return _distance_to_segments(_flattened(points, direction), starts, ends) > reach
+
+
+def hidden(sil, points, width):
+    """Which 3D ``points`` are hidden in ``sil``: their view ray runs through the mesh, from first entry to last exit,
+    for longer than ``width`` — behind or along something, like a foot under a body or a leg seen end-on, not at the
+    edge of a thin sheet."""
+    offset = points - sil.origin
+    layers = sil.layers(np.stack([offset @ sil.u, offset @ sil.v], axis=1))
+    return np.array([len(layer) > 0 and layer[-1, 1] - layer[0, 0] > width for layer in layers], dtype=bool)
+
+
+def _flattened(points, direction):
+    return points - np.outer(points @ direction, direction)
+
+
+def _segments(lines, direction):
+    starts = np.concatenate([line[:-1] for line in lines if len(line) > 1] or [np.zeros((0, 3))])
+    ends = np.concatenate([line[1:] for line in lines if len(line) > 1] or [np.zeros((0, 3))])
+    return _flattened(starts, direction), _flattened(ends, direction)
+
+
+def _distance_to_segments(points, starts, ends):
+    """Distance from each point to the nearest of the segments (inf without segments)."""
+    if not len(starts):
+        return np.full(len(points), np.inf)
+    seg = ends - starts
+    length2 = np.maximum((seg * seg).sum(axis=1), 1e-300)
+    rel = points[:, None, :] - starts[None]
+    t = np.clip((rel * seg[None]).sum(axis=2) / length2, 0.0, 1.0)
+    return np.linalg.norm(rel - t[..., None] * seg[None], axis=2).min(axis=1)
