@@ -1,8 +1,9 @@
 """``python -m rigger``: rig model files from the command line (``rig``), or whole folders in parallel (``batch``).
 
 ``rig`` imports an OBJ, glTF/GLB, FBX or .blend file into an empty headless Blender (the ``bpy`` module), rigs its
-mesh, skins it and saves .blend, .glb/.gltf or .fbx, plus an optional JSON report. Outputs are written to temporary
-files and renamed into place only when everything succeeded, so a failure leaves nothing behind.
+mesh, skins it and saves .blend, .glb or .fbx, plus an optional JSON report. Outputs are written to temporary
+files and renamed into place only when everything succeeded (``rigger.core.files``), so a failure leaves nothing
+behind.
 """
 import argparse
 import collections
@@ -14,8 +15,9 @@ import pathlib
 import shutil
 import subprocess
 import sys
-import tempfile
 import time
+
+from .core.files import replaced_on_success
 
 INPUTS = (".obj", ".glb", ".gltf", ".fbx", ".blend")
 OUTPUTS = (".blend", ".glb", ".fbx")
@@ -121,8 +123,8 @@ def _run_rig(args):
     register()  # the properties the Blender layer keeps on scenes and objects
     try:
         report = scenefiles.rig_file(source, output, method.name, params, skin=not args.no_skin)
-        with _written(args.report) as path:
-            if path is not None:
+        if args.report is not None:
+            with replaced_on_success(args.report) as path:
                 path.write_text(json.dumps(report, indent=2))
     except ValueError as error:
         raise CliError(str(error)) from None
@@ -149,32 +151,6 @@ def _check_destinations(source, output, report):
         if key in seen:
             raise CliError(f"{path}: {role} would overwrite {seen[key]}; choose another file name")
         seen[key] = role
-
-
-class _written:
-    """Context manager giving a temporary path beside ``final`` (or None); renamed to ``final`` on success only."""
-
-    def __init__(self, final):
-        self.final = final
-        self.temporary = None
-
-    def __enter__(self):
-        if self.final is None:
-            return None
-        self.final.parent.mkdir(parents=True, exist_ok=True)
-        handle, name = tempfile.mkstemp(prefix=f".{self.final.name}.", dir=self.final.parent)
-        os.close(handle)
-        self.temporary = pathlib.Path(name)
-        return self.temporary
-
-    def __exit__(self, kind, error, trace):
-        if self.temporary is None:
-            return False
-        if kind is None:
-            os.replace(self.temporary, self.final)
-        else:
-            self.temporary.unlink(missing_ok=True)
-        return False
 
 
 def _run_batch(args):

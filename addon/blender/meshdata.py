@@ -15,20 +15,29 @@ def evaluated_arrays(obj, depsgraph=None):
         raise ValueError(f"{obj.name!r} is a {obj.type.lower()} object, not a mesh")
     depsgraph = depsgraph or bpy.context.evaluated_depsgraph_get()
     evaluated = obj.evaluated_get(depsgraph)
-    mesh = evaluated.to_mesh()
     try:
-        mesh.calc_loop_triangles()
-        vertices = np.empty(len(mesh.vertices) * 3, dtype=np.float64)
-        mesh.vertices.foreach_get("co", vertices)
-        triangles = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
-        mesh.loop_triangles.foreach_get("vertices", triangles)
-        world = np.array(evaluated.matrix_world, dtype=np.float64)
+        vertices, triangles = mesh_arrays(evaluated.to_mesh())
     finally:
         evaluated.to_mesh_clear()
     if not len(triangles):
         raise ValueError(f"mesh {obj.name!r} has no faces to rig")
-    vertices = vertices.reshape(-1, 3) @ world[:3, :3].T + world[:3, 3]
-    return vertices, triangles.reshape(-1, 3)
+    return world_points(vertices, evaluated.matrix_world), triangles
+
+
+def mesh_arrays(mesh):
+    """Vertices (N, 3) float64 in the mesh's own space and triangles (M, 3) int32 of mesh data ``mesh``."""
+    mesh.calc_loop_triangles()
+    vertices = np.empty(len(mesh.vertices) * 3, dtype=np.float64)
+    mesh.vertices.foreach_get("co", vertices)
+    triangles = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", triangles)
+    return vertices.reshape(-1, 3), triangles.reshape(-1, 3)
+
+
+def world_points(points, matrix_world):
+    """(N, 3) ``points`` mapped by an object's 4x4 ``matrix_world`` (a mathutils Matrix or an array)."""
+    world = np.array(matrix_world, dtype=np.float64)
+    return points @ world[:3, :3].T + world[:3, 3]
 
 
 def combined_arrays(objects, depsgraph=None):

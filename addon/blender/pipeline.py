@@ -1,13 +1,13 @@
 """Rigging a Blender mesh object: evaluated mesh → method → skeleton → armature (+ overlays), shared by the
 operators and the command line so both do exactly the same thing."""
 import contextlib
-import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import bpy
 import numpy as np
 
 from ..api import rig_mesh
+from ..core.timing import StageClock
 from . import overlays, skinning
 from .armature import build_armature, delete_armature
 from .meshdata import combined_arrays
@@ -19,14 +19,13 @@ METHOD_PROPERTY = "rigger_method"  # custom property on the armature: the method
 @dataclass
 class RigResult:
     """What :func:`rig_object` made: the armature object, the meshes it was made for, the skeleton (with its
-    stages), the overlay objects by kind, whether a previous Rigger armature was replaced, and seconds per step."""
+    stages), whether a previous Rigger armature was replaced, and seconds per step."""
 
     armature: bpy.types.Object
     meshes: list
     skeleton: object
-    overlays: dict
     replaced: bool
-    timings: dict = field(default_factory=dict)
+    timings: dict
 
 
 def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays=None, progress=None):
@@ -41,15 +40,14 @@ def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays
     nothing is created when rigging fails.
     """
     report = progress or (lambda fraction: None)
-    timings = {}
-    start = time.perf_counter()
+    clock = StageClock()
     meshes = [obj, *(part for part in parts if part != obj)]
     with _previous_rigs_at_rest(meshes):
         vertices, triangles = combined_arrays(meshes)
-    timings["read_mesh"] = time.perf_counter() - start
+    clock.lap("read_mesh")
     report(0.1)
     skeleton = rig_mesh(vertices, triangles, method, **(params or {}))
-    timings["rig"] = time.perf_counter() - start - sum(timings.values())
+    clock.lap("rig")
     report(0.7)
     parent = _rig_parent(obj)
     replaced = any([remove_rig(mesh) for mesh in meshes])
@@ -62,14 +60,13 @@ def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays
     armature[METHOD_PROPERTY] = method if isinstance(method, str) else method.name
     for mesh in meshes:
         setattr(mesh, ARMATURE_POINTER, armature)
-    timings["armature"] = time.perf_counter() - start - sum(timings.values())
+    clock.lap("armature")
     report(0.8)
-    made = {}
     if show_overlays is not None:
-        made = overlays.build_overlays(skeleton.stages, obj.name, visible=show_overlays)
-        timings["overlays"] = time.perf_counter() - start - sum(timings.values())
+        overlays.build_overlays(skeleton.stages, obj.name, visible=show_overlays)
+        clock.lap("overlays")
     report(1.0)
-    return RigResult(armature, meshes, skeleton, made, replaced, timings)
+    return RigResult(armature, meshes, skeleton, replaced, clock.laps)
 
 
 @contextlib.contextmanager

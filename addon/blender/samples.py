@@ -14,6 +14,7 @@ import bpy
 import numpy as np
 
 from .. import samples
+from .meshdata import mesh_arrays
 
 TIP_RADIUS_SCALE = 0.7  # the rounding vertex past an end joint is this much thinner than the joint
 ZERO_LENGTH = 1e-6  # metres: the Skin modifier's degenerate edges are zero up to float precision
@@ -99,12 +100,7 @@ def character_arrays(name, subdivisions=2):
     obj = build_character(name, subdivisions)
     mesh = obj.data
     try:
-        vertices = np.empty(len(mesh.vertices) * 3, dtype=np.float64)
-        mesh.vertices.foreach_get("co", vertices)
-        mesh.calc_loop_triangles()
-        triangles = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
-        mesh.loop_triangles.foreach_get("vertices", triangles)
+        return mesh_arrays(mesh)  # the object sits at the origin, unrotated: its mesh space is world space
     finally:
         bpy.data.objects.remove(obj)
         bpy.data.meshes.remove(mesh)
-    return vertices.reshape(-1, 3), triangles.reshape(-1, 3)

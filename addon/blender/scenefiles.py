@@ -1,12 +1,11 @@
 """Model files in and out of a headless Blender for the command line: import, rig, skin, save, report."""
 import contextlib
-import os
 import pathlib
-import tempfile
 
 import bpy
 import numpy as np
 
+from ..core.files import replaced_on_success
 from . import overlays, skinning
 from .armature import delete_armature
 from .pipeline import METHOD_PROPERTY, rig_object, skin_meshes
@@ -141,11 +140,8 @@ def save_scene(output, objects=None):
     get ``objects`` (default: the scene's meshes and armatures, not Rigger's overlays or other helpers)."""
     suffix = output.suffix.lower()
     exported = _exported() if objects is None else objects
-    output.parent.mkdir(parents=True, exist_ok=True)
-    # a fresh folder beside the output: the same file system for the rename, no existing file for Blender to back
-    # up as .blend1, and the usual permissions
-    with tempfile.TemporaryDirectory(prefix=f".{output.name}.", dir=output.parent) as folder:
-        name = os.path.join(folder, output.name)
+    with replaced_on_success(output) as path:
+        name = str(path)
         if suffix == ".blend":
             bpy.ops.wm.save_as_mainfile(filepath=name, copy=True)
         elif suffix == ".glb":
@@ -157,7 +153,6 @@ def save_scene(output, objects=None):
                                          add_leaf_bones=False)
         else:
             raise ValueError(f"{output}: unsupported output type {suffix!r}")
-        os.replace(name, output)
 
 
 def _exported():

@@ -27,7 +27,9 @@ import bpy
 import bmesh
 import numpy as np
 
+from ..core.graphs import components
 from ..weights import bone_weights
+from .meshdata import mesh_arrays, world_points
 
 MODIFIER_NAME = "Rigger Armature"
 GROUPS_PROPERTY = "rigger_vertex_groups"  # mesh object property: JSON list of the vertex groups Rigger wrote
@@ -250,9 +252,8 @@ def _weighted_mask(obj, bone_names):
 def _repair(mesh_obj, armature_obj, bone_names, weighted, report):
     """Run the repair ladder for the vertices ``weighted`` says are not; updates ``weighted`` and ``report``."""
     started = time.perf_counter()
-    local_positions, triangles = _mesh_arrays(mesh_obj.data)
-    world = np.array(mesh_obj.matrix_world)
-    positions = local_positions @ world[:3, :3].T + world[:3, 3]
+    local_positions, triangles = mesh_arrays(mesh_obj.data)
+    positions = world_points(local_positions, mesh_obj.matrix_world)
     weld_map, kept, welded_triangles = _welded(mesh_obj.data, local_positions, triangles)
     welded = (weld_map, positions[kept], welded_triangles)
     if len(kept) < len(positions):
@@ -280,7 +281,8 @@ def _repair_islands(mesh_obj, armature_obj, bone_names, weighted, welded, report
     other part hides its bones, no other part makes its heat system singular)."""
     started = time.perf_counter()
     weld_map, welded_positions, welded_triangles = welded
-    island_of = _islands(len(welded_positions), welded_triangles)
+    edges = np.concatenate([welded_triangles[:, [0, 1]], welded_triangles[:, [1, 2]]])
+    island_of = components(len(welded_positions), edges)
     parts = int(island_of.max()) + 1
     if parts == 1:  # the whole mesh was tried already
         return
@@ -334,16 +336,6 @@ def _finish_stage(stage, started, report, sentence):
     report.warnings.append(sentence)
 
 
-def _mesh_arrays(mesh):
-    """The mesh's own vertices (N, 3) in object space and its triangles (M, 3), modifiers not applied."""
-    positions = np.empty(len(mesh.vertices) * 3)
-    mesh.vertices.foreach_get("co", positions)
-    mesh.calc_loop_triangles()
-    triangles = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int64)
-    mesh.loop_triangles.foreach_get("vertices", triangles)
-    return positions.reshape(-1, 3), triangles.reshape(-1, 3)
-
-
 def _world_normals(obj):
     """Unit vertex normals (N, 3) in world space (zero where a vertex has none)."""
     mesh = obj.data
@@ -358,10 +350,9 @@ def _world_normals(obj):
 def _world_bones(armature_obj, bone_names):
     """Heads and tails (B, 3) of the named bones in world space, rest pose."""
     bones = [armature_obj.data.bones[name] for name in bone_names]
-    local = np.array([[bone.head_local, bone.tail_local] for bone in bones], dtype=np.float64)
-    world = np.array(armature_obj.matrix_world)
-    ends = local @ world[:3, :3].T + world[:3, 3]
-    return ends[:, 0], ends[:, 1]
+    local = np.array([point for bone in bones for point in (bone.head_local, bone.tail_local)], dtype=np.float64)
+    ends = world_points(local, armature_obj.matrix_world)
+    return ends[0::2], ends[1::2]
 
 
 def _welded(mesh, positions, triangles):
@@ -385,21 +376,6 @@ def _welded(mesh, positions, triangles):
     welded = weld_map[triangles]
     distinct = (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & (welded[:, 2] != welded[:, 0])
     return weld_map, kept, welded[distinct]
-
-
-def _islands(count, triangles):
-    """(count,) loose-part label of every vertex, 0 .. parts - 1 (a vertex in no triangle is a part of its own)."""
-    label = np.arange(count)
-    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
-    while True:
-        low = np.minimum(label[edges[:, 0]], label[edges[:, 1]])
-        previous = label.copy()
-        np.minimum.at(label, edges[:, 0], low)
-        np.minimum.at(label, edges[:, 1], low)
-        while not np.array_equal(label[label], label):  # point every vertex at its label's label
-            label = label[label]
-        if np.array_equal(label, previous):
-            return np.unique(label, return_inverse=True)[1]
 
 
 def _bone_heat_weights(positions, triangles, armature_obj, bone_names):

@@ -14,7 +14,6 @@ Blender::
 
 This example lays a chain of bones along the mesh's main axis; replace ``rig`` with your algorithm.
 """
-import time
 
 import numpy as np
 
@@ -22,6 +21,7 @@ import numpy as np
 from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
+from ..core.timing import StageClock
 
 AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 
@@ -40,23 +40,21 @@ class TemplateMethod(RigMethod):
 
     def rig(self, mesh, *, bones, axis):
         """Every declared parameter arrives as a keyword, coerced and range-checked."""
-        timings = {}
-        start = time.perf_counter()
+        clock = StageClock()  # seconds per stage, for stages["timings"]
         centred = mesh.vertices - mesh.centroid
         if axis == "AUTO":
             direction = np.linalg.svd(centred, full_matrices=False)[2][0]
         else:
             direction = np.array(AXES[axis])
-        timings["axis"] = time.perf_counter() - start
+        clock.lap("axis")
 
-        start = time.perf_counter()
         along = centred @ direction
         cuts = np.linspace(along.min(), along.max(), bones + 1)
         points = mesh.centroid + cuts[:, None] * direction
-        timings["chain"] = time.perf_counter() - start
+        clock.lap("chain")
 
         # Stages: every intermediate result, keyed by name, for the overlays, reports and debugging.
-        stages = {"principal_axis": direction, "timings": timings}
+        stages = {"principal_axis": direction, "timings": clock.laps}
         return Skeleton(
             names=[f"chain.{i:03d}" for i in range(bones)],
             heads=points[:-1],

@@ -8,7 +8,6 @@ chains into bones at sharp turns and at a maximum length. Islands of the silhoue
 to the nearest bone of the largest island. Last, limbs the primary view hides behind the body (a bird's legs under
 its spread wings) are taken from the perpendicular view's tree and hung from the nearest bone.
 """
-import time
 
 import numpy as np
 
@@ -16,10 +15,11 @@ from .. import cdt, silhouette
 from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
+from ..core.timing import StageClock
 from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mirror_plane
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
-from ..skeletonize.second_view import uncovered, uncovered_limbs
+from ..skeletonize.second_view import segment_distances, uncovered, uncovered_limbs
 from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chains
 
 AXES = np.eye(3)
@@ -68,7 +68,7 @@ class SilhouetteMethod(RigMethod):
 
     def rig(self, mesh, *, view, resolution, outline_spacing, min_hole, merge, prune, bone_angle, bone_length,
             max_chain_bones, split_layers, side_view):
-        clock = _Clock()
+        clock = StageClock()
         vertices, triangles = mesh.vertices, mesh.triangles
         axis = choose_axis(vertices, triangles) if view == "AUTO" else AXIS_NAMES.index(view)
         sil, tri, graph = planar_axis(vertices, triangles, AXES[axis], resolution, outline_spacing, min_hole)
@@ -84,7 +84,7 @@ class SilhouetteMethod(RigMethod):
             side_axis = max((a for a in range(3) if a != axis), key=lambda a: spread.sum() - spread[a])
             side_sil, _, side_graph = planar_axis(vertices, triangles, AXES[side_axis], resolution, outline_spacing,
                                                   min_hole)
-            side = SideAxis(lambda: (side_sil, side_graph.points, side_graph.radius), sil.direction)
+            side = SideAxis(side_sil, side_graph.points, side_graph.radius, sil.direction)
 
         plane = mirror_plane(vertices, 0.01 * mesh.scale)
         builder = _BoneBuilder(np.radians(bone_angle), bone_length * mesh.scale, max_chain_bones, plane,
@@ -347,21 +347,7 @@ class _BoneBuilder:
         """The bone nearest ``point`` (for a new island), or -1 for the first island."""
         if not self.heads:
             return -1
-        heads, tails = np.array(self.heads), np.array(self.tails)
-        seg = tails - heads
-        t = np.clip(((point - heads) * seg).sum(1) / np.maximum((seg * seg).sum(1), 1e-300), 0, 1)
-        return int(np.argmin(np.linalg.norm(heads + t[:, None] * seg - point, axis=1)))
+        return int(np.argmin(segment_distances(point[None], np.array(self.heads), np.array(self.tails))[0]))
 
     def arrays(self):
         return np.array(self.heads), np.array(self.tails), np.array(self.parents, dtype=np.int64)
-
-
-class _Clock:
-    def __init__(self):
-        self.laps = {}
-        self._last = time.perf_counter()
-
-    def lap(self, name):
-        now = time.perf_counter()
-        self.laps[name] = now - self._last
-        self._last = now

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.graphs import components
+
 TERMINAL, SLEEVE, JUNCTION, ISOLATED = 2, 1, 0, 3
 
 
@@ -77,7 +79,7 @@ def chordal_axis(tri):
     points = np.concatenate([edge_points, centre_points])
     radius = np.concatenate([edge_radius, centre_radius])
     junction = np.concatenate([np.zeros(len(edge_points), bool), classes[centre_tris] != TERMINAL])
-    return AxisGraph(points, radius, junction, links, _components(len(points), links))
+    return AxisGraph(points, radius, junction, links, components(len(points), links))
 
 
 def _triangle_centres(corners, classes):
@@ -102,22 +104,3 @@ def _inside_triangle(p, a, b, c):
     def side(u, w):
         return (w[:, 0] - u[:, 0]) * (p[:, 1] - u[:, 1]) - (w[:, 1] - u[:, 1]) * (p[:, 0] - u[:, 0])
     return (side(a, b) >= 0) & (side(b, c) >= 0) & (side(c, a) >= 0)
-
-
-def _components(count, links):
-    """Connected component label of every node: hook every link's larger root onto its smaller one, then shortcut
-    every node to its root, until no link joins two roots (a few vectorised rounds instead of a Python loop)."""
-    parent = np.arange(count)
-    a, b = links[:, 0], links[:, 1]
-    while True:
-        ra, rb = parent[a], parent[b]
-        apart = ra != rb
-        if not apart.any():
-            break
-        np.minimum.at(parent, np.maximum(ra[apart], rb[apart]), np.minimum(ra[apart], rb[apart]))
-        while True:
-            grand = parent[parent]
-            if (grand == parent).all():
-                break
-            parent = grand
-    return np.unique(parent, return_inverse=True)[1] if count else parent

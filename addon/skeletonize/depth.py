@@ -124,35 +124,25 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
 
 
 class SideAxis:
-    """The chordal axis of the perpendicular silhouette, indexed for depth look-ups on first use only, since most
-    meshes never need it.
+    """The chordal axis of the perpendicular silhouette, indexed for depth look-ups.
 
     The two views share the axis ``w`` perpendicular to both directions. A primary node at height ``w`` is matched
     with side-view axis nodes at the same ``w``; their coordinate along the primary direction is the depth.
     """
 
-    def __init__(self, build, primary_direction):
-        """``build()`` returns (side silhouette, axis points (n, 2), axis radii (n,))."""
-        self._build = build
-        self._primary = primary_direction
-        self._ready = False
-
-    def _prepare(self):
-        side_sil, points, radius = self._build()
+    def __init__(self, side_sil, points, radius, primary_direction):
+        """``points`` (n, 2) and ``radius`` (n,): the side view's chordal axis nodes in ``side_sil``'s plane."""
         world = side_sil.origin + points[:, :1] * side_sil.u + points[:, 1:] * side_sil.v
-        self.w_axis = np.cross(self._primary, side_sil.direction)
+        self.w_axis = np.cross(primary_direction, side_sil.direction)
         self.w = world @ self.w_axis
-        self.along = world @ self._primary
+        self.along = world @ primary_direction
         self.radius = radius
         self.cell = side_sil.cell
-        self._ready = True
 
     def depth_at(self, sil, point2d, radius, interval, previous):
         """Depth (in ``sil``'s frame) of the side-view part matching a primary node, inside ``interval``: of the
         side-view axis nodes at the node's height, the one nearest ``previous`` (ties to the closest width); None if
         no side-view node fits."""
-        if not self._ready:
-            self._prepare()
         world = sil.origin + point2d[0] * sil.u + point2d[1] * sil.v
         w0 = float(world @ self.w_axis)
         base = float(sil.origin @ sil.direction)

@@ -70,12 +70,17 @@ def _segments(lines, direction):
     return _flattened(starts, direction), _flattened(ends, direction)
 
 
-def _distance_to_segments(points, starts, ends):
-    """Distance from each point to the nearest of the segments (inf without segments)."""
-    if not len(starts):
-        return np.full(len(points), np.inf)
+def segment_distances(points, starts, ends):
+    """(P, S) distances from each of the (P, 3) ``points`` to each segment ``starts[k]``–``ends[k]``."""
     seg = ends - starts
     length2 = np.maximum((seg * seg).sum(axis=1), 1e-300)
     rel = points[:, None, :] - starts[None]
     t = np.clip((rel * seg[None]).sum(axis=2) / length2, 0.0, 1.0)
-    return np.linalg.norm(rel - t[..., None] * seg[None], axis=2).min(axis=1)
+    return np.linalg.norm(rel - t[..., None] * seg[None], axis=2)
+
+
+def _distance_to_segments(points, starts, ends):
+    """Distance from each point to the nearest of the segments (inf without segments)."""
+    if not len(starts):
+        return np.full(len(points), np.inf)
+    return segment_distances(points, starts, ends).min(axis=1)

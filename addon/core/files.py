@@ -1,0 +1,18 @@
+"""Writing a file so that a failure part way leaves nothing behind."""
+import contextlib
+import os
+import pathlib
+import tempfile
+
+
+@contextlib.contextmanager
+def replaced_on_success(final):
+    """A temporary path to write ``final`` to, renamed to ``final`` when the block ends without an error (and
+    removed otherwise). It lies in a fresh folder ".<name>.*" beside ``final``: the same file system for the rename,
+    no existing file for Blender to back up as .blend1, and the usual permissions."""
+    final = pathlib.Path(final)
+    final.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix=f".{final.name}.", dir=final.parent) as folder:
+        path = pathlib.Path(folder) / final.name
+        yield path
+        os.replace(path, final)
