@@ -29,7 +29,8 @@ from scipy.sparse.csgraph import connected_components
 from rigger import silhouette
 
 sys.path.insert(0, str(ROOT / "bench"))
-from union_reference import exact_union, frame_points, traced_region  # noqa: E402  (bench/ is no package)
+from rigdata import load_obj  # noqa: E402  (bench/ is no package)
+from union_reference import exact_union, frame_points, iou, traced_region  # noqa: E402
 
 MIN_IOU = 0.995
 BIG_FEATURE = 8  # islands and holes above this many square cells must match
@@ -184,20 +185,6 @@ GENERATED = {
 }
 
 
-def load_obj(path):
-    """Vertices and fan-triangulated faces of an OBJ file (v and f lines, 1-based or negative indices)."""
-    vertices, faces = [], []
-    for line in open(path, encoding="utf-8", errors="replace"):
-        fields = line.split()
-        if fields and fields[0] == "v":
-            vertices.append([float(x) for x in fields[1:4]])
-        elif fields and fields[0] == "f":
-            corners = [int(c.split("/")[0]) for c in fields[1:]]
-            corners = [c - 1 if c > 0 else len(vertices) + c for c in corners]
-            faces += [[corners[0], corners[k], corners[k + 1]] for k in range(1, len(corners) - 1)]
-    return np.array(vertices), np.array(faces)
-
-
 def real_models():
     """Model paths relative to ../shared/models, small enough for the exact reference to stay quick."""
     folder = SHARED / "models"
@@ -277,8 +264,7 @@ def check_against_union(vertices, triangles, direction, **options):
     assert_valid_loops(sil.loops)
     exact = exact_union(sil, vertices, triangles)
     traced = traced_region(sil.loops)
-    iou = shapely.intersection(traced, exact).area / shapely.union(traced, exact).area
-    return sil, iou, topology_errors(traced, exact, sil.cell)
+    return sil, iou(traced, exact), topology_errors(traced, exact, sil.cell)
 
 
 # ------------------------------------------------------------------------------------------------ outline

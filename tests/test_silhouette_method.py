@@ -1,12 +1,19 @@
 """The silhouette rigging method on the project's generated characters (exact ground truth) and on bad input."""
+import sys
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import rigger
+from cdt_checks import polygon_area
 from characters import load_character, winding_numbers
+from conftest import ROOT
 from rigger import samples
+
+sys.path.insert(0, str(ROOT / "bench"))
+from rigdata import chamfer_distance  # noqa: E402  (bench/ is no package)
 
 CHARACTERS = ("humanoid", "humanoid_hips", "quadruped", "octopus", "tree", "snake")
 
@@ -14,11 +21,6 @@ CHARACTERS = ("humanoid", "humanoid_hips", "quadruped", "octopus", "tree", "snak
 def bone_samples(skeleton, per_bone=9):
     t = np.linspace(0.0, 1.0, per_bone)[None, :, None]
     return (skeleton.heads[:, None] * (1 - t) + skeleton.tails[:, None] * t).reshape(-1, 3)
-
-
-def chamfer(a, b):
-    d = np.linalg.norm(a[:, None] - b[None], axis=2)
-    return 0.5 * (d.min(axis=1).mean() + d.min(axis=0).mean())
 
 
 @pytest.fixture(scope="module", params=CHARACTERS)
@@ -46,7 +48,7 @@ def test_joints_near_the_true_skeleton(rigged):
     name, vertices, _, skeleton = rigged
     truth = samples.ground_truth_bones(name)
     size = np.ptp(vertices, axis=0).max()
-    error = chamfer(skeleton.joints(), truth.joints()) / size
+    error = chamfer_distance(skeleton.joints(), truth.joints()) / size
     assert error < 0.08, f"{name}: joint chamfer distance {error:.3f} of the model size"
 
 
@@ -120,12 +122,8 @@ def test_the_hole_between_arm_and_body_is_cut():
     vertices, triangles = load_character("humanoid_hips")
     skeleton = rigger.rig_mesh(vertices, triangles, view="Y")
     loops = skeleton.stages["silhouette"]["loops"]
-    assert sum(1 for loop in loops if _area(loop) < 0) == 2  # both holes were seen …
+    assert sum(1 for loop in loops if polygon_area(loop) < 0) == 2  # both holes were seen …
     assert list(skeleton.roots) == [0]  # … and the result is still a tree
-
-
-def _area(loop):
-    return 0.5 * float(np.sum(loop[:, 0] * np.roll(loop[:, 1], -1) - np.roll(loop[:, 0], -1) * loop[:, 1]))
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -140,7 +138,7 @@ def test_same_skeleton_when_moved_rotated_or_scaled(seed):
         skeleton = rigger.rig_mesh(moved, triangles)
         back = ((skeleton.joints() - (moved.mean(axis=0))) @ rotation) / scale + vertices.mean(axis=0)
         size = np.ptp(vertices, axis=0).max()
-        assert chamfer(back, reference.joints()) / size < 0.03
+        assert chamfer_distance(back, reference.joints()) / size < 0.03
 
 
 def test_a_flat_cut_out_character_is_rigged_in_its_plane():
@@ -153,7 +151,7 @@ def test_a_flat_cut_out_character_is_rigged_in_its_plane():
     reference = rigger.rig_mesh(vertices, triangles)
     size = np.ptp(vertices, axis=0).max()
     drop_y = [0, 2]
-    assert chamfer(skeleton.joints()[:, drop_y], reference.joints()[:, drop_y]) / size < 0.03
+    assert chamfer_distance(skeleton.joints()[:, drop_y], reference.joints()[:, drop_y]) / size < 0.03
 
 
 def uv_sphere(rings=16, segments=32):
