@@ -3,8 +3,12 @@ PYTHON ?= python3.11
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
+# Blender 4.2 LTS as a module in its own venv (inside .venv, which git ignores), for the add-on install test;
+# pip takes the wheel from its cache when it has it.
+BPY42_VENV := $(VENV)/bpy42
+BPY42_STAMP := $(BPY42_VENV)/.installed
 
-.PHONY: test build demo bench bench-quality bench-silhouette clean
+.PHONY: test build demo addon bpy42 bench bench-quality bench-silhouette bench-skinning bench-rig-time clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -12,14 +16,25 @@ $(STAMP): requirements.txt
 	$(PY) -m pip install --quiet -r requirements.txt
 	touch $(STAMP)
 
+$(BPY42_STAMP): requirements-bpy42.txt
+	$(PYTHON) -m venv $(BPY42_VENV)
+	$(BPY42_VENV)/bin/python -m pip install --quiet -r requirements-bpy42.txt
+	touch $(BPY42_STAMP)
+
 build: $(STAMP)
 	$(PY) -m pip install --quiet --no-build-isolation --no-deps -e .
 
-test: build
+bpy42: $(BPY42_STAMP)
+
+test: build bpy42
 	$(PY) -m pytest -q tests
 
 demo: build
 	$(PY) tools/demo.py
+
+# The offline-installable add-on zip for this platform and Python: dist/rigger-<version>-<platform>-py<XY>.zip.
+addon: build
+	$(PY) tools/build_addon.py --output-dir dist
 
 bench: build
 	$(PY) bench/cdt.py
@@ -31,29 +46,12 @@ bench-quality: build
 bench-silhouette: build
 	$(PY) bench/silhouette.py
 
-clean:
-	rm -rf build dist out *.egg-info addon/*.so ext/cdt.c ext/silhouette_binding.c ext/skin_weights_binding.c
-
-# The offline-installable add-on zip for this platform and Python: dist/rigger-<version>-<platform>-py<XY>.zip.
-.PHONY: addon bpy42
-addon: build
-	$(PY) tools/build_addon.py --output-dir dist
-
-# Blender 4.2 LTS as a module in its own venv (inside .venv, which git ignores), for the add-on install test;
-# pip takes the wheel from its cache when it has it.
-BPY42_VENV := $(VENV)/bpy42
-BPY42_STAMP := $(BPY42_VENV)/.installed
-
-$(BPY42_STAMP): requirements-bpy42.txt
-	$(PYTHON) -m venv $(BPY42_VENV)
-	$(BPY42_VENV)/bin/python -m pip install --quiet -r requirements-bpy42.txt
-	touch $(BPY42_STAMP)
-
-bpy42: $(BPY42_STAMP)
-
-test: bpy42
-
 # Skinning over ../shared/models/gt with the artists' skeletons and Rigger's: bench/results/skinning.md and .png.
-.PHONY: bench-skinning
 bench-skinning: build
 	$(PY) bench/skinning.py
+
+bench-rig-time: build
+	$(PY) bench/rig_time.py
+
+clean:
+	rm -rf build dist out *.egg-info addon/*.so ext/cdt.c ext/silhouette_binding.c ext/skin_weights_binding.c

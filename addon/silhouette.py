@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _rigger_silhouette
-from .core.arrays import index_array, numeric_array
+from .core.arrays import index_array, numeric_array, point_array
 
 DEFAULT_RESOLUTION = 1024
 DEFAULT_TOLERANCE = 0.05
@@ -126,12 +126,7 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
         ValueError: wrong shapes, NaN or infinite coordinates, out-of-range indices, an empty mesh, a bad
             direction or resolution or tolerance, or a mesh whose projection has zero area.
     """
-    verts = numeric_array(vertices, "vertices")
-    if verts.ndim != 2 or verts.shape[1] != 3:
-        raise ValueError(f"vertices must have shape (N, 3), got {verts.shape}")
-    if not np.isfinite(verts).all():
-        bad = int(np.flatnonzero(~np.isfinite(verts).all(axis=1))[0])
-        raise ValueError(f"vertices must be finite; vertex {bad} is {verts[bad].tolist()}")
+    verts = point_array(vertices, 3, "vertices")
     tris = index_array(triangles, 3, len(verts), name="triangles", item="triangle", target=("vertex", "vertices"),
                        dtype=np.int64)
     if len(verts) == 0 or len(tris) == 0:
@@ -144,7 +139,7 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
     tol = DEFAULT_TOLERANCE if tolerance is None else tolerance
     if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)) or not 0 <= tol <= 1:
         raise ValueError(f"tolerance must be a number in [0, 1] (a fraction of a grid cell), got {tol!r}")
-    handle = _rigger_silhouette.trace(np.ascontiguousarray(verts), tris, view, int(res), float(tol))
+    handle = _rigger_silhouette.trace(verts, tris, view, int(res), float(tol))
     origin, u, v, unit = handle.frame()
     _, cell, _, _ = handle.grid()
     return Silhouette(handle.loops(), origin, u, v, unit, cell, handle)
@@ -168,13 +163,6 @@ def _as_direction(direction):
 
 
 def _as_points(values):
+    """(P, 2) finite points; a single (2,) point is one row."""
     pts = numeric_array(values, "points")
-    if pts.size == 0:
-        return np.zeros((0, 2), np.float64)
-    if pts.ndim == 1 and pts.shape == (2,):
-        pts = pts[None, :]
-    if pts.ndim != 2 or pts.shape[1] != 2:
-        raise ValueError(f"points must have shape (P, 2), got {pts.shape}")
-    if not np.isfinite(pts).all():
-        raise ValueError("points must be finite")
-    return np.ascontiguousarray(pts)
+    return point_array(pts[None] if pts.shape == (2,) else pts, 2, "points")

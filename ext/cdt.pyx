@@ -570,7 +570,7 @@ cdef int walk_start(Mesh *m, int p, int last, const int *linked) noexcept nogil:
 cdef int delaunay(Mesh *m, int n, const int *order, int *vmap, const int *linked) noexcept nogil:
     """Insert points 0..n-1 in the given order. Returns 1 when they are all collinear (no triangle), 0 when done.
     ``linked`` (or NULL) gives each point one segment neighbour, or -1, to start the point location from."""
-    cdef int i, k, p, a, b = -1, c = -1, loc, h, err, last
+    cdef int k, p, a, b = -1, c = -1, loc, h, err, last
     a = order[0]
     for k in range(1, n):
         p = order[k]
@@ -665,6 +665,11 @@ cdef int work_push(Work *w, int a, int b, int count) noexcept nogil:
     w.data[w.n + 2] = count
     w.n += 3
     return 0
+
+
+cdef inline int split_at(Work *w, int a, int r, int b, int count) noexcept nogil:
+    """Queue segment a-b as its two pieces a-r and r-b (``r`` a vertex on it), the far piece first."""
+    return work_push(w, r, b, count) or work_push(w, a, r, count)
 
 
 cdef inline int same_direction(Mesh *m, int a, int b, int p) noexcept nogil:
@@ -764,10 +769,10 @@ cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a,
         # a sliver apex within SNAP of the edge (beside a Steiner vertex) lies on the segment: route through it
         r = m.V[prv(h)]
         if r != GHOST and on_segment(m, a, b, r):
-            return work_push(w, r, b, count) or work_push(w, a, r, count)
+            return split_at(w, a, r, b, count)
         r = m.V[prv(m.N[h])]
         if r != GHOST and on_segment(m, a, b, r):
-            return work_push(w, r, b, count) or work_push(w, a, r, count)
+            return split_at(w, a, r, b, count)
         return mark(m, h, count)
     # the triangle around a that the segment leaves through
     h = m.VT[a]
@@ -792,7 +797,7 @@ cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a,
         # a vertex a rounding error off the segment (beside a Steiner vertex): split there, start again
         r = m.V[h] if on_segment(m, a, b, m.V[h]) else (m.V[nxt(h)] if on_segment(m, a, b, m.V[nxt(h)]) else -1)
         if r >= 0:
-            return work_push(w, r, b, count) or work_push(w, a, r, count)
+            return split_at(w, a, r, b, count)
         if m.C[h]:
             return split_constraint(m, w, fresh, h, a, b, count)
         if buf_push2(crossed, m.V[h], m.V[nxt(h)]):
@@ -811,7 +816,7 @@ cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a,
             break
         if on_segment(m, a, b, r):
             # a rounding error off the segment (next to a Steiner vertex): split there and start again
-            return work_push(w, r, b, count) or work_push(w, a, r, count)
+            return split_at(w, a, r, b, count)
         h = nxt(o) if s > 0 else prv(o)
     # Sloan: flip crossed edges (a ring buffer of vertex pairs) until none crosses a-b
     fresh.n = 0
@@ -1072,7 +1077,7 @@ cdef object _collect(Mesh *m, object points, int exponent, object vmap_arr, obje
                      double[:, ::1] holes):
     """Keep the wanted real triangles and build the output arrays (vertices numbered as the input, ``to_input``)."""
     cdef int[::1] to_input = to_input_arr
-    cdef int nt = m.nt, t, k, j, h, loc, at, start, kept = 0, nb, nseg = 0, d
+    cdef int nt = m.nt, t, k, j, h, loc, at, start, kept = 0, nseg = 0, d
     removed_arr = np.zeros(nt, dtype=np.int8)
     stack_arr = np.empty(nt + 1, dtype=np.int32)
     cdef signed char[::1] removed = removed_arr

@@ -1555,7 +1555,6 @@ typedef struct {
     double *cost;
     int64_t *heap, *slot, heap_n;
     PointIndex index;
-    double tolerance;
 } Simplifier;
 
 static double segment_distance(double px, double py, double ax, double ay, double bx, double by)
@@ -1690,7 +1689,6 @@ static int simplify(Loops *loops, double tolerance, int32_t width, int32_t heigh
     Simplifier s;
     memset(&s, 0, sizeof s);
     s.xy = loops->xy;
-    s.tolerance = tolerance;
     s.prev = alloc_array(n, sizeof(int64_t));
     s.next = alloc_array(n, sizeof(int64_t));
     s.loop = alloc_array(n, sizeof(int64_t));

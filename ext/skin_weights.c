@@ -175,9 +175,10 @@ static void offer(Keyed *best, int32_t *count, int32_t capacity, double key, int
     best[slot] = item;
 }
 
-/* The `capacity` bones with the smallest keys, depth first with the nearer child first; a node is skipped when
- * its box is farther than the worst key kept (the key is never below the distance, so nothing better is lost). */
-static int32_t nearest_bones(const Tree *tree, const double *heads, const double *tails, const double point[3],
+/* The `capacity` bones (at most all of them) with the smallest keys into `best`, depth first with the nearer child
+ * first; a node is skipped when its box is farther than the worst key kept (the key is never below the distance, so
+ * nothing better is lost). */
+static void nearest_bones(const Tree *tree, const double *heads, const double *tails, const double point[3],
                              const double *normal, double facing_penalty, Keyed *best, int32_t capacity,
                              int32_t *stack)
 {
@@ -208,7 +209,6 @@ static int32_t nearest_bones(const Tree *tree, const double *heads, const double
         stack[top++] = far;
         stack[top++] = near;
     }
-    return count;
 }
 
 static double relative_weight(double key, double nearest, double power)
@@ -216,12 +216,13 @@ static double relative_weight(double key, double nearest, double power)
     return key == nearest ? 1.0 : pow(nearest / key, power);
 }
 
-/* One point's row: the first `used` of `found` bones weighted, the bone after them (if found) setting the zero. */
-static void point_weights(const Keyed *best, int32_t found, int32_t used, int32_t per_point, double power,
+/* One point's row: the first `used` of the `kept` nearest bones weighted, the bone after them (if kept) setting the
+ * zero. */
+static void point_weights(const Keyed *best, int32_t kept, int32_t used, int32_t per_point, double power,
                           int32_t *bones, double *weights)
 {
     double nearest = best[0].key;
-    double floor = found > used ? relative_weight(best[used].key, nearest, power) : 0.0;
+    double floor = kept > used ? relative_weight(best[used].key, nearest, power) : 0.0;
     double total = 0.0;
     for (int32_t i = 0; i < used; i++) {
         weights[i] = relative_weight(best[i].key, nearest, power) - floor;
@@ -268,9 +269,8 @@ int sw_bone_weights(const double *points, int64_t n_points, const double *normal
     }
     for (int64_t p = 0; p < n_points; p++) {
         const double *normal = normals ? normals + 3 * p : NULL;
-        int32_t found = nearest_bones(&tree, heads, tails, points + 3 * p, normal, facing_penalty, best, capacity,
-                                      stack);
-        point_weights(best, found, used, per_point, power, bones_out + p * per_point, weights_out + p * per_point);
+        nearest_bones(&tree, heads, tails, points + 3 * p, normal, facing_penalty, best, capacity, stack);
+        point_weights(best, capacity, used, per_point, power, bones_out + p * per_point, weights_out + p * per_point);
     }
     free(best);
     free(stack);

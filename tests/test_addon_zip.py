@@ -18,11 +18,11 @@ import tomllib
 import zipfile
 
 import pytest
+from conftest import ROOT
 
 import rigger
 from rigger import compat
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
 CHILD = pathlib.Path(__file__).with_name("addon_child.py")
 BLENDER_VENVS = {"5.0": ROOT / ".venv", "4.2": ROOT / ".venv" / "bpy42"}
 PYTHON = sys.version_info[:2]
