@@ -1,5 +1,14 @@
-"""Helpers the benchmarks share: the machine's CPU, time formatting, mesh refinement."""
+"""Helpers the benchmarks share: where the shared models are, the machine and commit, markdown tables, time
+formatting, mesh refinement."""
+import os
+import pathlib
+import subprocess
+
 import numpy as np
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+# The read-only shared data beside the checkout (RIGGER_SHARED overrides, as for the tests).
+SHARED_MODELS = pathlib.Path(os.environ.get("RIGGER_SHARED", REPO.parent / "shared")) / "models"
 
 
 def cpu_model():
@@ -9,6 +18,28 @@ def cpu_model():
             return next(line.split(":", 1)[1].strip() for line in info if line.startswith("model name"))
     except (OSError, StopIteration):
         return "unknown CPU"
+
+
+def described_commit():
+    """``git describe --always --dirty`` of the checkout, or "unknown"."""
+    try:
+        described = subprocess.run(["git", "-C", str(REPO), "describe", "--always", "--dirty"], capture_output=True,
+                                   text=True, timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        described = ""
+    return described or "unknown"
+
+
+def markdown_table(header, rows, numeric=False):
+    """Lines of a markdown table; ``numeric`` right-aligns every column but the first."""
+    rule = "|" + "|".join("---:" if numeric and i else "---" for i in range(len(header))) + "|"
+    return ["| " + " | ".join(header) + " |", rule] + ["| " + " | ".join(str(cell) for cell in row) + " |"
+                                                       for row in rows]
+
+
+def table_cell(text, limit=160):
+    """``text`` (an error message, say) on one line, shortened, safe inside a markdown table cell."""
+    return " ".join(text.split())[:limit].replace("|", "\\|")
 
 
 def format_seconds(seconds):

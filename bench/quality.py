@@ -20,10 +20,10 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
-from benchkit import cpu_model  # noqa: E402
+from benchkit import SHARED_MODELS, cpu_model, markdown_table, table_cell  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
-MODELS_DIR = REPO.parent / "shared" / "models" / "gt"
+MODELS_DIR = SHARED_MODELS / "gt"
 RESULTS_DIR = REPO / "bench" / "results"
 DRAWN_MODELS = ("CesiumMan", "Quaternius_Fox", "rignet_2982")
 REFERENCE_CD_J2J = {"stick": 0.147, "skeletor": 0.076}
@@ -220,16 +220,9 @@ def machine_description():
             f"Python {platform.python_version()}, numpy {np.__version__}")
 
 
-def format_table(header, rows):
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    lines += ["| " + " | ".join(str(cell) for cell in row) + " |" for row in rows]
-    return "\n".join(lines)
-
-
 def model_row(record):
     if not succeeded(record):
-        message = " ".join(record["error"].split())[:160].replace("|", "\\|")
-        return [record["model"], "—", "—", "—", "—", "—", "—", f"**error**: {message}"]
+        return [record["model"], "—", "—", "—", "—", "—", "—", f"**error**: {table_cell(record['error'])}"]
     note = f"not a tree: {record['tree_problem']}" if record["tree_problem"] else ""
     return [record["model"], f"{record['cd_j2j']:.4f}", f"{record['cd_j2b']:.4f}", f"{record['cd_b2b']:.4f}",
             f"{record['joints']} ({record['joint_ratio']:.2f}×)", f"{record['inside']:.1%}",
@@ -261,8 +254,8 @@ def write_report(path, truths, records, summary, methods, notes, command):
                      f"{row['seconds'] * 1e3:.0f}", f"{row['failed']}/{row['models']}"])
     artists_inside = np.mean([truth.inside for truth in truths])
     rows.append(["artist rigs", "—", "—", "—", "1.00×", f"{artists_inside:.1%}", "—", "—"])
-    lines.append(format_table(["method", "CD-J2J", "CD-J2B", "CD-B2B", "joints vs artist (min–max)",
-                               "inside", "ms / model", "failed"], rows))
+    lines += markdown_table(["method", "CD-J2J", "CD-J2B", "CD-B2B", "joints vs artist (min–max)",
+                             "inside", "ms / model", "failed"], rows)
     lines += ["", "Averages are over the models each method scored (failures excluded). Baselines: *stick* is one "
               "straight stick along the vertices' main principal axis through their centroid, spanning their extent, "
               "jointed at its middle (three joints); *skeletor* is skeletor's wavefront skeleton (`waves=1`, "
@@ -271,9 +264,9 @@ def write_report(path, truths, records, summary, methods, notes, command):
               "largest one.", "",
               "## Targets (issue 4)", ""]
     target_names = list(dict.fromkeys(name for m in methods for name in summary[m]["targets"]))
-    lines.append(format_table(["target"] + methods, [
+    lines += markdown_table(["target"] + methods, [
         [name] + [{True: "PASS", False: "FAIL", None: "—"}[summary[m]["targets"].get(name)] for m in methods]
-        for name in target_names]))
+        for name in target_names])
     lines += ["", "## Reference numbers", "",
               "The issue quotes CD-J2J ≈ 0.147 for a single stick and ≈ 0.076 for skeletor in this convention, and "
               f"artists' bones inside the mesh ≈ 97% of the time (measured here: {artists_inside:.1%}). The baselines "
@@ -284,21 +277,22 @@ def write_report(path, truths, records, summary, methods, notes, command):
     for method, reference in REFERENCE_CD_J2J.items():
         if "cd_j2j" in summary.get(method, {}):
             lines.append(f"- {method}: measured {summary[method]['cd_j2j']:.4f} vs reference {reference}")
-    lines += ["", "## Per model", "",
-              format_table(["model", "vertices", "triangles", "artist joints", "artist bones inside"],
-                           [[t.name, len(t.vertices), len(t.triangles), len(t.joints), f"{t.inside:.1%}"]
-                            for t in truths])]
+    lines += ["", "## Per model", ""]
+    lines += markdown_table(["model", "vertices", "triangles", "artist joints", "artist bones inside"],
+                            [[t.name, len(t.vertices), len(t.triangles), len(t.joints), f"{t.inside:.1%}"]
+                             for t in truths])
     for method in methods:
-        lines += ["", f"### {method}", "",
-                  format_table(["model", "CD-J2J", "CD-J2B", "CD-B2B", "joints (vs artist)", "inside", "ms", "note"],
-                               [model_row(r) for r in records if r["method"] == method])]
+        lines += ["", f"### {method}", ""]
+        lines += markdown_table(["model", "CD-J2J", "CD-J2B", "CD-B2B", "joints (vs artist)", "inside", "ms", "note"],
+                                [model_row(r) for r in records if r["method"] == method])
     staged = [r for r in records if succeeded(r) and r["stages"]]
     if staged:
         stage_names = list(dict.fromkeys(name for r in staged for name in r["stages"]))
-        lines += ["", "## Time per stage (ms)", "", format_table(
+        lines += ["", "## Time per stage (ms)", ""]
+        lines += markdown_table(
             ["model", "method"] + stage_names + ["total"],
             [[r["model"], r["method"]] + [f"{r['stages'][s] * 1e3:.1f}" if s in r["stages"] else "—"
-                                          for s in stage_names] + [f"{r['seconds'] * 1e3:.1f}"] for r in staged])]
+                                          for s in stage_names] + [f"{r['seconds'] * 1e3:.1f}"] for r in staged])
     lines += ["", "## Plots", "", "![CD-J2J per model](quality_cd_j2j.png)", "",
               "![Models with artist and predicted skeletons](quality_models.png)", ""]
     path.write_text("\n".join(lines))

@@ -36,11 +36,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
-from benchkit import cpu_model, midpoint_subdivided  # noqa: E402
+from benchkit import (SHARED_MODELS, cpu_model, described_commit, markdown_table,  # noqa: E402
+                      midpoint_subdivided, table_cell)
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "bench" / "results"
-SHARED_MODELS = REPO.parent / "shared" / "models"
 GENERATE_FLAG = "--generate-characters"  # child-process mode: write the characters' arrays into a directory
 GENERATION_TIMEOUT_S = 300
 SKIN_LEVELS = (0, 1, 2)  # Catmull-Clark levels over the Skin hull; the last one is refined further
@@ -305,33 +305,18 @@ def verdicts(summary):
     return result
 
 
-def table(header, rows):
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---:" if i else "---" for i in range(len(header))) + "|"]
-    return lines + ["| " + " | ".join(str(cell) for cell in row) + " |" for row in rows]
-
-
 def measurement_row(measurement, stages, first_column):
     mesh = measurement.mesh
     head = [first_column, f"{len(mesh.vertices):,}", f"{len(mesh.triangles):,}"]
     if measurement.error:
-        message = " ".join(measurement.error.split())[:160].replace("|", "\\|")
+        message = table_cell(measurement.error)
         return head + ["—"] * (4 + len(stages)) + [f"**{'error' if measurement.failed else 'rejected'}**: {message}"]
     return head + [measurement.runs, ms(measurement.wall), ms(measurement.cpu)] + \
         [ms(measurement.stages.get(stage, float("nan"))) for stage in stages] + [measurement.bones, ""]
 
 
-def machine_notes():
-    model = cpu_model()
-    try:
-        commit = subprocess.run(["git", "-C", str(REPO), "describe", "--always", "--dirty"], capture_output=True,
-                                text=True, timeout=10).stdout.strip() or "unknown"
-    except (OSError, subprocess.SubprocessError):
-        commit = "unknown"
-    return model, os.cpu_count(), commit
-
-
 def markdown(measurements, summary, profiles, notes, run):
-    model, cores, commit = machine_notes()
+    model, cores, commit = cpu_model(), os.cpu_count(), described_commit()
     stages = stage_names(measurements)
     load = lambda values: ", ".join(f"{value:.2f}" for value in values)  # noqa: E731
     out = [
@@ -362,7 +347,7 @@ def markdown(measurements, summary, profiles, notes, run):
     out += ["", "A target passes only when every character meets it in both wall-clock and CPU time.", ""]
     if summary:
         out += ["## At exactly 10^3 .. 10^6 vertices (median over characters, ms)", ""]
-        out += table(["vertices", "total (wall)", "total (CPU)"] + stages + ["slowest character (wall)"],
+        out += markdown_table(["vertices", "total (wall)", "total (CPU)"] + stages + ["slowest character (wall)"],
                      [[f"{row['size']:,}", ms(row["wall"]), ms(row["cpu"])]
                       + [ms(row["stages"][stage]) for stage in stages]
                       + [f"{row['slowest']} {ms(row['slowest_wall'])}"
@@ -373,13 +358,13 @@ def markdown(measurements, summary, profiles, notes, run):
     characters = [m for m in measurements if m.mesh.kind == "character"]
     out += ["## Sample characters (ms)", ""]
     if characters:
-        out += table(header, [measurement_row(m, stages, f"{m.mesh.name}, {m.mesh.recipe}") for m in characters])
+        out += markdown_table(header, [measurement_row(m, stages, f"{m.mesh.name}, {m.mesh.recipe}") for m in characters])
     else:
         out += [f"Not measured: {notes['characters']}"]
     out += ["", "## Real models in ../shared/models (ms)", ""]
     real = [m for m in measurements if m.mesh.kind != "character"]
     if real:
-        out += table(header, [measurement_row(m, stages, f"{m.mesh.kind}/{m.mesh.name}") for m in real])
+        out += markdown_table(header, [measurement_row(m, stages, f"{m.mesh.kind}/{m.mesh.name}") for m in real])
         if any(m.error and not m.failed for m in real):
             out += ["", "**rejected**: `rig_mesh` raised the ValueError it gives by design for a mesh it cannot rig "
                         "(here: flat meshes, every vertex in one plane)."]

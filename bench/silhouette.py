@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchkit import cpu_model, format_seconds, midpoint_subdivided
+from benchkit import SHARED_MODELS, cpu_model, format_seconds, midpoint_subdivided
 from rigdata import load_obj
 from union_reference import exact_union, iou, traced_region
 
@@ -32,7 +32,6 @@ from rigger import silhouette
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "bench" / "results"
-SHARED_MODELS = Path(os.environ.get("RIGGER_SHARED", REPO.parent / "shared")) / "models"
 # (series name, model path under models/, subdivision levels to time)
 SERIES = (
     ("rignet_2586 (character)", "gt/rignet_2586/rignet_2586.obj", range(1, 6)),

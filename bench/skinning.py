@@ -15,7 +15,6 @@ import os
 import pathlib
 import platform
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -25,10 +24,10 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
-from benchkit import cpu_model, format_seconds  # noqa: E402
+from benchkit import SHARED_MODELS, cpu_model, described_commit, format_seconds, markdown_table  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
-MODELS_DIR = REPO.parent / "shared" / "models" / "gt"
+MODELS_DIR = SHARED_MODELS / "gt"
 RESULTS_DIR = REPO / "bench" / "results"
 REPAIR_STAGES = ("welded bone heat", "island bone heat", "nearest bones")
 SKELETONS = ("artist", "rigger")
@@ -215,19 +214,10 @@ def summary_rows(records, alone):
     return rows
 
 
-def table(header, rows):
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    return lines + ["| " + " | ".join(row) + " |" for row in rows]
-
-
 def markdown(records, alone, speed, run):
     import bpy
 
-    try:
-        commit = subprocess.run(["git", "-C", str(REPO), "describe", "--always", "--dirty"], capture_output=True,
-                                text=True, timeout=10).stdout.strip() or "unknown"
-    except (OSError, subprocess.SubprocessError):
-        commit = "unknown"
+    commit = described_commit()
     out = [
         "# Skinning (issue 5, item 4)",
         "",
@@ -256,7 +246,7 @@ def markdown(records, alone, speed, run):
         verdict(records),
         "",
     ]
-    out += table(["skeleton", "models", "errors", "unweighted vertices", "bone heat failed (message)",
+    out += markdown_table(["skeleton", "models", "errors", "unweighted vertices", "bone heat failed (message)",
                   "bone heat left vertices silently", "welded bone heat", "island bone heat", "nearest bones",
                   "time (median)", "time (max)", "top-1 agreement (mean)"], summary_rows(records, alone))
     out += ["", "![agreement per model, skinning time, fallback speed](skinning.png)", "", "## Per model", ""]
@@ -271,14 +261,14 @@ def markdown(records, alone, speed, run):
                      str(record["unweighted"] + record["recounted_unweighted"]), format_seconds(record["seconds"]),
                      percent(record["agreement"]),
                      percent(alone.get(record["model"])) if record["skeleton"] == "artist" else ""])
-    out += table(["model", "skeleton", "vertices", "bones", "bone heat", "welded", "islands", "nearest",
+    out += markdown_table(["model", "skeleton", "vertices", "bones", "bone heat", "welded", "islands", "nearest",
                   "unweighted", "skin time", "top-1 agreement", "nearest bones alone"], rows)
     if speed:
         out += ["", "## The compiled nearest-bones weighting alone", "",
                 "`rigger.weights.bone_weights(points, heads, tails, normals)` (4 bones per point), random bone "
                 "segments and points in a unit cube: points far from every bone are the hard case for the search.",
                 ""]
-        out += table(["points", "bones", "time (median)"],
+        out += markdown_table(["points", "bones", "time (median)"],
                      [[f"{row['points']:,}", f"{row['bones']:,}", format_seconds(row["seconds"])] for row in speed])
     return "\n".join(out) + "\n"
 

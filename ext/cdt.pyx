@@ -781,8 +781,9 @@ cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a,
         p = m.V[nxt(h)]
         q = m.V[prv(h)]
         if p != GHOST and on_segment(m, a, b, p):
-            mark(m, h, count)
-            return work_push(w, p, b, count)
+            # through p; the piece a-p is queued rather than marked, so that a sliver apex within SNAP of it (a
+            # vertex nearer along the segment) is routed through as well
+            return split_at(w, a, p, b, count)
         if p != GHOST and q != GHOST and orient_v(m, a, b, p) < 0 and orient_v(m, a, b, q) > 0:
             h = nxt(h)
             break

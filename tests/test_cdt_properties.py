@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 import triangle
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from cdt_checks import (assert_same_up_to_cocircular, check_convex_hull, check_delaunay, check_even_odd,
@@ -124,8 +124,18 @@ def test_messy_input_is_valid_in_both_modes(case):
 
 @budget(300)
 @given(st.integers(0, 2 ** 32 - 1))
+@example(17554)  # four points within 1e-16 of one line: see the next test
 def test_near_degenerate_input_is_valid_in_both_modes(seed):
     check_both_modes(*near_grid_input(seed))
+
+
+def test_a_segment_through_two_nearly_collinear_vertices_is_split_at_both():
+    """Segment 3-2 passes within rounding of vertex 1 and then vertex 0. Routing through 0 along the existing edge
+    3-0 must not skip 1, the apex of the sliver beside that edge; the pieces are 3-1, 1-0, 0-2."""
+    points = np.array([[0.249999999, 0.749999999], [0.375000001, 0.875000001], [0.0, 0.5], [0.5, 1.0]])
+    tri = triangulate(points, [(3, 2)], mode="all")
+    assert sorted(map(tuple, tri.segments.tolist())) == [(0, 1), (0, 2), (1, 3)]
+    check_both_modes(points, np.array([(0, 3), (3, 2)]))
 
 
 @budget(10)
