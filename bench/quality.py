@@ -290,7 +290,7 @@ def write_report(path, truths, records, summary, methods, notes, command):
         stage_names = list(dict.fromkeys(name for r in staged for name in r["stages"]))
         lines += ["", "## Time per stage (ms)", ""]
         lines += markdown_table(
-            ["model", "method"] + stage_names + ["total"],
+            ["model", "method"] + stage_names + ["wall (harness)"],
             [[r["model"], r["method"]] + [f"{r['stages'][s] * 1e3:.1f}" if s in r["stages"] else "—"
                                           for s in stage_names] + [f"{r['seconds'] * 1e3:.1f}"] for r in staged])
     lines += ["", "## Plots", "", "![CD-J2J per model](quality_cd_j2j.png)", "",

@@ -10,33 +10,44 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None):
     ``widths`` are the half-widths of the part along the line. A chain leaving a branch point first gets a joint
     where it leaves that point's disc (``widths[0]``): where a limb meets the body, like a hip or a shoulder. Every
     corner where the simplified line turns by more than ``bone_angle`` radians gets a joint (an elbow, a knee), and
-    so does every bend that would take a straight bone out of the part (a snake's curves). The pieces between are
-    cut evenly into bones about ``bone_length`` long, at most ``max_bones`` in all when positive unless the corners
+    so does every bend that would take a straight bone out of the part (a snake's curves), the sharpest first where
+    two are closer than a third of a bone. The pieces between are cut evenly into one bone per bone length begun
+    (``ceil(length / bone_length)`` in all: the artist rigs of the quality benchmark give a chain about one more
+    bone than ``length / bone_length``, a hand or a foot), at most ``max_bones`` when positive unless the corners
     need more or a bone would be longer than ``LONGEST`` bone lengths.
     """
     widths = np.zeros(len(line)) if widths is None else widths
     arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))]
-    stops = [0.0]
-    reach = np.linalg.norm(line - line[0], axis=1)
-    outside = np.flatnonzero(reach > widths[0]) if widths[0] > 0 else []
-    if len(outside) and arc[outside[0]] >= 0.3 * bone_length and arc[-1] - arc[outside[0]] >= 0.5 * bone_length:
-        stops.append(arc[outside[0]])
-    sharp = _corners(line, bone_angle, np.full(len(line), 0.25 * bone_length))[1:-1]
-    bends = _simplified(line, np.maximum(0.5 * widths, 1e-12 * bone_length))[1:-1] if widths.any() else []
-    for corner in sorted(set(sharp) | set(bends)):
-        if arc[corner] - stops[-1] >= 0.35 * bone_length and arc[-1] - arc[corner] >= 0.35 * bone_length:
-            stops.append(arc[corner])
-    stops.append(arc[-1])
-    lengths = np.diff(stops)
-    wanted = max(1, int(round(arc[-1] / bone_length)))
+    wanted = max(1, int(np.ceil(arc[-1] / bone_length - 1e-9)))  # one bone per bone length begun
     if max_bones > 0:
         wanted = min(wanted, max_bones)
+    stops = [0.0, arc[-1]]
+    for at in _candidate_stops(line, arc, widths, bone_angle, bone_length):
+        if min(abs(at - stop) for stop in stops) >= 0.35 * bone_length:
+            stops.append(at)
+    stops.sort()
+    lengths = np.diff(stops)
     counts = _share(lengths, max(wanted, len(lengths)))
     counts = np.maximum(counts, np.ceil(lengths / (LONGEST * bone_length)).astype(int))
     at = [0.0]
     for start, length, count in zip(stops[:-1], lengths, counts):
         at.extend(start + length * np.arange(1, count + 1) / count)
     return np.stack([np.interp(at, arc, line[:, d]) for d in range(3)], axis=1)
+
+
+def _candidate_stops(line, arc, widths, bone_angle, bone_length):
+    """Arc lengths where a joint belongs, most important first: leaving the branch point's disc, then corners by
+    how sharply they turn, then bends that a straight bone would cut through."""
+    found = []
+    reach = np.linalg.norm(line - line[0], axis=1)
+    outside = np.flatnonzero(reach > widths[0]) if widths[0] > 0 else []
+    if len(outside) and arc[outside[0]] >= 0.3 * bone_length and arc[-1] - arc[outside[0]] >= 0.5 * bone_length:
+        found.append(arc[outside[0]])
+    turns = _turns(line, np.full(len(line), 0.25 * bone_length))
+    found += [arc[i] for i, angle in sorted(turns, key=lambda item: -item[1]) if angle > bone_angle]
+    if widths.any():
+        found += [arc[i] for i in _simplified(line, np.maximum(0.5 * widths, 1e-12 * bone_length))[1:-1]]
+    return found
 
 
 def _share(lengths, total):
@@ -82,19 +93,15 @@ def _simplified(line, tolerance):
     return list(np.flatnonzero(keep))
 
 
-def _corners(line, angle, tolerance):
-    """Indices of the ends and of the corners of the simplified ``line`` that turn by more than ``angle``."""
+def _turns(line, tolerance):
+    """(index, turning angle) at each inner vertex of the simplified ``line``."""
     idx = _simplified(line, tolerance)
-    if len(idx) <= 2:
-        return idx
-    corners = [idx[0]]
+    turns = []
     for prev, here, nxt in zip(idx[:-2], idx[1:-1], idx[2:]):
         u, w = line[here] - line[prev], line[nxt] - line[here]
         cos = float(u @ w) / max(np.linalg.norm(u) * np.linalg.norm(w), 1e-300)
-        if np.arccos(np.clip(cos, -1.0, 1.0)) > angle:
-            corners.append(here)
-    corners.append(idx[-1])
-    return corners
+        turns.append((here, float(np.arccos(np.clip(cos, -1.0, 1.0)))))
+    return turns
 
 
 def mirror_plane(vertices, tolerance, samples=600):

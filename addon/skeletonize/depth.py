@@ -11,6 +11,7 @@ import numpy as np
 
 # an interval this many times thicker than the part is wide means the part is occluded by (merged with) another
 OCCLUSION_RATIO = 2.5
+THIN = 0.2  # intervals thinner than this many half-widths of the part are sheets, not parts
 
 
 def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
@@ -28,10 +29,11 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
     """
     used = sorted({root} | {n for c in chains for n in c.nodes})
     slot = {n: i for i, n in enumerate(used)}
-    layers = sil.layers(points[used])
+    layers = [_solid(layer, radius[n]) for layer, n in zip(sil.layers(points[used]), used)]
     root_layers = layers[slot[root]]
     root_depth = _middle(root_layers[np.argmax(root_layers[:, 1] - root_layers[:, 0])]) if len(root_layers) else 0.0
     end_depth = {-1: root_depth}
+    root_is_end = sum(chain.parent < 0 for chain in chains) == 1
     placed = []
     origin_of = {}  # placed index -> source chain index
     for ci, chain in enumerate(chains):
@@ -40,6 +42,8 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
         node_layers = [layers[slot[n]] for n in chain.nodes]
         copies = _layer_count(node_layers) if split else 1
         widths = radius[chain.nodes]
+        if chain.parent < 0 and root_is_end:
+            widths = np.r_[0.0, widths[1:]]  # no branch point here: no disc for the chain to leave (chain_joints)
         for copy in range(copies):
             depths = _follow(node_layers, copy, copies, start_depths)
             depths = _resolve_occlusion(sil, points[chain.nodes], radius[chain.nodes], node_layers, depths, side_axis)
@@ -60,15 +64,26 @@ def _middle(interval):
     return 0.5 * (interval[0] + interval[1])
 
 
+def _solid(layer, radius):
+    """One node's depth intervals without those thinner than ``THIN`` times its half-width when a thicker one
+    exists: the zero-thickness intervals of open sheets (a cloak's hem) are not parts a chain should split into."""
+    thick = layer[:, 1] - layer[:, 0] >= THIN * radius
+    return layer[thick] if thick.any() else layer
+
+
 def _layer_count(node_layers):
-    """How many separate parts a chain runs through: the most frequent interval count over its outer two thirds
-    (the part near its parent often runs into the body)."""
+    """How many separate parts a chain runs through, judged over its outer two thirds (the part near its parent
+    often runs into the body): the fewest parts (more than one) that a third of those nodes cross, else the most
+    frequent count. Fewest, because parts split further towards the tip (a dinosaur's left and right feet, each
+    with its toes) are still one limb each."""
     counts = np.array([len(layer) for layer in node_layers])
     outer = counts[len(counts) // 3:]
     outer = outer[outer > 0]
     if not len(outer):
         return 1
-    return int(np.argmax(np.bincount(outer)))
+    frequency = np.bincount(outer)
+    several = np.flatnonzero(frequency[2:] * 3 >= len(outer)) + 2
+    return int(several[0]) if len(several) else int(np.argmax(frequency))
 
 
 def _follow(node_layers, copy, copies, start):

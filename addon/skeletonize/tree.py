@@ -8,12 +8,15 @@ A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch p
 2. Spur pruning: a branch that pokes out of the disc it hangs on by less than ``prune`` times its own width is a
    bump or outline noise, not a limb; it is removed, repeatedly, since removing one can expose another.
 3. Rooting at the most central branch point (smallest largest distance to any end), then cutting every cycle (holes
-   in the silhouette) where the two ways around it from the root meet.
+   in the silhouette) where the two ways around it from the root meet. A path without branch points is rooted at
+   its widest node, or at its thicker end when it is about equally wide throughout.
 """
 import heapq
 from dataclasses import dataclass
 
 import numpy as np
+
+UNIFORM = 1.25  # a path whose widest node is at most this many times its median width is a column, not a body
 
 
 @dataclass
@@ -144,7 +147,7 @@ def rooted_chains(points, keys, chains, radius):
     if branch_points:
         root = min(branch_points, key=lambda k: (max(_distances(k, adjacency, lengths).values()), -radius[k]))
     else:
-        return _root_single_path(points, chains, keys)
+        return _root_single_path(chains, keys, radius)
     dist, via = _shortest_paths(root, adjacency, lengths)
     tree = set(via.values())
     ordered = []
@@ -169,14 +172,20 @@ def rooted_chains(points, keys, chains, radius):
     return root, ordered
 
 
-def _root_single_path(points, chains, keys):
-    """A graph without branch points is one path: root it at its middle node."""
+def _root_single_path(chains, keys, radius):
+    """A graph without branch points is one path. Root it at its widest node, the body (a bird with spread wings,
+    a fish), with a chain each way; a path about as wide everywhere (a column, a tentacle) is rooted at its thicker
+    end instead, one chain from its base, as an artist would rig it."""
     nodes = chains[0] if chains else sorted(keys)
-    steps = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[nodes], axis=0), axis=1))]
-    middle = int(np.clip(np.searchsorted(steps, steps[-1] / 2), 0, len(nodes) - 1))
-    root = nodes[middle]
+    width = radius[nodes]
+    quarter = max(1, len(nodes) // 4)  # the very ends taper to a point whatever the part's width
+    if width.max() <= UNIFORM * np.median(width):
+        if width[-quarter:].mean() > width[:quarter].mean():
+            nodes = nodes[::-1]
+        return nodes[0], [Chain(list(nodes), -1)] if len(nodes) > 1 else []
+    middle = int(np.argmax(width))
     halves = [nodes[middle:], nodes[:middle + 1][::-1]]
-    return root, [Chain(h, -1) for h in halves if len(h) > 1]
+    return nodes[middle], [Chain(h, -1) for h in halves if len(h) > 1]
 
 
 def _distances(source, adjacency, lengths):

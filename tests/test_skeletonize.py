@@ -1,0 +1,70 @@
+"""The skeleton-building steps on hand-made inputs: rooting a path, counting stacked parts, joints along a chain."""
+import numpy as np
+import pytest
+
+from rigger.skeletonize import depth
+from rigger.skeletonize.bones import chain_joints
+from rigger.skeletonize.tree import chains_of, rooted_chains
+
+
+def rooted_path(radius):
+    """Root and chains of a straight path of len(radius) axis nodes with the given half-widths."""
+    count = len(radius)
+    points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
+    links = np.stack([np.arange(count - 1), np.arange(1, count)], axis=1)
+    keys, chains = chains_of(list(range(count)), links)
+    return rooted_chains(points, keys, chains, np.asarray(radius, dtype=float))
+
+
+def test_a_column_is_one_chain_from_its_thicker_end():
+    radius = np.r_[0.2, np.linspace(1.0, 1.1, 18), 0.2]  # tapered tips, a little thicker at the far end
+    root, chains = rooted_path(radius)
+    assert root == 19
+    assert len(chains) == 1 and chains[0].nodes == list(range(19, -1, -1)) and chains[0].parent == -1
+
+
+def test_a_path_with_a_body_is_rooted_at_the_body():
+    radius = np.r_[np.full(12, 0.3), 2.0, np.full(7, 0.3)]  # two thin wings, one wide body between them
+    root, chains = rooted_path(radius)
+    assert root == 12
+    assert sorted(len(chain.nodes) for chain in chains) == [8, 13]
+    assert all(chain.nodes[0] == 12 and chain.parent == -1 for chain in chains)
+
+
+def layers(*intervals):
+    return np.array(intervals, dtype=float).reshape(-1, 2)
+
+
+def test_sheets_are_not_parts():
+    """An open sheet hit once is a zero-thickness interval: no part for a chain to split into, unless nothing else
+    is there."""
+    np.testing.assert_array_equal(depth._solid(layers((0.0, 1.0), (2.0, 2.0)), radius=0.5), layers((0.0, 1.0)))
+    np.testing.assert_array_equal(depth._solid(layers((2.0, 2.0)), radius=0.5), layers((2.0, 2.0)))
+
+
+def test_a_chain_splits_into_its_limbs_not_into_their_toes():
+    """Seen from the side: the body (one part), then both legs (two), then each foot's two toes (four)."""
+    node_layers = ([layers((0, 4))] * 6 + [layers((0, 1), (3, 4))] * 6
+                   + [layers((0, 0.4), (0.6, 1), (3, 3.4), (3.6, 4))] * 8)
+    assert depth._layer_count(node_layers) == 2
+    assert depth._layer_count([layers((0, 1))] * 10) == 1
+    assert depth._layer_count([layers((0, 1), (3, 4))] * 10) == 2
+
+
+def straight(length, points=101):
+    return np.stack([np.linspace(0.0, length, points), np.zeros(points), np.zeros(points)], axis=1)
+
+
+@pytest.mark.parametrize("length, bones", [(0.05, 1), (0.1, 1), (0.15, 2), (0.25, 3), (0.4, 4), (0.9, 4)])
+def test_a_straight_chain_gets_one_bone_per_bone_length_begun_up_to_the_limit(length, bones):
+    joints = chain_joints(straight(length), np.radians(40), bone_length=0.1, max_bones=4)
+    assert len(joints) == bones + 1
+    np.testing.assert_allclose(np.diff(joints[:, 0]), length / bones)  # evenly cut
+
+
+def test_corners_get_joints_even_beyond_the_limit():
+    zigzag = np.array([[0, 0, 0], [0.2, 0, 0], [0.2, 0.2, 0], [0.4, 0.2, 0], [0.4, 0.4, 0]], dtype=float)
+    joints = chain_joints(zigzag, np.radians(40), bone_length=0.1, max_bones=2)
+    for corner in zigzag[1:-1]:
+        assert np.linalg.norm(joints - corner, axis=1).min() < 1e-9
+    assert np.linalg.norm(np.diff(joints, axis=0), axis=1).min() >= 0.035 - 1e-9  # no stub bones
