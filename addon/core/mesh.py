@@ -104,15 +104,21 @@ def _as_array(values, what):
         raise ValueError(f"{what} must be a rectangular array of numbers ({error})") from None
 
 
-def _validated_vertices(values):
-    array = _as_array(values, "vertices")
+def _rows_of_three(values, what, kinds, kind_text, count_letter):
+    """``values`` as a non-empty (count, 3) array whose dtype kind is one of ``kinds``, or a ValueError naming
+    ``what`` is wrong."""
+    array = _as_array(values, what)
     if array.size == 0:
-        raise ValueError("mesh has no vertices")
-    if array.dtype.kind not in "iuf":
-        raise ValueError(f"vertices must be real numbers, got dtype {array.dtype}")
+        raise ValueError(f"mesh has no {what}")
+    if array.dtype.kind not in kinds:
+        raise ValueError(f"{what} must be {kind_text}, got dtype {array.dtype}")
     if array.ndim != 2 or array.shape[1] != 3:
-        raise ValueError(f"vertices must have shape (N, 3), got {array.shape}")
-    array = np.array(array, dtype=np.float64)
+        raise ValueError(f"{what} must have shape ({count_letter}, 3), got {array.shape}")
+    return array
+
+
+def _validated_vertices(values):
+    array = np.array(_rows_of_three(values, "vertices", "iuf", "real numbers", "N"), dtype=np.float64)
     if not np.isfinite(array).all():
         bad = np.flatnonzero(~np.isfinite(array).all(axis=1))
         raise ValueError(f"{bad.size} vertices have NaN or infinite coordinates (the first is vertex {bad[0]})")
@@ -120,13 +126,7 @@ def _validated_vertices(values):
 
 
 def _validated_triangles(values, vertex_count):
-    array = _as_array(values, "triangles")
-    if array.size == 0:
-        raise ValueError("mesh has no triangles")
-    if array.dtype.kind not in "iu":
-        raise ValueError(f"triangles must be integer vertex indices, got dtype {array.dtype}")
-    if array.ndim != 2 or array.shape[1] != 3:
-        raise ValueError(f"triangles must have shape (M, 3), got {array.shape}")
+    array = _rows_of_three(values, "triangles", "iu", "integer vertex indices", "M")
     lowest, highest = array.min(), array.max()
     if lowest < 0:
         raise ValueError(f"triangles contain the negative vertex index {lowest}")
