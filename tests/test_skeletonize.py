@@ -4,7 +4,7 @@ import pytest
 
 from rigger.skeletonize import depth
 from rigger.skeletonize.bones import chain_joints
-from rigger.skeletonize.tree import chains_of, rooted_chains
+from rigger.skeletonize.tree import Chain, chains_of, rooted_chains
 
 
 def rooted_path(radius):
@@ -49,6 +49,55 @@ def test_a_chain_splits_into_its_limbs_not_into_their_toes():
     assert depth._layer_count(node_layers) == 2
     assert depth._layer_count([layers((0, 1))] * 10) == 1
     assert depth._layer_count([layers((0, 1), (3, 4))] * 10) == 2
+
+
+def test_plates_of_one_limb_are_one_part():
+    """A robot's forearm seen along the view: shells and plates thinner than the arm is wide, a little apart."""
+    plates = layers((0.0, 0.3), (0.35, 0.6), (0.9, 1.1))
+    np.testing.assert_array_equal(depth._parts(plates, radius=1.0), layers((0.0, 1.1)))
+    legs = layers((0.0, 1.0), (3.0, 4.2))
+    np.testing.assert_array_equal(depth._parts(legs, radius=1.0), legs)
+    assert depth._layer_count([depth._parts(plates, 1.0)] * 10) == 1
+
+
+def test_fingers_fork_off_their_arm_but_legs_split_from_the_body():
+    """An arm (one round part as thick as it is wide), then four fingers apart: the chain forks at the wrist. A leg
+    pair seen from the side runs into the body (one part much thicker than the legs are wide): split from the
+    start."""
+    radius = np.full(20, 0.5)
+    fingers = [layers((0, 0.8), (1, 1.8), (2, 2.8), (3, 3.8))] * 8
+    arm = [layers((1.4, 2.4))] * 12 + fingers
+    assert depth._fork(arm, radius, 4) == 11
+    body = [layers((0, 4))] * 6 + [layers((0, 1), (3, 4))] * 14
+    assert depth._fork(body, radius, 2) == 0
+
+
+class FlatSilhouette:
+    """A stand-in for ``Silhouette``: fixed depth intervals per axis node, depth along z."""
+
+    def __init__(self, node_layers):
+        self.node_layers = node_layers
+
+    def layers(self, points):
+        return [self.node_layers[int(round(x))] for x in points[:, 0]]
+
+    def lift(self, points, depth):
+        return np.column_stack([points, np.broadcast_to(depth, (len(points),))])
+
+
+def test_a_forked_chain_is_one_stem_then_a_chain_per_part():
+    count = 20
+    node_layers = [layers((1.4, 2.4))] * 12 + [layers((0, 0.8), (1, 1.8), (2, 2.8), (3, 3.8))] * 8
+    points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
+    _, placed = depth.place_chains(FlatSilhouette(node_layers), points, np.full(count, 0.5), 0,
+                                   [Chain(list(range(count)), -1)])
+    stem, *fingers = placed
+    assert stem[1] == -1 and len(stem[0]) == 12  # nodes 0..11, the wrist last
+    assert len(fingers) == 4 and all(parent == 0 for _, parent, _ in fingers)
+    for line, _, _ in fingers:
+        np.testing.assert_array_equal(line[0], stem[0][-1])  # each finger starts at the wrist
+    tips = sorted(line[-1, 2] for line, _, _ in fingers)
+    np.testing.assert_allclose(tips, [0.4, 1.4, 2.4, 3.4])  # one per finger, centred in it
 
 
 def straight(length, points=101):

@@ -2,8 +2,9 @@
 
 Each axis node is a ray along the view direction; ``Silhouette.layers`` gives the depth intervals where that ray is
 inside the mesh. A node is centred in one of them, chosen for continuity along its chain. Where a chain's rays cross
-the mesh in k > 1 separate intervals over most of its length (a quadruped's left and right legs seen from the side),
-the chain is split into k chains, one per interval. Where the chosen interval is much thicker than the part is wide
+the mesh in k > 1 separate parts over much of its length (a quadruped's left and right legs seen from the side),
+the chain is split into k chains, one per part, from where the parts come apart (a hand's fingers seen edge-on fork
+off the one arm). Where the chosen interval is much thicker than the part is wide
 (an arm in front of the body merges with it along the ray), the perpendicular silhouette decides, as in Pan et al.:
 its own chordal axis, seen from the side, says at which depth a part of that width and height lies.
 """
@@ -12,6 +13,10 @@ import numpy as np
 # an interval this many times thicker than the part is wide means the part is occluded by (merged with) another
 OCCLUSION_RATIO = 2.5
 THIN = 0.2  # intervals thinner than this many half-widths of the part are sheets, not parts
+SEVERAL = 0.3  # a chain is split when this share of its outer nodes cross the same number (> 1) of parts
+FORK = 0.8  # parts apart over this share of a chain's outer nodes fork where that stretch begins
+ROUND = 1.5  # a part at most this many times as thick along the view as it is wide is one limb, not two side by side
+PART = 0.8  # a separate part (a leg behind a leg) is at least this many of its half-widths thick along the view
 
 
 def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
@@ -37,25 +42,34 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
     placed = []
     origin_of = {}  # placed index -> source chain index
     for ci, chain in enumerate(chains):
-        start_depths = end_depth.get(chain.parent, root_depth)
+        start = end_depth.get(chain.parent, root_depth)
         parents = [p for p, src in origin_of.items() if src == chain.parent]
+        nodes = np.asarray(chain.nodes)
         node_layers = [layers[slot[n]] for n in chain.nodes]
-        copies = _layer_count(node_layers) if split else 1
-        widths = radius[chain.nodes]
+        parts = [_parts(layer, radius[n]) for layer, n in zip(node_layers, chain.nodes)]
+        copies = _layer_count(parts) if split else 1
+        widths = radius[nodes]
         if chain.parent < 0 and root_is_end:
             widths = np.r_[0.0, widths[1:]]  # no branch point here: no disc for the chain to leave (chain_joints)
-        for copy in range(copies):
-            depths = _follow(node_layers, copy, copies, start_depths)
-            depths = _resolve_occlusion(sil, points[chain.nodes], radius[chain.nodes], node_layers, depths, side_axis)
-            line = sil.lift(points[chain.nodes], depths)
-            parent = -1
-            if chain.parent >= 0:
-                # a copy hangs from the copy of its parent chain that ends nearest to it
-                probe = line[min(1, len(line) - 1)]
-                parent = min(parents, key=lambda p: np.linalg.norm(placed[p][0][-1] - probe))
-                line[0] = placed[parent][0][-1]
-            origin_of[len(placed)] = ci
-            placed.append((line, parent, widths))
+        fork = _fork(parts, radius[nodes], copies) if copies > 1 else 0
+        pieces = [(slice(0, fork + 1), 1), (slice(fork, None), copies)] if fork else [(slice(None), copies)]
+        for piece, (part, count) in enumerate(pieces):
+            last = piece == len(pieces) - 1
+            for copy in range(count):
+                depths = _follow((parts if count > 1 else node_layers)[part], copy, count, start)
+                depths = _resolve_occlusion(sil, points[nodes[part]], radius[nodes[part]], node_layers[part], depths,
+                                            side_axis)
+                line = sil.lift(points[nodes[part]], depths)
+                parent = -1
+                if parents:
+                    # a copy hangs from the copy of its parent chain that ends nearest to it
+                    probe = line[min(1, len(line) - 1)]
+                    parent = min(parents, key=lambda p: np.linalg.norm(placed[p][0][-1] - probe))
+                    line[0] = placed[parent][0][-1]
+                if last:
+                    origin_of[len(placed)] = ci
+                placed.append((line, parent, widths[part]))
+            parents, start = [len(placed) - 1], depths[-1]
         end_depth[ci] = depths[-1]
     return sil.lift(points[[root]], [root_depth])[0], placed
 
@@ -71,9 +85,37 @@ def _solid(layer, radius):
     return layer[thick] if thick.any() else layer
 
 
+def _parts(layer, radius):
+    """The intervals of one node that count as separate parts for splitting: those at least ``PART`` times its
+    half-width thick, a limb's round cross-section, not the plates and shells of one limb (a robot's forearm, a
+    sheet); a single part spanning all the intervals when none is that thick."""
+    thick = layer[:, 1] - layer[:, 0] >= PART * radius
+    if thick.any() or not len(layer):
+        return layer[thick]
+    return np.array([[layer[0, 0], layer[-1, 1]]])
+
+
+def _fork(parts, radius, copies):
+    """Where a chain that runs through ``copies`` parts forks into them: the last node before the outer stretch over
+    which (for ``FORK`` of its nodes) the parts are apart, when the chain runs through one round part of its own
+    width before it (a hand's fingers off an arm: one arm, then a chain per finger); else 0, the parts apart from
+    the start (a leg pair seen from the side merges with the body and each other towards its parent)."""
+    apart = np.array([len(layer) >= 2 for layer in parts], dtype=float)
+    share = np.cumsum(apart[::-1])[::-1] / np.arange(len(apart), 0, -1)
+    if not (share >= FORK).any():
+        return 0
+    start = int(np.argmax(share >= FORK))
+    start += int(np.argmax(apart[start:]))  # the stretch begins where the parts are first apart
+    if start < 2 or not any(len(layer) == copies for layer in parts[start:]):
+        return 0
+    thickness = [layer[:, 1].max() - layer[:, 0].min() if len(layer) else 0.0 for layer in parts[:start]]
+    own = np.median(np.array(thickness) / (2 * np.maximum(radius[:start], 1e-300))) <= ROUND
+    return start - 1 if own else 0
+
+
 def _layer_count(node_layers):
     """How many separate parts a chain runs through, judged over its outer two thirds (the part near its parent
-    often runs into the body): the fewest parts (more than one) that a third of those nodes cross, else the most
+    often runs into the body): the fewest parts (more than one) that 30% of those nodes cross, else the most
     frequent count. Fewest, because parts split further towards the tip (a dinosaur's left and right feet, each
     with its toes) are still one limb each."""
     counts = np.array([len(layer) for layer in node_layers])
@@ -82,7 +124,7 @@ def _layer_count(node_layers):
     if not len(outer):
         return 1
     frequency = np.bincount(outer)
-    several = np.flatnonzero(frequency[2:] * 3 >= len(outer)) + 2
+    several = np.flatnonzero(frequency[2:] >= SEVERAL * len(outer)) + 2
     return int(several[0]) if len(several) else int(np.argmax(frequency))
 
 
