@@ -117,3 +117,34 @@ def test_corners_get_joints_even_beyond_the_limit():
     for corner in zigzag[1:-1]:
         assert np.linalg.norm(joints - corner, axis=1).min() < 1e-9
     assert np.linalg.norm(np.diff(joints, axis=0), axis=1).min() >= 0.035 - 1e-9  # no stub bones
+
+
+def test_a_line_jittering_in_depth_gets_no_stub_bones():
+    """A leg whose depth flickers between two values near the knee: its arc length grows, its bones must not
+    shrink to stubs there."""
+    line = straight(0.4)
+    line[45:55:2, 2] = 0.03  # every other point 0.03 off: many short corners within a tenth of a bone
+    joints = chain_joints(line, np.radians(40), bone_length=0.1, max_bones=4, widths=np.full(len(line), 0.01))
+    assert np.linalg.norm(np.diff(joints, axis=0), axis=1).min() >= 0.035 - 1e-9
+
+
+class FixedSide:
+    """A stand-in for ``SideAxis`` that puts every occluded node at depth 0 (the body's middle)."""
+
+    def depth_at(self, sil, point, radius, interval, previous):
+        return 0.0
+
+
+def test_one_node_seeing_two_legs_as_one_part_is_a_slip_not_an_occlusion():
+    """A leg at depth 3: one node's ray pairs its hits across both legs (one thick interval); the leg stays put.
+    Several such nodes in a row are an occlusion (an arm in front of the body): the side view decides there."""
+    sil = FlatSilhouette(None)
+    sil.cell = 0.01
+    leg, merged = layers((2.5, 3.5)), layers((-3.5, 3.5))
+    points, radius = np.zeros((9, 2)), np.full(9, 0.5)
+    slip = [leg] * 4 + [merged] + [leg] * 4
+    depths = depth._resolve_occlusion(sil, points, radius, slip, np.full(9, 3.0), FixedSide())
+    np.testing.assert_array_equal(depths, 3.0)
+    occluded = [leg] * 3 + [merged] * 3 + [leg] * 3
+    depths = depth._resolve_occlusion(sil, points, radius, occluded, np.full(9, 3.0), FixedSide())
+    np.testing.assert_array_equal(depths, [3, 3, 3, 0, 0, 0, 3, 3, 3])

@@ -11,20 +11,23 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None):
     where it leaves that point's disc (``widths[0]``): where a limb meets the body, like a hip or a shoulder. Every
     corner where the simplified line turns by more than ``bone_angle`` radians gets a joint (an elbow, a knee), and
     so does every bend that would take a straight bone out of the part (a snake's curves), the sharpest first where
-    two are closer than a third of a bone. The pieces between are cut evenly into one bone per bone length begun
-    (``ceil(length / bone_length)`` in all: the artist rigs of the quality benchmark give a chain about one more
-    bone than ``length / bone_length``, a hand or a foot), at most ``max_bones`` when positive unless the corners
-    need more or a bone would be longer than ``LONGEST`` bone lengths.
+    two lie closer than a third of a bone (measured straight: a line that jitters in depth makes no stub bones).
+    The pieces between are cut evenly into one bone per bone length begun (``ceil(length / bone_length)`` in all:
+    the artist rigs of the quality benchmark give a chain about one more bone than ``length / bone_length``, a hand
+    or a foot), at most ``max_bones`` when positive unless the corners need more or a bone would be longer than
+    ``LONGEST`` bone lengths.
     """
     widths = np.zeros(len(line)) if widths is None else widths
     arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))]
     wanted = max(1, int(np.ceil(arc[-1] / bone_length - 1e-9)))  # one bone per bone length begun
     if max_bones > 0:
         wanted = min(wanted, max_bones)
-    stops = [0.0, arc[-1]]
+    stops, places = [0.0, arc[-1]], [line[0], line[-1]]
     for at in _candidate_stops(line, arc, widths, bone_angle, bone_length):
-        if min(abs(at - stop) for stop in stops) >= 0.35 * bone_length:
+        place = _point_at(line, arc, at)
+        if min(np.linalg.norm(place - other) for other in places) >= 0.35 * bone_length:
             stops.append(at)
+            places.append(place)
     stops.sort()
     lengths = np.diff(stops)
     counts = _share(lengths, max(wanted, len(lengths)))
@@ -32,7 +35,12 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None):
     at = [0.0]
     for start, length, count in zip(stops[:-1], lengths, counts):
         at.extend(start + length * np.arange(1, count + 1) / count)
-    return np.stack([np.interp(at, arc, line[:, d]) for d in range(3)], axis=1)
+    return _point_at(line, arc, np.array(at))
+
+
+def _point_at(line, arc, at):
+    """The point(s) at arc length(s) ``at`` along a polyline whose cumulative arc lengths are ``arc``."""
+    return np.stack([np.interp(at, arc, line[:, d]) for d in range(3)], axis=-1)
 
 
 def _candidate_stops(line, arc, widths, bone_angle, bone_length):

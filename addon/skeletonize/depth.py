@@ -162,20 +162,24 @@ def _track(node_layers, order, previous, depths, stay=False):
 def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
     """Where a node's interval is much thicker than its part is wide, take the depth from the side view instead,
     choosing among the side-view candidates the one closest to the previous node's depth (so a chain never
-    hops between two legs that the side view shows at the same height)."""
+    hops between two legs that the side view shows at the same height). A thick interval at one node alone, between
+    nodes that see the part by itself, is a slip of the ray casting (hits paired across two legs), not an arm in
+    front of the body: it is left alone."""
     if side_axis is None:
         return depths
     out = depths.copy()
     previous = depths[0]
     typical = max(float(np.median(radius)), sil.cell)  # not the tip's vanishing radius
     limits = (OCCLUSION_RATIO * 2 * np.maximum(radius, typical)).tolist()
-    for i, (layer, depth) in enumerate(zip(node_layers, depths.tolist())):
-        if len(layer):
-            low, high = min(layer.tolist(), key=lambda interval: abs(0.5 * (interval[0] + interval[1]) - depth))
-            if high - low > limits[i]:
-                found = side_axis.depth_at(sil, points[i], radius[i], (low, high), previous)
-                if found is not None:
-                    out[i] = found
+    chosen = [min(layer.tolist(), key=lambda interval: abs(0.5 * (interval[0] + interval[1]) - depth))
+              if len(layer) else None for layer, depth in zip(node_layers, depths.tolist())]
+    thick = np.array([c is not None and c[1] - c[0] > limit for c, limit in zip(chosen, limits)])
+    thick &= np.r_[False, thick[:-1]] | np.r_[thick[1:], False]  # a single node is a tracing slip, not a body
+    for i, interval in enumerate(chosen):
+        if thick[i]:
+            found = side_axis.depth_at(sil, points[i], radius[i], tuple(interval), previous)
+            if found is not None:
+                out[i] = found
         previous = out[i]
     return out
 
