@@ -111,6 +111,14 @@ def test_a_straight_chain_gets_one_bone_per_bone_length_begun_up_to_the_limit(le
     np.testing.assert_allclose(np.diff(joints[:, 0]), length / bones)  # evenly cut
 
 
+def test_a_finger_gets_two_bones_a_short_link_one():
+    """A leaf chain (a finger) half a bone long or more gets two bones, as artists give it; a link between two
+    branch points that short gets one, and a stub of a leaf one."""
+    assert len(chain_joints(straight(0.07), np.radians(40), bone_length=0.1, max_bones=4, leaf=True)) == 3
+    assert len(chain_joints(straight(0.07), np.radians(40), bone_length=0.1, max_bones=4)) == 2
+    assert len(chain_joints(straight(0.04), np.radians(40), bone_length=0.1, max_bones=4, leaf=True)) == 2
+
+
 def test_corners_get_joints_even_beyond_the_limit():
     zigzag = np.array([[0, 0, 0], [0.2, 0, 0], [0.2, 0.2, 0], [0.4, 0.2, 0], [0.4, 0.4, 0]], dtype=float)
     joints = chain_joints(zigzag, np.radians(40), bone_length=0.1, max_bones=2)

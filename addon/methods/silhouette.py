@@ -260,8 +260,10 @@ class _BoneBuilder:
         roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
         trunk = max(roots, key=lambda i: placed[i][2].mean())
         order = [trunk] + [i for i in range(len(placed)) if i != trunk]
-        joints = self._symmetric([chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths)
-                                  for line, _, widths in placed], [line for line, _, _ in placed])
+        inner = {parent for _, parent, _ in placed}
+        joints = self._symmetric([chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths,
+                                               leaf=i not in inner)
+                                  for i, (line, _, widths) in enumerate(placed)], [line for line, _, _ in placed])
         attach = self._attachment(root_point)
         last_bone, first_bone = {}, {}
         for i in order:
@@ -279,7 +281,8 @@ class _BoneBuilder:
         """Bones along extra chains, (polyline, half-widths) each, hung from the bone nearest their start."""
         if not limbs:
             return
-        joints = self._symmetric([chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths)
+        joints = self._symmetric([chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths,
+                                               leaf=True)
                                   for line, widths in limbs], [line for line, _ in limbs])
         for (line, _), along in zip(limbs, joints):
             self._add_chain(line, along, self._attachment(line[0]))
