@@ -89,6 +89,8 @@ def _parts(layer, radius):
     """The intervals of one node that count as separate parts for splitting: those at least ``PART`` times its
     half-width thick, a limb's round cross-section, not the plates and shells of one limb (a robot's forearm, a
     sheet); a single part spanning all the intervals when none is that thick."""
+    if len(layer) < 2:
+        return layer  # the common case, kept free of numpy calls: nodes are many
     thick = layer[:, 1] - layer[:, 0] >= PART * radius
     if thick.any() or not len(layer):
         return layer[thick]
