@@ -22,4 +22,4 @@ def components(count, links):
             if (grand == parent).all():
                 break
             parent = grand
-    return np.unique(parent, return_inverse=True)[1] if count else parent
+    return np.unique(parent, return_inverse=True)[1]

@@ -16,7 +16,7 @@ from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
 from ..core.timing import StageClock
-from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mirror_plane
+from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mirror_plane, mirrored, resampled
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
 from ..skeletonize.second_view import segment_distances, uncovered, uncovered_limbs
@@ -29,6 +29,7 @@ MIN_BRANCH = 0.5  # branches sticking out less than this many bone lengths are d
 AXIS_NAMES = ("X", "Y", "Z")
 MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
 SAME_SHAPE = 0.6  # ... and get mirrored joints when their shapes agree this closely (in tolerances)
+SHAPE_SAMPLES = 9  # points along each chain compared for that
 HIDDEN_REACH = 1.0  # side-view limb tips this many bone lengths off the skeleton (seen from the side) are missing
 
 
@@ -230,13 +231,6 @@ def _islands(graph, alive, links):
     return [(nodes, sub, size) for size, nodes, sub in result]
 
 
-def _resampled(line, count=9):
-    """``count`` points evenly spaced by arc length along a polyline."""
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))]
-    at = np.linspace(0.0, arc[-1], count)
-    return np.stack([np.interp(at, arc, line[:, d]) for d in range(3)], axis=1)
-
-
 def _removed(before, after):
     kept = set(map(tuple, np.sort(after, axis=1).tolist())) if len(after) else set()
     gone = [pair for pair in np.sort(before, axis=1).tolist() if tuple(pair) not in kept]
@@ -252,8 +246,7 @@ class _BoneBuilder:
         self.plane, self.tolerance = plane, tolerance
         self.heads, self.tails, self.parents = [], [], []
         self.chain_of_bone, self.index_in_chain = [], []
-        self.lines = []
-        self.chains = 0
+        self.lines = []  # one polyline per chain, indexed by chain number
 
     def add_island(self, root_point, placed):
         """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk."""
@@ -261,9 +254,7 @@ class _BoneBuilder:
         trunk = max(roots, key=lambda i: placed[i][2].mean())
         order = [trunk] + [i for i in range(len(placed)) if i != trunk]
         inner = {parent for _, parent, _ in placed}
-        joints = self._symmetric([chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths,
-                                               leaf=i not in inner)
-                                  for i, (line, _, widths) in enumerate(placed)], [line for line, _, _ in placed])
+        joints = self._joints([(line, widths, i not in inner) for i, (line, _, widths) in enumerate(placed)])
         attach = self._attachment(root_point)
         last_bone, first_bone = {}, {}
         for i in order:
@@ -281,17 +272,20 @@ class _BoneBuilder:
         """Bones along extra chains, (polyline, half-widths) each, hung from the bone nearest their start."""
         if not limbs:
             return
-        joints = self._symmetric([chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths,
-                                               leaf=True)
-                                  for line, widths in limbs], [line for line, _ in limbs])
+        joints = self._joints([(line, widths, True) for line, widths in limbs])
         for (line, _), along in zip(limbs, joints):
             self._add_chain(line, along, self._attachment(line[0]))
+
+    def _joints(self, chains):
+        """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror pairs made symmetric."""
+        return self._symmetric([chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths,
+                                             leaf=leaf) for line, widths, leaf in chains],
+                               [line for line, _, _ in chains])
 
     def _add_chain(self, line, joints, up):
         """Bones between consecutive ``joints`` of one chain, the first hanging from bone ``up``; returns the
         indices of the bones added (none where the joints coincide)."""
-        chain = self.chains
-        self.chains += 1
+        chain = len(self.lines)
         self.lines.append(line)
         added = []
         for k in range(len(joints) - 1):
@@ -312,23 +306,19 @@ class _BoneBuilder:
         attaches to its parent."""
         if self.plane is None:
             return joints
-        axis, offset = self.plane
         for i, j in mirror_chain_pairs(lines, self.plane, self.tolerance):
-            image_of_j = _resampled(lines[j])
-            image_of_j[:, axis] = 2 * offset - image_of_j[:, axis]
-            if np.linalg.norm(_resampled(lines[i]) - image_of_j, axis=1).max() > SAME_SHAPE * self.tolerance:
+            image_of_j = mirrored(resampled(lines[j], SHAPE_SAMPLES), self.plane)
+            apart = np.linalg.norm(resampled(lines[i], SHAPE_SAMPLES) - image_of_j, axis=1).max()
+            if apart > SAME_SHAPE * self.tolerance:
                 continue  # ends that mirror, shapes that do not (a leg stepping forward): leave both as they are
             a, b = joints[i], joints[j]
-            mirrored = b.copy()
-            mirrored[:, axis] = 2 * offset - mirrored[:, axis]
+            b_image = mirrored(b, self.plane)
             if len(a) == len(b):
-                mean = (a + mirrored) / 2
+                mean = (a + b_image) / 2
             else:
-                mean = a if len(a) > len(b) else mirrored
-            image = mean.copy()
-            image[:, axis] = 2 * offset - image[:, axis]
+                mean = a if len(a) > len(b) else b_image
             joints[i] = np.vstack([a[:1], mean[1:]])
-            joints[j] = np.vstack([b[:1], image[1:]])
+            joints[j] = np.vstack([b[:1], mirrored(mean, self.plane)[1:]])
         return joints
 
     def add_blob(self, sil, point2d, radius):
@@ -337,14 +327,8 @@ class _BoneBuilder:
         depth = 0.5 * (layers[0, 0] + layers[-1, 1]) if len(layers) else 0.0
         centre = sil.lift(point2d[None], [depth])[0]
         half = max(radius, sil.cell) * sil.v
-        attach = self._attachment(centre)
-        self.heads.append(centre - half)
-        self.tails.append(centre + half)
-        self.parents.append(attach)
-        self.chain_of_bone.append(self.chains)
-        self.index_in_chain.append(0)
-        self.lines.append(np.array([centre - half, centre + half]))
-        self.chains += 1
+        ends = np.array([centre - half, centre + half])
+        self._add_chain(ends, ends, self._attachment(centre))
 
     def _attachment(self, point):
         """The bone nearest ``point`` (for a new island), or -1 for the first island."""

@@ -1,6 +1,8 @@
 """Bones from 3D chains: where joints go along a chain, the bone hierarchy, and names with mirror suffixes."""
 import numpy as np
 
+from ..core.arrays import column_bounds
+
 LONGEST = 3.0  # no bone longer than this many bone lengths, whatever max_bones says (a straight leg gets a knee)
 
 
@@ -19,21 +21,21 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=F
     least two bones, as the artists' leaf chains that long have (1.9 on average).
     """
     widths = np.zeros(len(line)) if widths is None else widths
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))]
+    arc = arc_lengths(line)
     wanted = max(1, int(np.ceil(arc[-1] / bone_length - 1e-9)))  # one bone per bone length begun
     if leaf and arc[-1] >= 0.5 * bone_length:
         wanted = max(wanted, 2)
     if max_bones > 0:
         wanted = min(wanted, max_bones)
     stops, places = [0.0, arc[-1]], [line[0], line[-1]]
-    for at in _candidate_stops(line, arc, widths, bone_angle, bone_length):
-        place = _point_at(line, arc, at)
+    candidates = _candidate_stops(line, arc, widths, bone_angle, bone_length)
+    for at, place in zip(candidates, _point_at(line, arc, np.array(candidates, dtype=float))):
         if min(np.linalg.norm(place - other) for other in places) >= 0.35 * bone_length:
             stops.append(at)
             places.append(place)
     stops.sort()
     lengths = np.diff(stops)
-    counts = _share(lengths, max(wanted, len(lengths)))
+    counts = _share(lengths, wanted)
     counts = np.maximum(counts, np.ceil(lengths / (LONGEST * bone_length)).astype(int))
     at = [0.0]
     for start, length, count in zip(stops[:-1], lengths, counts):
@@ -44,6 +46,25 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=F
 def _point_at(line, arc, at):
     """The point(s) at arc length(s) ``at`` along a polyline whose cumulative arc lengths are ``arc``."""
     return np.stack([np.interp(at, arc, line[:, d]) for d in range(3)], axis=-1)
+
+
+def arc_lengths(line):
+    """Cumulative length along a polyline, from 0 at its first point."""
+    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))]
+
+
+def resampled(line, count):
+    """``count`` points evenly spaced by arc length along a polyline."""
+    arc = arc_lengths(line)
+    return _point_at(line, arc, np.linspace(0.0, arc[-1], count))
+
+
+def mirrored(points, plane):
+    """A copy of ``points`` (..., 3) reflected across ``plane`` = (axis, offset)."""
+    axis, offset = plane
+    image = np.array(points, dtype=float)
+    image[..., axis] = 2 * offset - image[..., axis]
+    return image
 
 
 def _candidate_stops(line, arc, widths, bone_angle, bone_length):
@@ -122,7 +143,7 @@ def mirror_plane(vertices, tolerance, samples=600):
     (up to ``samples``) vertices have a mirror image among the vertices within ``tolerance``: vertices are hashed to
     a grid of that size and the mirrored ones looked up in the sorted hashes, with their 26 neighbour cells.
     """
-    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    low, high = column_bounds(vertices)
     origin = low - 2 * tolerance
     span = np.floor((high - low) / tolerance).astype(np.int64) + 5
     table = np.unique(_cell_keys(np.floor((vertices - origin) / tolerance).astype(np.int64), span))
@@ -132,9 +153,7 @@ def mirror_plane(vertices, tolerance, samples=600):
     best = None
     for axis in range(3):
         centre = 0.5 * (low[axis] + high[axis])
-        mirrored = probe.copy()
-        mirrored[:, axis] = 2 * centre - mirrored[:, axis]
-        cells = np.floor((mirrored - origin) / tolerance).astype(np.int64)
+        cells = np.floor((mirrored(probe, (axis, centre)) - origin) / tolerance).astype(np.int64)
         around = np.clip(cells[:, None, :] + offsets[None], 0, span - 1).reshape(-1, 3)
         keys = _cell_keys(around, span)
         at = np.minimum(np.searchsorted(table, keys), len(table) - 1)
@@ -151,16 +170,14 @@ def _cell_keys(cells, span):
 def mirror_chain_pairs(lines, plane, tolerance):
     """Pairs (i, j) of chains (3D polylines) that are mirror images of each other across ``plane`` = (axis, offset):
     their ends match the mirrored ends within ``tolerance``. Chains on the plane are never paired."""
-    axis, offset = plane
     ends = np.array([[line[0], line[-1]] for line in lines])  # (C, 2, 3)
-    mirrored = ends.copy()
-    mirrored[:, :, axis] = 2 * offset - mirrored[:, :, axis]
+    images = mirrored(ends, plane)
     side = np.array([_side(line, plane, tolerance) for line in lines])
     pairs, taken = [], set()
     for i in range(len(lines)):
         if i in taken or side[i] == 0:
             continue
-        cost = np.linalg.norm(ends - mirrored[i], axis=2).sum(axis=1)
+        cost = np.linalg.norm(ends - images[i], axis=2).sum(axis=1)
         cost[(side != -side[i]) | np.isin(np.arange(len(lines)), list(taken))] = np.inf
         j = int(np.argmin(cost))
         if cost[j] <= 2 * tolerance:

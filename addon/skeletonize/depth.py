@@ -38,38 +38,39 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
     root_layers = layers[slot[root]]
     root_depth = _middle(root_layers[np.argmax(root_layers[:, 1] - root_layers[:, 0])]) if len(root_layers) else 0.0
     end_depth = {-1: root_depth}
+    ends_of = {-1: []}  # chain -> the placed entries its child chains hang from (its outer copies)
     root_is_end = sum(chain.parent < 0 for chain in chains) == 1
     placed = []
-    origin_of = {}  # placed index -> source chain index
     for ci, chain in enumerate(chains):
-        start = end_depth.get(chain.parent, root_depth)
-        parents = [p for p, src in origin_of.items() if src == chain.parent]
         nodes = np.asarray(chain.nodes)
+        chain_points, chain_radius = points[nodes], radius[nodes]
         node_layers = [layers[slot[n]] for n in chain.nodes]
-        parts = [_parts(layer, radius[n]) for layer, n in zip(node_layers, chain.nodes)]
-        copies = _layer_count(parts) if split else 1
-        widths = radius[nodes]
+        copies = 1
+        if split:
+            parts = [_parts(layer, r) for layer, r in zip(node_layers, chain_radius)]
+            copies = _layer_count(parts)
+        widths = chain_radius
         if chain.parent < 0 and root_is_end:
             widths = np.r_[0.0, widths[1:]]  # no branch point here: no disc for the chain to leave (chain_joints)
-        fork = _fork(parts, radius[nodes], copies) if copies > 1 else 0
+        fork = _fork(parts, chain_radius, copies) if copies > 1 else 0
         pieces = [(slice(0, fork + 1), 1), (slice(fork, None), copies)] if fork else [(slice(None), copies)]
-        for piece, (part, count) in enumerate(pieces):
-            last = piece == len(pieces) - 1
+        parents = ends_of[chain.parent]
+        for part, count in pieces:
+            first = len(placed)
             for copy in range(count):
-                depths = _follow((parts if count > 1 else node_layers)[part], copy, count, start)
-                depths = _resolve_occlusion(sil, points[nodes[part]], radius[nodes[part]], node_layers[part], depths,
+                depths = _follow((parts if count > 1 else node_layers)[part], copy, count, end_depth[chain.parent])
+                depths = _resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part], depths,
                                             side_axis)
-                line = sil.lift(points[nodes[part]], depths)
+                line = sil.lift(chain_points[part], depths)
                 parent = -1
                 if parents:
                     # a copy hangs from the copy of its parent chain that ends nearest to it
                     probe = line[min(1, len(line) - 1)]
                     parent = min(parents, key=lambda p: np.linalg.norm(placed[p][0][-1] - probe))
                     line[0] = placed[parent][0][-1]
-                if last:
-                    origin_of[len(placed)] = ci
                 placed.append((line, parent, widths[part]))
-            parents, start = [len(placed) - 1], depths[-1]
+            parents = list(range(first, len(placed)))
+        ends_of[ci] = parents
         end_depth[ci] = depths[-1]
     return sil.lift(points[[root]], [root_depth])[0], placed
 
@@ -81,6 +82,8 @@ def _middle(interval):
 def _solid(layer, radius):
     """One node's depth intervals without those thinner than ``THIN`` times its half-width when a thicker one
     exists: the zero-thickness intervals of open sheets (a cloak's hem) are not parts a chain should split into."""
+    if len(layer) < 2:
+        return layer  # the common case, kept free of numpy calls: nodes are many
     thick = layer[:, 1] - layer[:, 0] >= THIN * radius
     return layer[thick] if thick.any() else layer
 
@@ -92,7 +95,7 @@ def _parts(layer, radius):
     if len(layer) < 2:
         return layer  # the common case, kept free of numpy calls: nodes are many
     thick = layer[:, 1] - layer[:, 0] >= PART * radius
-    if thick.any() or not len(layer):
+    if thick.any():
         return layer[thick]
     return np.array([[layer[0, 0], layer[-1, 1]]])
 
@@ -179,7 +182,7 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
     thick &= np.r_[False, thick[:-1]] | np.r_[thick[1:], False]  # a single node is a tracing slip, not a body
     for i, interval in enumerate(chosen):
         if thick[i]:
-            found = side_axis.depth_at(sil, points[i], radius[i], tuple(interval), previous)
+            found = side_axis.depth_at(sil, points[i], radius[i], interval, previous)
             if found is not None:
                 out[i] = found
         previous = out[i]

@@ -120,7 +120,8 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0):
         if not spurs:
             return _links_of(chains)
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
-        kept = [c for i, c in enumerate(chains) if i not in set(spurs)]
+        spurs = set(spurs)
+        kept = [c for i, c in enumerate(chains) if i not in spurs]
         if not kept:
             return np.zeros((0, 2), dtype=np.int64)
         _, chains = chains_of(sorted({n for c in kept for n in c}), _links_of(kept))
