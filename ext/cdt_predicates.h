@@ -73,10 +73,8 @@ static int rg_grow(int elen, const double *e, double b, double *h) {
 }
 
 /* h = e + f in linear time: take the components of both in order of magnitude and carry one running sum through
- * them (Fast-Expansion-Sum). h must hold elen + flen doubles and may not alias e or f; ``unused`` is kept for the
- * callers' buffers. Returns length. */
-static int rg_sum(int elen, const double *e, int flen, const double *f, double *h, double *unused) {
-    (void)unused;
+ * them (Fast-Expansion-Sum). h must hold elen + flen doubles and may not alias e or f. Returns length. */
+static int rg_sum(int elen, const double *e, int flen, const double *f, double *h) {
     int i = 0, j = 0, n = 0;
     double q, hh, next;
     if (elen == 0 && flen == 0) {
@@ -112,14 +110,14 @@ static int rg_scale(int elen, const double *e, double b, double *h) {
     return n;
 }
 
-/* h = e * f. h must hold 2 * elen * flen doubles; scratch likewise (twice). Returns length. */
+/* h = e * f. h and scratch must each hold 2 * elen * flen doubles. Returns length. */
 static int rg_mul(int elen, const double *e, int flen, const double *f, double *h, double *scratch) {
     double part[2 * 16];
-    double *acc = scratch, *tmp = scratch + 2 * elen * flen;
+    double *acc = scratch;
     int n = 0;
     for (int j = 0; j < flen; j++) {
         int pn = rg_scale(elen, e, f[j], part);
-        n = rg_sum(n, acc, pn, part, h, tmp);
+        n = rg_sum(n, acc, pn, part, h);
         for (int i = 0; i < n; i++) acc[i] = h[i];
     }
     for (int i = 0; i < n; i++) h[i] = acc[i];
@@ -172,14 +170,14 @@ static inline int rg_sign(double x) { return (x > 0.0) - (x < 0.0); }
  * decides when the differences were exact (nearby points) or when it clears the second-stage bound; otherwise the
  * determinant is expanded from the raw coordinates. */
 static int rg_orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy, double detsum) {
-    double acx, acy, bcx, bcy, t0, t1, t2, t3, l[2], r[2], e[12], merged[12];
+    double acx, acy, bcx, bcy, t0, t1, t2, t3, l[2], r[2], e[12];
     rg_two_diff(ax, cx, &acx, &t0);
     rg_two_diff(ay, cy, &acy, &t1);
     rg_two_diff(bx, cx, &bcx, &t2);
     rg_two_diff(by, cy, &bcy, &t3);
     rg_two_product(acx, bcy, &l[1], &l[0]);
     rg_two_product(-acy, bcx, &r[1], &r[0]);
-    int n = rg_sum(2, l, 2, r, e, merged);
+    int n = rg_sum(2, l, 2, r, e);
     if (t0 == 0.0 && t1 == 0.0 && t2 == 0.0 && t3 == 0.0) return rg_sign_of(n, e);
     double est = rg_estimate(n, e);
     if (fabs(est) >= rigger_ccw_bound_b * detsum) return rg_sign(est);
@@ -203,28 +201,28 @@ static inline int rg_orient2d(double ax, double ay, double bx, double by, double
 
 /* Exact x^2 + y^2 (4 doubles). */
 static int rg_lift(double x, double y, double *out) {
-    double xx[2], yy[2], scratch[4];
+    double xx[2], yy[2];
     rg_two_product(x, x, &xx[1], &xx[0]);
     rg_two_product(y, y, &yy[1], &yy[0]);
-    return rg_sum(2, xx, 2, yy, out, scratch);
+    return rg_sum(2, xx, 2, yy, out);
 }
 
 static int rg_incircle_exact(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy) {
     /* det of rows (x, y, x^2 + y^2, 1) for a, b, c, d, expanded along the lifted column:
      * l_a |bcd| - l_b |acd| + l_c |abd| - l_d |abc|, positive when d is inside the circle of ccw a, b, c. */
     const double px[4] = {ax, bx, cx, dx}, py[4] = {ay, by, cy, dy};
-    double total[4 * 96 + 8], next[4 * 96 + 8], scratch[4 * 96 + 8];
+    double total[4 * 96 + 8], next[4 * 96 + 8];
     int tn = 0;
     for (int i = 0; i < 4; i++) {
         int idx[3], m = 0;
         for (int j = 0; j < 4; j++) if (j != i) idx[m++] = j;
-        double minor[12], lift[4], prod[96], mulscratch[2 * 96];
+        double minor[12], lift[4], prod[96], mulscratch[96];
         int mn = rg_orient_exact_expansion(px[idx[0]], py[idx[0]], px[idx[1]], py[idx[1]], px[idx[2]], py[idx[2]],
                                            minor);
         int ln = rg_lift(px[i], py[i], lift);
         int pn = rg_mul(mn, minor, ln, lift, prod, mulscratch);
         if (i & 1) for (int k = 0; k < pn; k++) prod[k] = -prod[k];
-        tn = rg_sum(tn, total, pn, prod, next, scratch);
+        tn = rg_sum(tn, total, pn, prod, next);
         for (int k = 0; k < tn; k++) total[k] = next[k];
     }
     return tn ? rg_sign_of(tn, total) : 0;
@@ -232,13 +230,13 @@ static int rg_incircle_exact(double ax, double ay, double bx, double by, double 
 
 /* x * (p*q - r*s) * x + y * (p*q - r*s) * y, exactly, for one row of the translated in-circle determinant. */
 static int rg_lifted_minor(double x, double y, double p, double q, double r, double s, double *out) {
-    double pq[2], rs[2], minor[4], xm[8], xxm[16], ym[8], yym[16], merged[32];
+    double pq[2], rs[2], minor[4], xm[8], xxm[16], ym[8], yym[16];
     rg_two_product(p, q, &pq[1], &pq[0]);
     rg_two_product(-r, s, &rs[1], &rs[0]);
-    int mn = rg_sum(2, pq, 2, rs, minor, merged);
+    int mn = rg_sum(2, pq, 2, rs, minor);
     int n1 = rg_scale(rg_scale(mn, minor, x, xm), xm, x, xxm);
     int n2 = rg_scale(rg_scale(mn, minor, y, ym), ym, y, yym);
-    return rg_sum(n1, xxm, n2, yym, out, merged);
+    return rg_sum(n1, xxm, n2, yym, out);
 }
 
 /* One row l * m of the translated in-circle determinant, l = x^2 + y^2 and m = p*q - r*s, as hi + lo in double-double
@@ -277,12 +275,12 @@ static inline double rg_incircle_dd(double adx, double ady, double bdx, double b
 /* Exact determinant of the rounded differences as an expansion, for when they are exact (t = 0) but the double-double
  * estimate was too close to zero. */
 static int rg_incircle_expansion(double adx, double ady, double bdx, double bdy, double cdx, double cdy, double *all) {
-    double ra[32], rb[32], rc[32], ab[64], merged[96];
+    double ra[32], rb[32], rc[32], ab[64];
     int na = rg_lifted_minor(adx, ady, bdx, cdy, cdx, bdy, ra);
     int nb = rg_lifted_minor(bdx, bdy, cdx, ady, adx, cdy, rb);
     int nc = rg_lifted_minor(cdx, cdy, adx, bdy, bdx, ady, rc);
-    int nab = rg_sum(na, ra, nb, rb, ab, merged);
-    return rg_sum(nab, ab, nc, rc, all, merged);
+    int nab = rg_sum(na, ra, nb, rb, ab);
+    return rg_sum(nab, ab, nc, rc, all);
 }
 
 /* In-circle sign once the plain filter failed (near-cocircular): the determinant of the rounded differences in

@@ -71,20 +71,7 @@ cdef class Trace:
         """The outline as a list of (K, 2) float64 arrays."""
         cdef int64_t n = sil_loop_count(self.handle)
         cdef const int64_t *offsets = sil_loop_offsets(self.handle)
-        cdef const double *xy = sil_loop_points(self.handle)
-        cdef int64_t k, i, first, count
-        cdef double[:, ::1] view
-        loops = []
-        for k in range(n):
-            first = offsets[k]
-            count = offsets[k + 1] - first
-            loop = np.empty((count, 2))
-            view = loop
-            for i in range(count):
-                view[i, 0] = xy[2 * (first + i)]
-                view[i, 1] = xy[2 * (first + i) + 1]
-            loops.append(loop)
-        return loops
+        return _rows(n, offsets, sil_loop_points(self.handle))
 
     def depth(self, const double[:, ::1] points):
         """Nearest and farthest hit depth per (P, 2) frame point; NaN where the ray misses."""
@@ -109,23 +96,11 @@ cdef class Trace:
         cdef int code = sil_layers(self.handle, &points[0, 0], n, &offsets, &intervals)
         if code != SIL_OK:
             raise_for(code)
-        cdef int64_t p, i, first, count
-        cdef double[:, ::1] view
-        result = []
         try:
-            for p in range(n):
-                first = offsets[p]
-                count = offsets[p + 1] - first
-                layer = np.empty((count, 2))
-                view = layer
-                for i in range(count):
-                    view[i, 0] = intervals[2 * (first + i)]
-                    view[i, 1] = intervals[2 * (first + i) + 1]
-                result.append(layer)
+            return _rows(n, offsets, intervals)
         finally:
             sil_release(offsets)
             sil_release(intervals)
-        return result
 
 
 def trace(const double[:, ::1] vertices, const int64_t[:, ::1] triangles, const double[::1] direction, int resolution,
@@ -145,3 +120,21 @@ def trace(const double[:, ::1] vertices, const int64_t[:, ::1] triangles, const 
     result = Trace.__new__(Trace)
     (<Trace>result).handle = handle
     return result
+
+
+cdef list _rows(int64_t n, const int64_t *offsets, const double *xy):
+    """Group ``n`` runs of interleaved (x, y) pairs, run k from pair offsets[k] to offsets[k + 1], into a list of
+    (K, 2) float64 arrays."""
+    cdef int64_t k, i, first, count
+    cdef double[:, ::1] view
+    rows = []
+    for k in range(n):
+        first = offsets[k]
+        count = offsets[k + 1] - first
+        row = np.empty((count, 2))
+        view = row
+        for i in range(count):
+            view[i, 0] = xy[2 * (first + i)]
+            view[i, 1] = xy[2 * (first + i) + 1]
+        rows.append(row)
+    return rows
