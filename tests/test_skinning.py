@@ -22,6 +22,7 @@ from rigger import samples  # noqa: E402
 from rigger.blender import skinning  # noqa: E402
 from rigger.blender.armature import build_armature  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
+from rigger.skeletonize.second_view import segment_distances  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "bench"))
 import rigdata  # noqa: E402  (bench/ is not a package)
@@ -66,13 +67,6 @@ def world_bones(armature, names):
     ends = np.array([[armature.data.bones[n].head_local, armature.data.bones[n].tail_local] for n in names])
     ends = ends @ matrix[:3, :3].T + matrix[:3, 3]
     return ends[:, 0], ends[:, 1]
-
-
-def segment_distances(points, heads, tails):
-    """(N, B) distance from every point to every bone segment."""
-    axis = tails - heads
-    t = np.clip(((points[:, None] - heads) * axis).sum(-1) / (axis * axis).sum(-1), 0.0, 1.0)
-    return np.linalg.norm(heads + t[..., None] * axis - points[:, None], axis=-1)
 
 
 def assert_skinned(obj, armature, report, checked=slice(None), nearest_share=NEAREST_SHARE):

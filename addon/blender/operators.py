@@ -54,11 +54,11 @@ class _RiggerOperator:
     bl_options = {'REGISTER', 'UNDO'}
 
     @classmethod
-    def _check_mode(cls, context):
-        if context.mode != 'OBJECT':
-            cls.poll_message_set("Switch to Object Mode first")
-            return False
-        return True
+    def poll(cls, context):
+        why = "Switch to Object Mode first" if context.mode != 'OBJECT' else cls.why_not(context)
+        if why:
+            cls.poll_message_set(why)
+        return not why
 
     def execute(self, context):
         window_manager = context.window_manager
@@ -102,17 +102,12 @@ class RIGGER_OT_rig(_RiggerOperator, bpy.types.Operator):
     bl_idname = "rigger.rig"
     bl_label = "Rig"
 
-    @classmethod
-    def poll(cls, context):
-        if not cls._check_mode(context):
-            return False
+    @staticmethod
+    def why_not(context):
+        """Why the operator cannot run here (a message for the disabled button), or None."""
         if getattr(context.scene, SETTINGS_ATTRIBUTE).method == NO_METHOD:
-            cls.poll_message_set("No rigging method could be loaded (see the Rigger panel)")
-            return False
-        meshes, why = rig_targets(context)
-        if not meshes:
-            cls.poll_message_set(why)
-        return bool(meshes)
+            return "No rigging method could be loaded (see the Rigger panel)"
+        return rig_targets(context)[1]
 
     def run(self, context, progress):
         self.rig(context, progress)
@@ -125,14 +120,9 @@ class RIGGER_OT_skin(_RiggerOperator, bpy.types.Operator):
     bl_idname = "rigger.skin"
     bl_label = "Skin"
 
-    @classmethod
-    def poll(cls, context):
-        if not cls._check_mode(context):
-            return False
-        meshes, _, why = skin_targets(context)
-        if not meshes:
-            cls.poll_message_set(why)
-        return bool(meshes)
+    @staticmethod
+    def why_not(context):
+        return skin_targets(context)[2]
 
     def run(self, context, progress):
         meshes, armature, _ = skin_targets(context)
@@ -146,7 +136,7 @@ class RIGGER_OT_rig_skin(_RiggerOperator, bpy.types.Operator):
     bl_idname = "rigger.rig_skin"
     bl_label = "Rig & Skin"
 
-    poll = classmethod(RIGGER_OT_rig.poll.__func__)
+    why_not = staticmethod(RIGGER_OT_rig.why_not)
 
     def run(self, context, progress):
         meshes, armature = self.rig(context, lambda fraction: progress(0.5 * fraction))
