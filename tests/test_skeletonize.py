@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from rigger.skeletonize import depth
-from rigger.skeletonize.bones import chain_joints
+from rigger.skeletonize.bones import arc_lengths, chain_joints
 from rigger.skeletonize.tree import Chain, chains_of, rooted_chains
 
 
@@ -58,6 +58,15 @@ def test_plates_of_one_limb_are_one_part():
     legs = layers((0.0, 1.0), (3.0, 4.2))
     np.testing.assert_array_equal(depth._parts(legs, radius=1.0), legs)
     assert depth._layer_count([depth._parts(plates, 1.0)] * 10) == 1
+
+
+def test_a_nose_beside_a_head_is_not_a_second_head():
+    """Two intervals each thicker than the part is wide, but one a fifth of the other's thickness (a nose, a brim):
+    one part. Two alike (legs, fingers) stay two."""
+    head = layers((0.0, 0.4), (0.6, 2.6))
+    np.testing.assert_array_equal(depth._parts(head, radius=0.4), layers((0.6, 2.6)))
+    legs = layers((0.0, 0.8), (1.2, 2.4))
+    np.testing.assert_array_equal(depth._parts(legs, radius=0.4), legs)
 
 
 def test_fingers_fork_off_their_arm_but_legs_split_from_the_body():
@@ -125,6 +134,25 @@ def test_corners_get_joints_even_beyond_the_limit():
     for corner in zigzag[1:-1]:
         assert np.linalg.norm(joints - corner, axis=1).min() < 1e-9
     assert np.linalg.norm(np.diff(joints, axis=0), axis=1).min() >= 0.035 - 1e-9  # no stub bones
+
+
+def wave(length, amplitude, waves, points=401):
+    line = straight(length, points)
+    line[:, 1] = amplitude * np.sin(np.linspace(0.0, 2 * np.pi * waves, points))
+    return line
+
+
+def test_wiggles_within_the_part_place_joints_but_add_no_bones():
+    """A wing whose axis wiggles by less than its half-width (feathers): one bone per bone length begun, not one
+    per wiggle; a snake bending farther than its half-width gets a joint at every bend, beyond the limit."""
+    wing = wave(0.4, 0.008, 6)
+    joints = chain_joints(wing, np.radians(40), bone_length=0.1, widths=np.full(401, 0.012))
+    assert len(joints) - 1 == np.ceil(arc_lengths(wing)[-1] / 0.1) == 5
+    snake = wave(0.4, 0.03, 6)
+    joints = chain_joints(snake, np.radians(40), bone_length=0.1, max_bones=4, widths=np.full(401, 0.01))
+    assert len(joints) - 1 > 4
+    for crest in np.flatnonzero(np.abs(snake[:, 1]) >= 0.03 - 1e-12)[1:-1]:
+        assert np.linalg.norm(joints - snake[crest], axis=1).min() <= 0.35 * 0.1
 
 
 def test_a_line_jittering_in_depth_gets_no_stub_bones():

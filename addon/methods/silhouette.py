@@ -58,7 +58,7 @@ class SilhouetteMethod(RigMethod):
               description="Start a new bone where a chain turns by more than this many degrees"),
         Param("bone_length", "float", 0.1, min=0.01, max=1.0,
               description="Typical bone length, as a fraction of the mesh's largest extent"),
-        Param("max_chain_bones", "int", 4, min=0, max=100,
+        Param("max_chain_bones", "int", 5, min=0, max=100,
               description="Most bones per chain between branch points (0: no limit)"),
         Param("split_layers", "bool", True,
               description="Split chains whose view rays cross the mesh in separate parts (stacked legs)"),

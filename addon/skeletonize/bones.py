@@ -14,11 +14,13 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=F
     corner where the simplified line turns by more than ``bone_angle`` radians gets a joint (an elbow, a knee), and
     so does every bend that would take a straight bone out of the part (a snake's curves), the sharpest first where
     two lie closer than a third of a bone (measured straight: a line that jitters in depth makes no stub bones).
-    The pieces between are cut evenly into one bone per bone length begun (``ceil(length / bone_length)`` in all:
-    the artist rigs of the quality benchmark give a chain about one more bone than ``length / bone_length``, a hand
-    or a foot), at most ``max_bones`` when positive unless the corners need more or a bone would be longer than
-    ``LONGEST`` bone lengths. A ``leaf`` chain (ending in a tip: a finger, a toe) at least half a bone long gets at
-    least two bones, as the artists' leaf chains that long have (1.9 on average).
+    The chain has one bone per bone length begun (``ceil(length / bone_length)``: the artist rigs of the quality
+    benchmark give a chain about one more bone than ``length / bone_length``, a hand or a foot), at most
+    ``max_bones`` when positive unless those joints need more or a bone would be longer than ``LONGEST`` bone
+    lengths. Bones to spare go to the gentler bends that would take a straight bone out of the part's middle, from
+    the chain's start: these place joints but add none (every wiggle of a feathered wing's outline would otherwise
+    be a bone). The pieces between joints are cut evenly. A ``leaf`` chain (ending in a tip: a finger, a toe) at
+    least half a bone long gets at least two bones, as the artists' leaf chains that long have (1.9 on average).
     """
     widths = np.zeros(len(line)) if widths is None else widths
     arc = arc_lengths(line)
@@ -28,8 +30,10 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=F
     if max_bones > 0:
         wanted = min(wanted, max_bones)
     stops, places = [0.0, arc[-1]], [line[0], line[-1]]
-    candidates = _candidate_stops(line, arc, widths, bone_angle, bone_length)
-    for at, place in zip(candidates, _point_at(line, arc, np.array(candidates, dtype=float))):
+    candidates, needed = _candidate_stops(line, arc, widths, bone_angle, bone_length)
+    for k, (at, place) in enumerate(zip(candidates, _point_at(line, arc, np.array(candidates, dtype=float)))):
+        if k >= needed and len(stops) > wanted:
+            break  # no bone to spare for this bend (nor for the gentler ones after it)
         if min(np.linalg.norm(place - other) for other in places) >= 0.35 * bone_length:
             stops.append(at)
             places.append(place)
@@ -68,8 +72,10 @@ def mirrored(points, plane):
 
 
 def _candidate_stops(line, arc, widths, bone_angle, bone_length):
-    """Arc lengths where a joint belongs, most important first: leaving the branch point's disc, then corners by
-    how sharply they turn, then bends that a straight bone would cut through."""
+    """Arc lengths where a joint belongs, most important first, and how many of them are needed: leaving the branch
+    point's disc, corners by how sharply they turn and the bends a straight bone would leave the part at (its axis
+    farther than a half-width away); then, for the bones to spare, the bends it would leave the part's middle at
+    (half a half-width)."""
     found = []
     reach = np.linalg.norm(line - line[0], axis=1)
     outside = np.flatnonzero(reach > widths[0]) if widths[0] > 0 else []
@@ -77,9 +83,12 @@ def _candidate_stops(line, arc, widths, bone_angle, bone_length):
         found.append(arc[outside[0]])
     turns = _turns(line, np.full(len(line), 0.25 * bone_length))
     found += [arc[i] for i, angle in sorted(turns, key=lambda item: -item[1]) if angle > bone_angle]
-    if widths.any():
-        found += [arc[i] for i in _simplified(line, np.maximum(0.5 * widths, 1e-12 * bone_length))[1:-1]]
-    return found
+    if not widths.any():
+        return found, len(found)
+    found += [arc[i] for i in _simplified(line, np.maximum(widths, 1e-12 * bone_length))[1:-1]]
+    needed = len(found)
+    found += [arc[i] for i in _simplified(line, np.maximum(0.5 * widths, 1e-12 * bone_length))[1:-1]]
+    return found, needed
 
 
 def _share(lengths, total):

@@ -17,6 +17,7 @@ SEVERAL = 0.3  # a chain is split when this share of its outer nodes cross the s
 FORK = 0.8  # parts apart over this share of a chain's outer nodes fork where that stretch begins
 ROUND = 1.5  # a part at most this many times as thick along the view as it is wide is one limb, not two side by side
 PART = 0.8  # a separate part (a leg behind a leg) is at least this many of its half-widths thick along the view
+ALIKE = 0.45  # ... and at least this share of the thickest part's thickness (not a nose or a brim beside a head)
 
 
 def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
@@ -91,10 +92,12 @@ def _solid(layer, radius):
 def _parts(layer, radius):
     """The intervals of one node that count as separate parts for splitting: those at least ``PART`` times its
     half-width thick, a limb's round cross-section, not the plates and shells of one limb (a robot's forearm, a
-    sheet); a single part spanning all the intervals when none is that thick."""
+    sheet), and ``ALIKE`` as thick as the thickest (legs and fingers side by side are alike; a nose or a hat's brim
+    beside a head is not a second head); a single part spanning all the intervals when none is that thick."""
     if len(layer) < 2:
         return layer  # the common case, kept free of numpy calls: nodes are many
-    thick = layer[:, 1] - layer[:, 0] >= PART * radius
+    size = layer[:, 1] - layer[:, 0]
+    thick = size >= max(PART * radius, ALIKE * size.max())
     if thick.any():
         return layer[thick]
     return np.array([[layer[0, 0], layer[-1, 1]]])
