@@ -8,7 +8,6 @@ behind.
 import argparse
 import collections
 import concurrent.futures
-import glob
 import json
 import os
 import pathlib
@@ -17,7 +16,7 @@ import subprocess
 import sys
 import time
 
-from .core.files import replaced_on_success
+from .core.files import leftovers, replaced_on_success
 
 INPUTS = (".obj", ".glb", ".gltf", ".fbx", ".blend")
 OUTPUTS = (".blend", ".glb", ".fbx")
@@ -226,7 +225,7 @@ def _remove_leftovers(*finals):
     """Remove what a killed child left half written: the temporary files and folders named ".<final name>.*" that
     it renames into place only on success."""
     for final in finals:
-        for leftover in final.parent.glob(f".{glob.escape(final.name)}.*"):
+        for leftover in leftovers(final):
             if leftover.is_dir():
                 shutil.rmtree(leftover)
             else:

@@ -352,19 +352,21 @@ def markdown(measurements, summary, profiles, notes, run):
                       + [ms(row["stages"][stage]) for stage in stages]
                       + [f"{row['slowest']} {ms(row['slowest_wall'])}"
                          + (" (extrapolated)" if row["slowest"] in row["extrapolated"] else "")]
-                      for row in summary])
+                      for row in summary], numeric=True)
         out += ["", "![total and per-stage time against vertex count, log-log](rig_time.png)", ""]
     header = ["mesh", "vertices", "triangles", "runs", "total (wall)", "total (CPU)"] + stages + ["bones", "note"]
     characters = [m for m in measurements if m.mesh.kind == "character"]
     out += ["## Sample characters (ms)", ""]
     if characters:
-        out += markdown_table(header, [measurement_row(m, stages, f"{m.mesh.name}, {m.mesh.recipe}") for m in characters])
+        out += markdown_table(header, [measurement_row(m, stages, f"{m.mesh.name}, {m.mesh.recipe}") for m in characters],
+                              numeric=True)
     else:
         out += [f"Not measured: {notes['characters']}"]
     out += ["", "## Real models in ../shared/models (ms)", ""]
     real = [m for m in measurements if m.mesh.kind != "character"]
     if real:
-        out += markdown_table(header, [measurement_row(m, stages, f"{m.mesh.kind}/{m.mesh.name}") for m in real])
+        out += markdown_table(header, [measurement_row(m, stages, f"{m.mesh.kind}/{m.mesh.name}") for m in real],
+                              numeric=True)
         if any(m.error and not m.failed for m in real):
             out += ["", "**rejected**: `rig_mesh` raised the ValueError it gives by design for a mesh it cannot rig "
                         "(here: flat meshes, every vertex in one plane)."]

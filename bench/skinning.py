@@ -24,7 +24,9 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
-from benchkit import SHARED_MODELS, cpu_model, described_commit, format_seconds, markdown_table  # noqa: E402
+from benchkit import (SHARED_MODELS, cpu_model, described_commit, format_seconds, markdown_table,  # noqa: E402
+                      table_cell)
+from rigger.skeletonize.second_view import segment_distances  # noqa: E402  (bpy-free)
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 MODELS_DIR = SHARED_MODELS / "gt"
@@ -70,9 +72,7 @@ def nearest_true_bones(ours, truth):
     fractions = np.linspace(0.0, 1.0, SAMPLES_PER_BONE)
     samples = ours.heads[:, None] + fractions[None, :, None] * (ours.tails - ours.heads)[:, None]
     points = samples.reshape(-1, 3)
-    axis = truth.tails - truth.heads
-    t = np.clip(((points[:, None] - truth.heads) * axis).sum(-1) / (axis * axis).sum(-1), 0.0, 1.0)
-    distances = np.linalg.norm(truth.heads + t[..., None] * axis - points[:, None], axis=-1)
+    distances = segment_distances(points, truth.heads, truth.tails)
     return distances.reshape(len(ours), SAMPLES_PER_BONE, len(truth)).mean(axis=1).argmin(axis=1)
 
 
@@ -254,7 +254,7 @@ def markdown(records, alone, speed, run):
     for record in sorted(records, key=lambda r: (r["model"], SKELETONS.index(r["skeleton"]))):
         if "error" in record:
             rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}"] + [""] * 8
-                        + [f"error: {record['error']}"])
+                        + [f"error: {table_cell(record['error'])}"])
             continue
         rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}", str(record["bones"]),
                      bone_heat_cell(record), *(stage_cell(record, stage) for stage in REPAIR_STAGES),

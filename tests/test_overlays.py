@@ -9,6 +9,7 @@ import rigger  # noqa: E402
 from rigger.blender import overlays, samples  # noqa: E402
 from rigger.methods._template import TemplateMethod  # noqa: E402
 from rigger.skeletonize.chordal import ISOLATED, JUNCTION, SLEEVE, TERMINAL  # noqa: E402
+from rigger.skeletonize.second_view import segment_distances  # noqa: E402
 
 KINDS = [key for key, _, _ in overlays.OVERLAY_KINDS]
 LINE_KINDS = ("silhouette", "axis", "pruned", "chains")
@@ -53,13 +54,9 @@ def stage_segments(stages, kind):
 
 def distance_to_segments(points, starts, ends):
     """Distance from every point to the nearest of the segments."""
-    span = ends - starts
-    length2 = np.maximum((span * span).sum(axis=1), 1e-300)
     nearest = np.empty(len(points))
     for chunk in np.array_split(np.arange(len(points)), max(1, len(points) // 256)):
-        offset = points[chunk, None, :] - starts
-        t = np.clip((offset * span).sum(axis=2) / length2, 0.0, 1.0)
-        nearest[chunk] = np.linalg.norm(offset - t[..., None] * span, axis=2).min(axis=1)
+        nearest[chunk] = segment_distances(points[chunk], starts, ends).min(axis=1)
     return nearest
 
 

@@ -1,15 +1,10 @@
 """The quality benchmark's data and scoring library (bench/rigdata.py) and its baseline skeleton helpers."""
-import pathlib
-import sys
-
 import numpy as np
 import pytest
 
+import quality
+import rigdata
 from conftest import shared_path
-
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "bench"))
-import quality  # noqa: E402  (bench/ is not a package)
-import rigdata  # noqa: E402
 
 CUBE_VERTICES = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
 # Outward-facing quads of the unit cube (vertex index = 4x + 2y + z).

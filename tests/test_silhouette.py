@@ -15,12 +15,11 @@ Memory checks, run once outside this suite on the final C code (2026-11-21):
   a frame in rigger._rigger_silhouette (the records left are CPython's and numpy's own).
 """
 import functools
-import sys
 
 import numpy as np
 import pytest
 import shapely
-from conftest import ROOT, SHARED, shared_path
+from conftest import SHARED, shared_path
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.sparse import csr_matrix
@@ -28,9 +27,8 @@ from scipy.sparse.csgraph import connected_components
 
 from rigger import silhouette
 
-sys.path.insert(0, str(ROOT / "bench"))
-from rigdata import load_obj  # noqa: E402  (bench/ is no package)
-from union_reference import exact_union, frame_points, iou, traced_region  # noqa: E402
+from rigdata import load_obj
+from union_reference import exact_union, frame_points, iou, traced_region
 
 MIN_IOU = 0.995
 BIG_FEATURE = 8  # islands and holes above this many square cells must match

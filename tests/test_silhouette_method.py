@@ -1,6 +1,4 @@
 """The silhouette rigging method on the project's generated characters (exact ground truth) and on bad input."""
-import sys
-
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -9,11 +7,9 @@ from hypothesis import strategies as st
 import rigger
 from cdt_checks import polygon_area
 from characters import load_character, winding_numbers
-from conftest import ROOT
 from rigger import samples
 
-sys.path.insert(0, str(ROOT / "bench"))
-from rigdata import chamfer_distance  # noqa: E402  (bench/ is no package)
+from rigdata import chamfer_distance
 
 CHARACTERS = ("humanoid", "humanoid_hips", "quadruped", "octopus", "tree", "snake")
 

@@ -7,13 +7,12 @@ body, an eye inside the head, a sliver and a speck of collapsed faces) that need
 Quaternius' fox from ../shared fails in Blender the same way as the skirt.
 """
 import math
-import sys
 
 import numpy as np
 import pytest
 from scipy.sparse import csr_matrix
 
-from conftest import ROOT, shared_path
+from conftest import shared_path
 
 bpy = pytest.importorskip("bpy")
 import bmesh  # noqa: E402  (Blender's own module, importable once bpy is)
@@ -24,8 +23,7 @@ from rigger.blender.armature import build_armature  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
 from rigger.skeletonize.second_view import segment_distances  # noqa: E402
 
-sys.path.insert(0, str(ROOT / "bench"))
-import rigdata  # noqa: E402  (bench/ is not a package)
+import rigdata  # noqa: E402
 
 NEAR_FRACTION = 0.05  # a vertex's dominant bone is at most this fraction of the model's size farther than its nearest
 NEAREST_SHARE = 0.9  # at least this share of vertices is dominated by their nearest bone

@@ -31,6 +31,7 @@ def main(name="humanoid"):
     import rigger
     from rigger import samples
     from rigger.blender import overlays, skinning
+    from rigger.blender.meshdata import mesh_arrays
     from rigger.blender.pipeline import rig_object
     from rigger.blender.samples import build_character
     from rigger.blender.scenefiles import rig_report, save_scene
@@ -47,7 +48,7 @@ def main(name="humanoid"):
     truth = samples.ground_truth_bones(name)
     joints, true_joints = result.skeleton.joints(), truth.joints()
     gaps = np.linalg.norm(joints[:, None] - true_joints[None], axis=2)
-    size = float(np.ptp(np.array([v.co for v in obj.data.vertices]), axis=0).max())
+    size = float(np.ptp(mesh_arrays(obj.data)[0], axis=0).max())
     report["model"] = {"name": name, "vertices": len(obj.data.vertices), "faces": len(obj.data.polygons)}
     report["joint_chamfer_to_truth"] = 0.5 * float(gaps.min(axis=1).mean() + gaps.min(axis=0).mean()) / size
     (OUT / f"{name}_report.json").write_text(json.dumps(report, indent=2))
@@ -70,7 +71,7 @@ def render(bpy, overlays, obj, skeleton, path):
     shows the overlays; none of this is saved in the .blend (written before).
     """
     scene = bpy.context.scene
-    for overlay in bpy.data.collections["Rigger Overlays"].objects:
+    for overlay in bpy.data.collections[overlays.COLLECTION_NAME].objects:
         overlay.hide_render = overlay[overlays.KIND_KEY] in HIDDEN_IN_PICTURE
     bones = bpy.data.objects.new("bones", _bone_mesh(bpy, skeleton))
     material = bpy.data.materials.new("bones")

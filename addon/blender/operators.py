@@ -90,9 +90,8 @@ class _RiggerOperator:
 
     def skin(self, meshes, armature, progress):
         outcomes, warnings = skin_meshes(meshes, armature, progress)
-        summary = "; ".join(f"{name}: {outcome.summary()}" if len(meshes) > 1 else outcome.summary()
-                            for name, outcome in outcomes.items())
-        warned = warnings or any(outcome.warnings for outcome in outcomes.values())
+        summary = "; ".join(outcome.summary() for outcome in outcomes.values())  # each names its mesh
+        warned = warnings or any(outcome.level == "WARNING" for outcome in outcomes.values())
         self.report({'WARNING'} if warned else {'INFO'}, "; ".join([*warnings, summary]))
 
 

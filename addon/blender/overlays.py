@@ -113,7 +113,8 @@ def clear_overlays():
             bpy.data.materials.remove(material)
 
 
-# Reading stage data: each reader returns a drawing, None when the stage is absent or empty, or raises ValueError.
+# Reading stage data: each reader gets its stage (present) and all stages, and returns a drawing, None when the
+# stage is empty, or raises ValueError.
 
 def _drawings(stages):
     """Drawings by kind in drawing order; malformed stages are left out with a warning."""
@@ -121,8 +122,11 @@ def _drawings(stages):
                "chains": _chains, "joints": _joints}
     drawings = {}
     for kind, _, _ in OVERLAY_KINDS:
+        stage = stages.get(STAGE_OF_KIND[kind])
+        if stage is None:
+            continue
         try:
-            drawing = readers[kind](stages)
+            drawing = readers[kind](stage, stages)
         except ValueError as error:
             warnings.warn(f"Rigger overlay {kind!r} skipped: stage {STAGE_OF_KIND[kind]!r} {error}", RuntimeWarning,
                           stacklevel=3)
@@ -132,10 +136,7 @@ def _drawings(stages):
     return drawings
 
 
-def _silhouette(stages):
-    stage = stages.get("silhouette")
-    if stage is None:
-        return None
+def _silhouette(stage, stages):
     lift = _plane(stages)
     loops = _field(stage, "loops")
     if not isinstance(loops, (list, tuple)):
@@ -150,10 +151,7 @@ def _silhouette(stages):
     return _Lines(np.concatenate(points), np.concatenate(edges)) if points else None
 
 
-def _triangulation(stages):
-    stage = stages.get("cdt")
-    if stage is None:
-        return None
+def _triangulation(stage, stages):
     lift = _plane(stages)
     vertices = _coordinates(_field(stage, "vertices"), 2, "'vertices'")
     triangles = _indices(_field(stage, "triangles"), 3, len(vertices), "'triangles'")
@@ -169,19 +167,13 @@ def _triangulation(stages):
     return _Triangles(lift(vertices[used]), compact.reshape(-1, 3), classes.astype(np.int64))
 
 
-def _axis(stages):
-    stage = stages.get("axis")
-    if stage is None:
-        return None
+def _axis(stage, stages):
     lift = _plane(stages)
     points = _coordinates(_field(stage, "points"), 2, "'points'")
     return _lines(lift(points), _indices(_field(stage, "links"), 2, len(points), "'links'"))
 
 
-def _pruned(stages):
-    stage = stages.get("pruned")
-    if stage is None:
-        return None
+def _pruned(stage, stages):
     lift = _plane(stages)
     axis = stages.get("axis")
     if not isinstance(axis, Mapping):
@@ -190,10 +182,7 @@ def _pruned(stages):
     return _lines(lift(points), _indices(_field(stage, "links"), 2, len(points), "'links'"))
 
 
-def _chains(stages):
-    chains = stages.get("chains")
-    if chains is None:
-        return None
+def _chains(chains, stages):
     if not isinstance(chains, (list, tuple)):
         raise ValueError(f"is a {type(chains).__name__}, not a list of (K, 3) polylines")
     points, edges, offset = [], [], 0
@@ -206,10 +195,7 @@ def _chains(stages):
     return _Lines(np.concatenate(points), np.concatenate(edges)) if points else None
 
 
-def _joints(stages):
-    joints = stages.get("joints")
-    if joints is None:
-        return None
+def _joints(joints, stages):
     points = _coordinates(joints, 3, "points")
     return _Points(points) if len(points) else None
 
@@ -297,7 +283,7 @@ class _Lines:
         mesh.from_pydata(self.points.tolist(), self.edges.tolist(), [])
 
     def modifier_inputs(self, kind, radius):
-        return _tubes_group(), {"Radius": radius, "Material": _material(f"Rigger {kind}", KIND_COLOURS[kind])}
+        return _tubes_group(), {"Radius": radius, "Material": _material(_material_name(kind), KIND_COLOURS[kind])}
 
 
 class _Points:
@@ -311,7 +297,7 @@ class _Points:
 
     def modifier_inputs(self, kind, radius):
         return _spheres_group(), {"Radius": JOINT_SCALE * radius,
-                                  "Material": _material(f"Rigger {kind}", KIND_COLOURS[kind])}
+                                  "Material": _material(_material_name(kind), KIND_COLOURS[kind])}
 
 
 class _Triangles:
@@ -403,16 +389,19 @@ def _collection():
     return collection
 
 
+def _material_name(label, faces=False):
+    return f"Rigger {label}" + (" faces" if faces else "")
+
+
 def _material_names():
-    names = [f"Rigger {kind}" for kind in KIND_COLOURS]
+    names = [_material_name(kind) for kind in KIND_COLOURS]
     for code in CLASS_ORDER:
-        names += [f"Rigger {CLASS_NAMES[code]}", f"Rigger {CLASS_NAMES[code]} faces"]
+        names += [_material_name(CLASS_NAMES[code]), _material_name(CLASS_NAMES[code], faces=True)]
     return names
 
 
 def _class_material(code, faces=False):
-    name = f"Rigger {CLASS_NAMES[code]}" + (" faces" if faces else "")
-    return _material(name, CLASS_COLOURS[code], FACE_ALPHA if faces else 1.0)
+    return _material(_material_name(CLASS_NAMES[code], faces), CLASS_COLOURS[code], FACE_ALPHA if faces else 1.0)
 
 
 def _material(name, colour, alpha=1.0):

@@ -4,15 +4,12 @@ import bpy
 from ..api import method_registry
 from . import overlays
 from .operators import RIGGER_OT_clear_overlays, RIGGER_OT_rig, RIGGER_OT_rig_skin, RIGGER_OT_skin
+from .problem import SidebarPanel
 from .properties import NO_METHOD, SETTINGS_ATTRIBUTE
 
 
-class RIGGER_PT_main(bpy.types.Panel):
-    bl_label = "Rigger"
+class RIGGER_PT_main(SidebarPanel, bpy.types.Panel):
     bl_idname = "RIGGER_PT_main"
-    bl_space_type = 'VIEW_3D'
-    bl_region_type = 'UI'
-    bl_category = "Rigger"
 
     def draw(self, context):
         layout = self.layout

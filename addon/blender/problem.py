@@ -11,13 +11,18 @@ import bpy
 CHARACTER_WIDTH = 7  # pixels per character of the default UI font at scale 1, to wrap the message to the sidebar
 
 
-class RIGGER_PT_problem(bpy.types.Panel):
-    """Rigger cannot run here: the reason and the fix."""
+class SidebarPanel:
+    """Where Rigger's panel sits (View3D > Sidebar > Rigger): the real one and this stand-in alike."""
 
     bl_space_type = 'VIEW_3D'
     bl_region_type = 'UI'
     bl_category = "Rigger"
     bl_label = "Rigger"
+
+
+class RIGGER_PT_problem(SidebarPanel, bpy.types.Panel):
+    """Rigger cannot run here: the reason and the fix."""
+
     message = ""
 
     def draw(self, context):

@@ -123,7 +123,9 @@ def skin(mesh_obj, armature_obj):
     result, stage.messages = _bone_heat(mesh_obj, armature_obj)
     report.bone_heat_result = ",".join(sorted(result))
     _bind(mesh_obj, armature_obj, bone_names)
-    weighted = _weighted_mask(mesh_obj, bone_names)
+    entries = _weight_entries(mesh_obj, bone_names)
+    weighted = np.zeros(report.vertices, dtype=bool)
+    weighted[entries[0]] = True
     stage.weighted = int(weighted.sum())
     stage.seconds = time.perf_counter() - started
     report.stages.append(stage)
@@ -133,8 +135,9 @@ def skin(mesh_obj, armature_obj):
         report.warnings.append(f"Bone heat left {report.vertices - stage.weighted} of {report.vertices} vertices "
                                f"unweighted")
         _repair(mesh_obj, armature_obj, bone_names, weighted, report)
+        entries = _weight_entries(mesh_obj, bone_names)  # the repairs wrote weights
 
-    report.unweighted = int((~_normalize(mesh_obj, bone_names)).sum())
+    report.unweighted = int((~_normalize(mesh_obj, bone_names, entries)).sum())
     if report.unweighted:
         report.warnings.append(f"{report.unweighted} vertices are still unweighted")
     report.seconds = time.perf_counter() - started
@@ -240,13 +243,6 @@ def _weight_entries(obj, bone_names):
                 bones.append(bone)
                 weights.append(element.weight)
     return np.array(vertices, dtype=np.int64), np.array(bones, dtype=np.int64), np.array(weights)
-
-
-def _weighted_mask(obj, bone_names):
-    """(N,) bool: which vertices have a weight > 0 in some deforming bone's group."""
-    mask = np.zeros(len(obj.data.vertices), dtype=bool)
-    mask[_weight_entries(obj, bone_names)[0]] = True
-    return mask
 
 
 def _repair(mesh_obj, armature_obj, bone_names, weighted, report):
@@ -425,10 +421,11 @@ def _transfer(mesh_obj, bone_names, entries, targets, sources, weighted):
     return fixed
 
 
-def _normalize(mesh_obj, bone_names):
-    """Scale each vertex's deforming weights to sum to 1 (bone heat leaves sums of 0.9 to 1), in Python rather than
-    with Blender's operator, whose poll refuses hidden objects. Returns the (N,) mask of weighted vertices."""
-    vertices, bones, weights = _weight_entries(mesh_obj, bone_names)
+def _normalize(mesh_obj, bone_names, entries):
+    """Scale each vertex's deforming weights (``_weight_entries``) to sum to 1 (bone heat leaves sums of 0.9 to 1),
+    in Python rather than with Blender's operator, whose poll refuses hidden objects. Returns the (N,) mask of
+    weighted vertices."""
+    vertices, bones, weights = entries
     sums = np.bincount(vertices, weights, minlength=len(mesh_obj.data.vertices))
     scaled = weights / sums[vertices]
     off = np.abs(sums[vertices] - 1.0) > NORMALIZED_TOLERANCE

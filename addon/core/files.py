@@ -1,8 +1,12 @@
 """Writing a file so that a failure part way leaves nothing behind."""
 import contextlib
+import glob
 import os
 import pathlib
 import tempfile
+
+
+_LEFTOVER = ".{}."  # the prefix of the temporary folder beside the final file
 
 
 @contextlib.contextmanager
@@ -12,7 +16,13 @@ def replaced_on_success(final):
     no existing file for Blender to back up as .blend1, and the usual permissions."""
     final = pathlib.Path(final)
     final.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix=f".{final.name}.", dir=final.parent) as folder:
+    with tempfile.TemporaryDirectory(prefix=_LEFTOVER.format(final.name), dir=final.parent) as folder:
         path = pathlib.Path(folder) / final.name
         yield path
         os.replace(path, final)
+
+
+def leftovers(final):
+    """What ``replaced_on_success`` leaves beside ``final`` when its process is killed before the rename."""
+    final = pathlib.Path(final)
+    return final.parent.glob(glob.escape(_LEFTOVER.format(final.name)) + "*")

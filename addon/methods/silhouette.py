@@ -241,7 +241,7 @@ class _BoneBuilder:
     """Accumulates bones island by island; the first island's trunk holds the single root bone. With a mirror
     ``plane``, mirror-image chains get mirror-image joints (their average), so a symmetric mesh gets a symmetric rig."""
 
-    def __init__(self, bone_angle, bone_length, max_bones, plane=None, tolerance=0.0):
+    def __init__(self, bone_angle, bone_length, max_bones, plane, tolerance):
         self.bone_angle, self.bone_length, self.max_bones = bone_angle, bone_length, max_bones
         self.plane, self.tolerance = plane, tolerance
         self.heads, self.tails, self.parents = [], [], []
