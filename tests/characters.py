@@ -51,6 +51,12 @@ def winding_numbers(vertices, triangles, points):
     return rigdata.winding_numbers(points, vertices, triangles)
 
 
+def inside_fraction(vertices, triangles, points):
+    """Fraction of ``points`` inside the mesh (winding number > 0.5). Stricter than ``rigdata.inside_fraction``,
+    which counts inward-facing parts as inside too."""
+    return float((winding_numbers(vertices, triangles, points) > 0.5).mean())
+
+
 def _write_characters(directory):
     """Child-process side: build every character with bpy and save its arrays into ``directory``."""
     with tempfile.TemporaryDirectory(prefix="rigger-blender-user-") as user_resources:

@@ -1,9 +1,11 @@
-"""Shared test fixtures: where the read-only shared data lives, and skipping when it is absent."""
+"""Shared test fixtures: where the read-only shared data lives, and skipping when it is absent; one reader of a
+Blender mesh's vertex-group weights for the Blender tests."""
 import os
 import pathlib
 import sys
 import tempfile
 
+import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -20,3 +22,15 @@ def shared_path(*parts):
     if not path.exists():
         pytest.skip(f"shared test data not found at {path} (clone the project beside ../shared to run this test)")
     return path
+
+
+def vertex_weights(obj, names):
+    """(N, len(names)) weights of mesh object ``obj``'s vertices in the vertex groups ``names``, in that order (0
+    where a group is missing)."""
+    column = {group.index: names.index(group.name) for group in obj.vertex_groups if group.name in names}
+    table = np.zeros((len(obj.data.vertices), len(names)))
+    for vertex in obj.data.vertices:
+        for element in vertex.groups:
+            if element.group in column:
+                table[vertex.index, column[element.group]] = element.weight
+    return table

@@ -10,7 +10,8 @@ import json
 import numpy as np
 import pytest
 
-from characters import winding_numbers
+from characters import inside_fraction
+from conftest import vertex_weights
 
 bpy = pytest.importorskip("bpy")
 
@@ -52,15 +53,6 @@ def reports_of(operator, **kwargs):
 def mesh_arrays(obj):
     from rigger.blender.meshdata import evaluated_arrays
     return evaluated_arrays(obj)
-
-
-def deform_weights(obj):
-    """(N, groups) weights of ``obj``'s vertices in its vertex groups."""
-    weights = np.zeros((len(obj.data.vertices), len(obj.vertex_groups)))
-    for vertex in obj.data.vertices:
-        for element in vertex.groups:
-            weights[vertex.index, element.group] = element.weight
-    return weights
 
 
 # registration
@@ -135,12 +127,10 @@ def test_rig_and_skin_every_character(rigged, name):
     vertices, triangles = mesh_arrays(obj)
     points = np.concatenate([np.array([bone.head_local for bone in bones]),
                              np.array([bone.tail_local for bone in bones])])
-    inside = winding_numbers(vertices, triangles, points) > 0.5
-    assert inside.mean() >= 0.9, f"{(~inside).sum()} of {len(points)} bone ends outside the mesh"
+    inside = inside_fraction(vertices, triangles, points)
+    assert inside >= 0.9, f"only {inside:.0%} of {len(points)} bone ends inside the mesh"
 
-    deforming = {bone.name for bone in bones if bone.use_deform}
-    group_is_bone = np.array([group.name in deforming for group in obj.vertex_groups])
-    weights = deform_weights(obj)[:, group_is_bone]
+    weights = vertex_weights(obj, [bone.name for bone in bones if bone.use_deform])
     assert (weights.max(axis=1) > 0).all(), "vertices left unweighted"
     assert any(m.type == 'ARMATURE' and m.object == armature for m in obj.modifiers)
 
@@ -176,7 +166,7 @@ def test_the_rig_follows_the_objects_transform_and_modifiers(scene):
     heads = np.array([bone.head_local for bone in armature.data.bones])
     vertices, triangles = mesh_arrays(obj)
     assert len(vertices) > len(obj.data.vertices)  # the modifier was applied
-    assert (winding_numbers(vertices, triangles, heads) > 0.5).mean() >= 0.9
+    assert inside_fraction(vertices, triangles, heads) >= 0.9
     # the humanoid, 1.8 m tall along its own Z, is now 3.6 m tall and stands at z = 1
     assert heads[:, 2].max() - heads[:, 2].min() > 2.0
     assert bpy.context.view_layer.objects.active == armature

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy.sparse import csr_matrix
 
-from conftest import shared_path
+from conftest import shared_path, vertex_weights
 
 bpy = pytest.importorskip("bpy")
 import bmesh  # noqa: E402  (Blender's own module, importable once bpy is)
@@ -43,17 +43,6 @@ def bone_names(armature):
     return [bone.name for bone in armature.data.bones if bone.use_deform]
 
 
-def weight_table(obj, names):
-    """(N, B) weights of ``obj``'s vertices in the groups named ``names`` (0 where a group is missing)."""
-    column = {group.index: names.index(group.name) for group in obj.vertex_groups if group.name in names}
-    table = np.zeros((len(obj.data.vertices), len(names)))
-    for vertex in obj.data.vertices:
-        for element in vertex.groups:
-            if element.group in column:
-                table[vertex.index, column[element.group]] = element.weight
-    return table
-
-
 def world_vertices(obj):
     positions = np.array([vertex.co for vertex in obj.data.vertices])
     matrix = np.array(obj.matrix_world)
@@ -71,7 +60,7 @@ def assert_skinned(obj, armature, report, checked=slice(None), nearest_share=NEA
     """Every vertex weighted, weights normalised, one Armature modifier last, and the dominant bone of each
     ``checked`` vertex near it."""
     names = bone_names(armature)
-    table = weight_table(obj, names)
+    table = vertex_weights(obj, names)
     assert report.unweighted == 0
     assert (table.max(axis=1) > 0).all(), f"{(table.max(axis=1) == 0).sum()} vertices unweighted"
     np.testing.assert_allclose(table.sum(axis=1), 1.0, atol=1e-5)
@@ -162,12 +151,12 @@ def test_hidden_and_unlinked_objects_are_skinned_too(scene):
 def test_skinning_again_replaces_the_modifier_and_groups(scene):
     obj, armature = character_with_rig("snake")
     first = skinning.skin(obj, armature)
-    weights = weight_table(obj, bone_names(armature))
+    weights = vertex_weights(obj, bone_names(armature))
     obj.vertex_groups.new(name="user paint")
     second = skinning.skin(obj, armature)
     assert_skinned(obj, armature, second)
     assert sorted(g.name for g in obj.vertex_groups) == sorted(bone_names(armature) + ["user paint"])
-    np.testing.assert_allclose(weight_table(obj, bone_names(armature)), weights, atol=1e-6)
+    np.testing.assert_allclose(vertex_weights(obj, bone_names(armature)), weights, atol=1e-6)
     assert first.summary().split(":")[0] == second.summary().split(":")[0]
 
     # a new armature with other bone names: the old groups go, the new ones come, still one modifier
@@ -278,7 +267,7 @@ def test_loose_parts_and_inner_shells_are_repaired_part_by_part_then_by_distance
     assert islands.note == "9 of 10 loose parts tried"  # a speck has no faces left
     assert_skinned(obj, armature, report)
     assert report.level == "WARNING" and "nearest bones 4" in report.summary()
-    table = weight_table(obj, bone_names(armature))
+    table = vertex_weights(obj, bone_names(armature))
     assert len({tuple(row) for row in table[speck]}) == 1  # the four coincident vertices get the same weights
 
 
@@ -302,7 +291,7 @@ def test_a_real_model_that_makes_bone_heat_fail_is_repaired_by_welding(scene):
     assert stage_names(report) == ["bone heat", "welded bone heat"] and report.stages[0].weighted == 0
     assert_skinned(obj, armature, report, nearest_share=0.8)
     # the repaired weights mostly agree with the artist's: the dominant bone starts at the artist's dominant joint
-    ours = head_joint[weight_table(obj, bone_names(armature)).argmax(axis=1)]
+    ours = head_joint[vertex_weights(obj, bone_names(armature)).argmax(axis=1)]
     artist = rigdata.dominant_joints(rig)
     assert (ours[artist >= 0] == artist[artist >= 0]).mean() > 0.7  # measured 0.74
 
