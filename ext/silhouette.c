@@ -245,6 +245,14 @@ static int64_t orient_fix(const int32_t *f, int32_t a, int32_t b, int32_t c)
            ((int64_t)f[2 * b + 1] - f[2 * a + 1]) * ((int64_t)f[2 * c] - f[2 * a]);
 }
 
+/* The lowest and highest snapped corner of a triangle (its corners x0 y0 x1 y1 x2 y2) along axis 0 (x) or 1 (y). */
+static void corner_range(const int32_t *xy, int axis, int32_t *lo, int32_t *hi)
+{
+    int32_t c0 = xy[axis], c1 = xy[2 + axis], c2 = xy[4 + axis];
+    *lo = c0 < c1 ? (c0 < c2 ? c0 : c2) : (c1 < c2 ? c1 : c2);
+    *hi = c0 > c1 ? (c0 > c2 ? c0 : c2) : (c1 > c2 ? c1 : c2);
+}
+
 /* Size the grid on the projected triangles of non-zero area, snap, and keep the triangles that stay non-degenerate. */
 static int snap(SilTrace *t, int32_t resolution)
 {
@@ -342,15 +350,9 @@ static int build_bins(SilTrace *t)
     int rc = b->start ? SIL_OK : SIL_ERR_NOMEM;
     for (int pass = 0; pass < 2 && rc == SIL_OK; pass++) {
         for (int64_t k = 0; k < t->n_tris; k++) {
-            const int32_t *xy = t->corners + 6 * k;
-            int32_t x0 = xy[0], x1 = x0, y0 = xy[1], y1 = y0;
-            for (int c = 1; c < 3; c++) {
-                int32_t x = xy[2 * c], y = xy[2 * c + 1];
-                if (x < x0) x0 = x;
-                if (x > x1) x1 = x;
-                if (y < y0) y0 = y;
-                if (y > y1) y1 = y;
-            }
+            int32_t x0, x1, y0, y1;
+            corner_range(t->corners + 6 * k, 0, &x0, &x1);
+            corner_range(t->corners + 6 * k, 1, &y0, &y1);
             int32_t bx0 = (x0 >> FIX_SHIFT) / b->block, bx1 = (x1 >> FIX_SHIFT) / b->block;
             int32_t by0 = (y0 >> FIX_SHIFT) / b->block, by1 = (y1 >> FIX_SHIFT) / b->block;
             for (int32_t by = by0; by <= by1; by++) {
@@ -378,12 +380,11 @@ static int build_bins(SilTrace *t)
     return SIL_OK;
 }
 
-/* The bin range [*first, *last) of the triangles that may contain snapped point (x, y); empty when off the grid. */
+/* The bin range [*first, *last) of the triangles that may contain snapped point (x, y), which must be on the grid
+ * (0 <= x <= width * FIX_ONE, likewise y): snap_point only passes such points. */
 static void bin_of(const SilTrace *t, int64_t x, int64_t y, int64_t *first, int64_t *last)
 {
     const Bins *b = t->bins;
-    *first = *last = 0;
-    if (x < 0 || y < 0 || x > (int64_t)t->width * FIX_ONE || y > (int64_t)t->height * FIX_ONE) return;
     int64_t bin = ((y >> FIX_SHIFT) / b->block) * b->cols + (x >> FIX_SHIFT) / b->block;
     *first = b->start[bin];
     *last = b->start[bin + 1];
@@ -582,8 +583,7 @@ static void activate(const int32_t *xy, int vertical, Active *a)
     a->hi = a->next_is_lo ? along_long : short_edge;
 }
 
-typedef struct { /* a cross-section that starts and ends between the same two grid points */
-    int32_t gap;
+typedef struct { /* a cross-section that starts and ends between the same two grid points (Tally.bucket's gap) */
     double from, to;
     int64_t next; /* 1 + the previous piece in the same gap, 0 for none */
 } Piece;
@@ -656,7 +656,6 @@ static int tally_span(Tally *y, const Span *s)
     }
     int rc = reserve((void **)&y->pieces, &y->piece_cap, y->n_pieces + 1, sizeof(Piece));
     if (rc != SIL_OK) return rc;
-    y->pieces[y->n_pieces].gap = s->gap_lo;
     y->pieces[y->n_pieces].from = s->pos_lo;
     y->pieces[y->n_pieces].to = s->pos_hi;
     y->pieces[y->n_pieces].next = y->bucket[s->gap_lo];
@@ -769,10 +768,8 @@ static int sweep(const SilTrace *t, int vertical, Crossings *c)
     }
     /* Bucket the triangles by the first line they cross: lines at levels with lowest <= level < highest. */
     for (int64_t k = 0; k < t->n_tris; k++) {
-        const int32_t *xy = t->corners + 6 * k;
-        int64_t c0 = xy[across], c1 = xy[2 + across], c2 = xy[4 + across];
-        int64_t cmin = c0 < c1 ? (c0 < c2 ? c0 : c2) : (c1 < c2 ? c1 : c2);
-        int64_t cmax = c0 > c1 ? (c0 > c2 ? c0 : c2) : (c1 > c2 ? c1 : c2);
+        int32_t cmin, cmax;
+        corner_range(t->corners + 6 * k, across, &cmin, &cmax);
         first_line[k] = first_line_at(cmin);
         if (first_line[k] > first_line_at(cmax) - 1) first_line[k] = -1; /* between two lines: crosses none */
         else first_start[first_line[k] + 1]++;
@@ -960,10 +957,8 @@ static int midline(Linker *L, const Box *b, int vertical, uint8_t inside[3], int
     int64_t n = 0;
     for (int64_t i = 0; i < L->n_near; i++) {
         int64_t k = L->near[i];
-        const int32_t *xy = t->corners + 6 * k;
-        int64_t c0 = xy[across], c1 = xy[2 + across], c2 = xy[4 + across];
-        int64_t cmin = c0 < c1 ? (c0 < c2 ? c0 : c2) : (c1 < c2 ? c1 : c2);
-        int64_t cmax = c0 > c1 ? (c0 > c2 ? c0 : c2) : (c1 > c2 ? c1 : c2);
+        int32_t cmin, cmax;
+        corner_range(t->corners + 6 * k, across, &cmin, &cmax);
         if (!(cmin <= level && level < cmax)) continue;
         int rc = reserve((void **)&L->spans, &L->span_cap, n + 1, sizeof(Span));
         if (rc == SIL_OK) rc = cross_section(t, k, level, vertical, origin, half, L->spans + n);
@@ -1168,14 +1163,9 @@ static int gather_saddle_triangles(Linker *L)
         blocks[(cy / 16) * block_cols + cx / 16] = 1;
     }
     for (int64_t k = 0; k < t->n_tris; k++) {
-        const int32_t *xy = t->corners + 6 * k;
-        int32_t x0 = xy[0], x1 = x0, y0 = xy[1], y1 = y0;
-        for (int c = 1; c < 3; c++) {
-            if (xy[2 * c] < x0) x0 = xy[2 * c];
-            if (xy[2 * c] > x1) x1 = xy[2 * c];
-            if (xy[2 * c + 1] < y0) y0 = xy[2 * c + 1];
-            if (xy[2 * c + 1] > y1) y1 = xy[2 * c + 1];
-        }
+        int32_t x0, x1, y0, y1;
+        corner_range(t->corners + 6 * k, 0, &x0, &x1);
+        corner_range(t->corners + 6 * k, 1, &y0, &y1);
         /* closed cells [c, c + 1] meeting [lo, hi] in lattice units: ceil(lo) - 1 <= c <= floor(hi) */
         int32_t cx0 = (x0 - 1) >> FIX_SHIFT, cx1 = x1 >> FIX_SHIFT, cy0 = (y0 - 1) >> FIX_SHIFT, cy1 = y1 >> FIX_SHIFT;
         int any = 0;
@@ -1326,6 +1316,12 @@ static double signed_area(const double *xy, int64_t n)
     return 0.5 * area;
 }
 
+/* A loop too small to keep: fewer than three points or less than SPECK of area (finite grid points, so no NaN). */
+static int is_speck(const double *xy, int64_t count)
+{
+    return count < 3 || fabs(signed_area(xy, count)) < SPECK;
+}
+
 /* Follow next[] into closed loops, dropping repeated points and loops without area (specks thinner than a line). */
 static int collect_loops(const Crossings *h, const Crossings *v, const Linker *L, Loops *out)
 {
@@ -1376,7 +1372,7 @@ static int collect_loops(const Crossings *h, const Crossings *v, const Linker *L
         while (count > 1 && out->xy[2 * begin] == out->xy[2 * (begin + count - 1)] &&
                out->xy[2 * begin + 1] == out->xy[2 * (begin + count - 1) + 1])
             count--;
-        if (count < 3 || fabs(signed_area(out->xy + 2 * begin, count)) < SPECK) {
+        if (is_speck(out->xy + 2 * begin, count)) {
             out->n_points = begin;
             continue;
         }
@@ -1521,13 +1517,13 @@ done:
     return rc;
 }
 
-/* Drop loops with fewer than three points or less than SPECK of area, keeping the others in order. */
+/* Drop the speck loops, keeping the others in order. */
 static void drop_specks(Loops *loops)
 {
     int64_t kept = 0, m = 0;
     for (int64_t l = 0, first = 0; l < loops->n_loops; l++) {
         int64_t end = loops->start[l + 1], count = end - first; /* start[l + 1] is not rewritten yet */
-        if (count >= 3 && fabs(signed_area(loops->xy + 2 * first, count)) >= SPECK) {
+        if (!is_speck(loops->xy + 2 * first, count)) {
             memmove(loops->xy + 2 * m, loops->xy + 2 * first, (size_t)(2 * count) * sizeof(double));
             m += count;
             loops->start[++kept] = m;

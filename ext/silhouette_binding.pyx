@@ -76,8 +76,8 @@ cdef class Trace:
     def depth(self, const double[:, ::1] points):
         """Nearest and farthest hit depth per (P, 2) frame point; NaN where the ray misses."""
         cdef int64_t n = points.shape[0]
-        front = np.full(n, np.nan)
-        back = np.full(n, np.nan)
+        front = np.empty(n)  # sil_depth writes every entry (NaN on a miss) or fails and they are dropped
+        back = np.empty(n)
         if n == 0:
             return front, back
         cdef double[::1] f = front, b = back

@@ -18,6 +18,12 @@ typedef struct {
     int32_t *order; /* bone indices, each leaf's bones contiguous */
 } Tree;
 
+/* A tree node waiting to be visited, with its box's squared distance from the point (computed once, when pushed). */
+typedef struct {
+    int32_t node;
+    double box_squared;
+} Pending;
+
 /* A bone with a sort key; ordered by key, then by bone index, so ties never depend on visiting order. */
 typedef struct {
     double key;
@@ -179,16 +185,16 @@ static void offer(Keyed *best, int32_t *count, int32_t capacity, double key, int
  * first; a node is skipped when its box is farther than the worst key kept (the key is never below the distance, so
  * nothing better is lost). */
 static void nearest_bones(const Tree *tree, const double *heads, const double *tails, const double point[3],
-                             const double *normal, double facing_penalty, Keyed *best, int32_t capacity,
-                             int32_t *stack)
+                          const double *normal, double facing_penalty, Keyed *best, int32_t capacity, Pending *stack)
 {
     int32_t count = 0, top = 0;
-    stack[top++] = 0;
+    stack[top++] = (Pending){0, 0.0}; /* the root's distance is never read: nothing is kept yet when it is visited */
     while (top) {
-        const Node *node = &tree->nodes[stack[--top]];
+        Pending visit = stack[--top];
+        const Node *node = &tree->nodes[visit.node];
         if (count == capacity) {
             double worst = best[capacity - 1].key;
-            if (box_distance_squared(node, point) > worst * worst)
+            if (visit.box_squared > worst * worst)
                 continue;
         }
         if (node->count) {
@@ -201,10 +207,12 @@ static void nearest_bones(const Tree *tree, const double *heads, const double *t
             continue;
         }
         const Node *left = &tree->nodes[node->first];
-        int32_t near = node->first, far = node->first + 1;
-        if (box_distance_squared(left + 1, point) < box_distance_squared(left, point)) {
-            near = node->first + 1;
-            far = node->first;
+        Pending near = {node->first, box_distance_squared(left, point)};
+        Pending far = {node->first + 1, box_distance_squared(left + 1, point)};
+        if (far.box_squared < near.box_squared) {
+            Pending swap = near;
+            near = far;
+            far = swap;
         }
         stack[top++] = far;
         stack[top++] = near;
@@ -260,7 +268,7 @@ int sw_bone_weights(const double *points, int64_t n_points, const double *normal
     int32_t used = per_point < n_bones ? per_point : n_bones;
     int32_t capacity = used < n_bones ? used + 1 : used;
     Keyed *best = malloc((size_t)capacity * sizeof(Keyed));
-    int32_t *stack = malloc((size_t)tree.n_nodes * sizeof(int32_t));
+    Pending *stack = malloc((size_t)tree.n_nodes * sizeof(Pending));
     if (!best || !stack) {
         free(best);
         free(stack);

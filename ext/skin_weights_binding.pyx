@@ -21,8 +21,9 @@ def bone_weights(const double[:, ::1] points, const double[:, ::1] normals, cons
                  const double[:, ::1] tails, int per_point, double power, double facing_penalty):
     """(bones (N, per_point) int32, weights (N, per_point) float64); ``normals`` may be None. See sw_bone_weights."""
     cdef int64_t n = points.shape[0]
-    bones = np.full((n, per_point), -1, dtype=np.int32)
-    weights = np.zeros((n, per_point), dtype=np.float64)
+    # sw_bone_weights writes every entry (-1 and 0 past the weighted bones), or fails and they are dropped
+    bones = np.empty((n, per_point), dtype=np.int32)
+    weights = np.empty((n, per_point), dtype=np.float64)
     if n == 0:
         return bones, weights
     if heads.shape[0] == 0 or tails.shape[0] != heads.shape[0] or points.shape[1] != 3 or heads.shape[1] != 3 \

@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from rigger.skeletonize import depth
-from rigger.skeletonize.bones import arc_lengths, chain_joints
+from rigger.skeletonize.bones import chain_joints
+from rigger.skeletonize.polyline import arc_lengths
 from rigger.skeletonize.tree import Chain, chains_of, rooted_chains
 
 

@@ -16,9 +16,10 @@ from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
 from ..core.timing import StageClock
-from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mirror_plane, mirrored, resampled
+from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mirror_plane, mirrored
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
+from ..skeletonize.polyline import resampled
 from ..skeletonize.second_view import segment_distances, uncovered, uncovered_limbs
 from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chains
 

@@ -2,6 +2,7 @@
 import numpy as np
 
 from ..core.arrays import column_bounds
+from .polyline import arc_lengths, point_at
 
 LONGEST = 3.0  # no bone longer than this many bone lengths, whatever max_bones says (a straight leg gets a knee)
 
@@ -31,7 +32,7 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=F
         wanted = min(wanted, max_bones)
     stops, places = [0.0, arc[-1]], [line[0], line[-1]]
     candidates, needed = _candidate_stops(line, arc, widths, bone_angle, bone_length)
-    for k, (at, place) in enumerate(zip(candidates, _point_at(line, arc, np.array(candidates, dtype=float)))):
+    for k, (at, place) in enumerate(zip(candidates, point_at(line, arc, np.array(candidates, dtype=float)))):
         if k >= needed and len(stops) > wanted:
             break  # no bone to spare for this bend (nor for the gentler ones after it)
         if min(np.linalg.norm(place - other) for other in places) >= 0.35 * bone_length:
@@ -44,23 +45,7 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=F
     at = [0.0]
     for start, length, count in zip(stops[:-1], lengths, counts):
         at.extend(start + length * np.arange(1, count + 1) / count)
-    return _point_at(line, arc, np.array(at))
-
-
-def _point_at(line, arc, at):
-    """The point(s) at arc length(s) ``at`` along a polyline whose cumulative arc lengths are ``arc``."""
-    return np.stack([np.interp(at, arc, line[:, d]) for d in range(3)], axis=-1)
-
-
-def arc_lengths(line):
-    """Cumulative length along a polyline, from 0 at its first point."""
-    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))]
-
-
-def resampled(line, count):
-    """``count`` points evenly spaced by arc length along a polyline."""
-    arc = arc_lengths(line)
-    return _point_at(line, arc, np.linspace(0.0, arc[-1], count))
+    return point_at(line, arc, np.array(at))
 
 
 def mirrored(points, plane):

@@ -9,6 +9,7 @@ primary skeleton comes within ``reach`` of is added. Parts both views show (a wi
 import numpy as np
 
 from .depth import OCCLUSION_RATIO
+from .polyline import length
 
 
 def uncovered_limbs(placed, primary_lines, primary_sil, direction, reach, min_length):
@@ -40,7 +41,7 @@ def uncovered_limbs(placed, primary_lines, primary_sil, direction, reach, min_le
         covered = np.flatnonzero(_distance_to_segments(_flattened(line, direction), starts, ends) <= reach)
         first = int(covered[-1]) if len(covered) else 0
         part = line[first:]
-        if len(part) >= 2 and np.linalg.norm(np.diff(part, axis=0), axis=1).sum() >= min_length:
+        if len(part) >= 2 and length(part) >= min_length:
             limbs.append((part, widths[first:]))
     return limbs
 

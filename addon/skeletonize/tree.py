@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .polyline import arc_lengths, length
+
 UNIFORM = 1.25  # a path whose widest node is at most this many times its median width is a column, not a body
 
 
@@ -132,14 +134,10 @@ def _links_of(chains):
     return np.array(pairs, dtype=np.int64).reshape(-1, 2)
 
 
-def _length(points, nodes):
-    return float(np.linalg.norm(np.diff(points[nodes], axis=0), axis=1).sum()) if len(nodes) > 1 else 0.0
-
-
 def rooted_chains(points, keys, chains, radius):
     """Root the chain graph at its most central branch point and cut its cycles; returns (root, [Chain])
     ordered parents first."""
-    lengths = [_length(points, c) for c in chains]
+    lengths = [length(points[c]) for c in chains]
     adjacency = {}
     for i, c in enumerate(chains):
         adjacency.setdefault(c[0], []).append((c[-1], i))
@@ -163,7 +161,7 @@ def rooted_chains(points, keys, chains, radius):
         if i in tree:
             continue
         nodes = chains[i]
-        steps = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[nodes], axis=0), axis=1))]
+        steps = arc_lengths(points[nodes])
         from_start = dist[nodes[0]] + steps
         from_end = dist[nodes[-1]] + (steps[-1] - steps)
         cut = int(np.clip(np.searchsorted(from_start - from_end, 0.0), 1, len(nodes) - 1))
