@@ -1,4 +1,4 @@
-"""Measuring along polylines (chains of axis nodes, bones' lines): shared by the tree, depth and bone steps."""
+"""Measuring along polylines (axis-node chains, placed 3D chains): shared by the tree, second-view and bone steps."""
 import numpy as np
 
 
