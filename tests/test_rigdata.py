@@ -1,6 +1,7 @@
 """The quality benchmark's data and scoring library (bench/rigdata.py) and its baseline skeleton helpers."""
 import numpy as np
 import pytest
+from scipy.sparse import csr_matrix
 
 import quality
 import rigdata
@@ -237,3 +238,19 @@ def test_real_rig_helper_joints_are_ignored():
     kept = rig.without_helpers()
     assert len(rig.names) == 51 and len(kept.names) == 47
     assert not any("PoleTarget" in name for name in kept.names)
+
+
+def test_artist_rig_as_armature_bones_drops_zero_length_bones():
+    # root r with a duplicate joint at its place (RigNet's root_dup), which carries the spine; a leaf hand on the arm
+    skin = csr_matrix(np.array([[0.2, 0.0, 0.8, 0.0, 0.0], [0.0, 0.0, 0.0, 0.3, 0.7], [0.0] * 5, [0.5, 0, 0, 0.4, 0]]))
+    rig = rigdata.Rig(("r", "dup", "spine", "arm", "hand"),
+                      np.array([[0, 0, 0], [0, 0, 0], [0, 0, 1], [1, 0, 0], [2, 0, 0]], dtype=float),
+                      np.array([-1, 0, 1, 0, 3]), "r", skin)
+    skeleton, head_joint = rigdata.armature_skeleton(rig)
+    assert skeleton.names == ("bone_000", "bone_001", "bone_002")
+    assert skeleton.heads.tolist() == [[0, 0, 0], [0, 0, 0], [1, 0, 0]]
+    assert skeleton.tails.tolist() == [[0, 0, 1], [1, 0, 0], [2, 0, 0]]
+    assert skeleton.parents.tolist() == [-1, -1, 1] and head_joint.tolist() == [1, 0, 3]
+    # a weight on a leaf joint belongs to the bone ending there, i.e. to its parent joint's bone
+    assert rigdata.weight_owners(rig.parents).tolist() == [0, 1, 1, 3, 3]
+    assert rigdata.dominant_joints(rig).tolist() == [1, 3, -1, 0]

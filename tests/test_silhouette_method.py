@@ -158,6 +158,24 @@ def test_a_flat_cut_out_character_is_rigged_in_its_plane(default_rig):
     assert chamfer_distance(skeleton.joints()[:, drop_y], reference.joints()[:, drop_y]) / size < 0.03
 
 
+@pytest.mark.parametrize("normal", [(0.0, 1.0, 1.0), (1.0, 1.0, 0.0), (0.3, 1.0, 1.0)])
+def test_a_flat_cut_out_tilted_off_the_axis_planes_is_rigged_in_its_plane(default_rig, normal):
+    """A cut-out in a tilted plane (which may contain a coordinate axis: an edge-on view along it sees nothing) is
+    seen face-on and rigged like the same cut-out lying in an axis plane, turned."""
+    vertices, triangles, _ = default_rig("humanoid")
+    front = vertices * [1.0, 0.0, 1.0]
+    reference = rigger.rig_mesh(front, triangles)
+    normal = np.array(normal) / np.linalg.norm(normal)
+    axis = np.cross([0.0, 1.0, 0.0], normal)
+    angle = np.arccos(normal[1])
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]]) / np.linalg.norm(axis)
+    rotation = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k  # takes +Y to the normal
+    skeleton = rigger.rig_mesh(front @ rotation.T, triangles)
+    np.testing.assert_allclose(skeleton.joints() @ normal, 0.0, atol=1e-9)
+    size = np.ptp(vertices, axis=0).max()
+    assert chamfer_distance(skeleton.joints() @ rotation, reference.joints()) / size < 0.03
+
+
 def uv_sphere(rings=16, segments=32):
     theta = np.linspace(0, np.pi, rings + 1)[1:-1]
     phi = np.linspace(0, 2 * np.pi, segments, endpoint=False)

@@ -10,7 +10,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.sparse import csr_matrix
 
 from conftest import shared_path, vertex_weights
 
@@ -294,22 +293,3 @@ def test_a_real_model_that_makes_bone_heat_fail_is_repaired_by_welding(scene):
     ours = head_joint[vertex_weights(obj, bone_names(armature)).argmax(axis=1)]
     artist = rigdata.dominant_joints(rig)
     assert (ours[artist >= 0] == artist[artist >= 0]).mean() > 0.7  # measured 0.74
-
-
-# the benchmark's view of the artist rigs (bench/rigdata.py)
-
-
-def test_artist_rig_as_armature_bones_drops_zero_length_bones():
-    # root r with a duplicate joint at its place (RigNet's root_dup), which carries the spine; a leaf hand on the arm
-    skin = csr_matrix(np.array([[0.2, 0.0, 0.8, 0.0, 0.0], [0.0, 0.0, 0.0, 0.3, 0.7], [0.0] * 5, [0.5, 0, 0, 0.4, 0]]))
-    rig = rigdata.Rig(("r", "dup", "spine", "arm", "hand"),
-                      np.array([[0, 0, 0], [0, 0, 0], [0, 0, 1], [1, 0, 0], [2, 0, 0]], dtype=float),
-                      np.array([-1, 0, 1, 0, 3]), "r", skin)
-    skeleton, head_joint = rigdata.armature_skeleton(rig)
-    assert skeleton.names == ("bone_000", "bone_001", "bone_002")
-    assert skeleton.heads.tolist() == [[0, 0, 0], [0, 0, 0], [1, 0, 0]]
-    assert skeleton.tails.tolist() == [[0, 0, 1], [1, 0, 0], [2, 0, 0]]
-    assert skeleton.parents.tolist() == [-1, -1, 1] and head_joint.tolist() == [1, 0, 3]
-    # a weight on a leaf joint belongs to the bone ending there, i.e. to its parent joint's bone
-    assert rigdata.weight_owners(rig.parents).tolist() == [0, 1, 1, 3, 3]
-    assert rigdata.dominant_joints(rig).tolist() == [1, 3, -1, 0]

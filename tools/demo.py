@@ -25,7 +25,12 @@ SKIN_COLOUR = (0.8, 0.8, 0.8, 0.2)  # Workbench draws material alpha as transpar
 
 
 def main(name="humanoid"):
-    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="rigger-blender-user-"))
+    with tempfile.TemporaryDirectory(prefix="rigger-blender-user-") as user_resources:
+        os.environ.setdefault("BLENDER_USER_RESOURCES", user_resources)
+        _demo(name)
+
+
+def _demo(name):
     import bpy
 
     import rigger

@@ -27,6 +27,7 @@ import bpy
 import bmesh
 import numpy as np
 
+from ..core.arrays import column_bounds
 from ..core.graphs import components
 from ..weights import bone_weights
 from .meshdata import mesh_arrays, world_points
@@ -313,12 +314,9 @@ def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, positions, rep
     targets = np.flatnonzero(~weighted)
     heads, tails = _world_bones(armature_obj, bone_names)
     result = bone_weights(positions[targets], heads, tails, _world_normals(mesh_obj)[targets])
-    groups = [mesh_obj.vertex_groups[name] for name in bone_names]
-    for slot in range(result.bones.shape[1]):
-        for vertex, bone, weight in zip(targets.tolist(), result.bones[:, slot].tolist(),
-                                        result.weights[:, slot].tolist()):
-            if bone >= 0:
-                groups[bone].add([vertex], weight, 'REPLACE')
+    kept = result.bones >= 0
+    _write_weights(mesh_obj, bone_names, np.broadcast_to(targets[:, None], kept.shape)[kept], result.bones[kept],
+                   result.weights[kept])
     weighted[targets] = True
     stage.weighted = len(targets)
     _finish_stage(stage, started, report,
@@ -355,7 +353,8 @@ def _welded(mesh, positions, triangles):
     """Merge vertices closer than ``WELD_DISTANCE`` of the mesh's size (``positions``: its object-space vertices):
     (weld map (N,) original -> welded index, the original index of each welded vertex, welded triangles without
     the ones welding collapsed)."""
-    size = float(np.ptp(positions, axis=0).max())
+    bounds = column_bounds(positions)
+    size = float((bounds[1] - bounds[0]).max())
     work = bmesh.new()
     try:
         work.from_mesh(mesh)
@@ -409,16 +408,12 @@ def _transfer(mesh_obj, bone_names, entries, targets, sources, weighted):
     copy_vertices, bones, weights = copy_vertices[order], bones[order], weights[order]
     first = np.searchsorted(copy_vertices, sources, side="left")
     last = np.searchsorted(copy_vertices, sources, side="right")
-    groups = [mesh_obj.vertex_groups[name] for name in bone_names]
-    fixed = 0
-    for vertex, start, stop in zip(targets.tolist(), first.tolist(), last.tolist()):
-        if start == stop:
-            continue
-        for bone, weight in zip(bones[start:stop].tolist(), weights[start:stop].tolist()):
-            groups[bone].add([vertex], weight, 'REPLACE')
-        weighted[vertex] = True
-        fixed += 1
-    return fixed
+    found = last > first
+    counts = (last - first)[found]
+    rows = np.repeat(first[found] - (np.cumsum(counts) - counts), counts) + np.arange(counts.sum())
+    _write_weights(mesh_obj, bone_names, np.repeat(targets[found], counts), bones[rows], weights[rows])
+    weighted[targets[found]] = True
+    return int(found.sum())
 
 
 def _normalize(mesh_obj, bone_names, entries):
@@ -429,7 +424,13 @@ def _normalize(mesh_obj, bone_names, entries):
     sums = np.bincount(vertices, weights, minlength=len(mesh_obj.data.vertices))
     scaled = weights / sums[vertices]
     off = np.abs(sums[vertices] - 1.0) > NORMALIZED_TOLERANCE
-    groups = [mesh_obj.vertex_groups[name] for name in bone_names]
-    for vertex, bone, weight in zip(vertices[off].tolist(), bones[off].tolist(), scaled[off].tolist()):
-        groups[bone].add([vertex], weight, 'REPLACE')
+    _write_weights(mesh_obj, bone_names, vertices[off], bones[off], scaled[off])
     return sums > 0
+
+
+def _write_weights(mesh_obj, bone_names, vertices, bones, weights):
+    """Set weight ``weights[k]`` of vertex ``vertices[k]`` in the group of bone ``bones[k]`` (an index into
+    ``bone_names``)."""
+    groups = [mesh_obj.vertex_groups[name] for name in bone_names]
+    for vertex, bone, weight in zip(vertices.tolist(), bones.tolist(), weights.tolist()):
+        groups[bone].add([vertex], weight, 'REPLACE')

@@ -11,7 +11,7 @@ import numpy as np
 
 from .arrays import column_bounds
 
-# The smallest principal variance, relative to the largest, below which the mesh has no volume to rig.
+# A principal variance this small relative to the largest is none: two such make a line, one a flat mesh.
 LINE_VARIANCE_RATIO = 1e-12
 
 
@@ -23,8 +23,8 @@ class Mesh:
         triangles: (M, 3) int32, read-only, indexing ``vertices``; faces that repeat a vertex index are removed.
         degenerate_count: how many such faces were removed.
 
-    ``bbox``, ``scale`` and ``centroid`` describe the vertices that triangles use, so a stray loose vertex cannot
-    distort them.
+    ``bbox``, ``scale``, ``centroid`` and ``flat_normal`` describe the vertices that triangles use, so a stray loose
+    vertex cannot distort them.
     """
 
     def __init__(self, vertices, triangles):
@@ -54,14 +54,29 @@ class Mesh:
         points = self._used_points
         return _read_only(np.ones(len(points)) @ points / len(points))  # a BLAS product: faster than mean(axis=0)
 
+    @cached_property
+    def _principal(self):
+        """Principal variances (ascending) and axes (columns) of the used vertices."""
+        centred = self._used_points - self.centroid
+        return np.linalg.eigh(centred.T @ centred)
+
+    @cached_property
+    def flat_normal(self):
+        """(3,) unit normal of the plane a flat mesh (a 2D cut-out) lies in, its largest component positive; None
+        for a mesh with thickness."""
+        variances, axes = self._principal
+        if variances[0] > LINE_VARIANCE_RATIO * variances[2]:
+            return None
+        normal = axes[:, 0]
+        return _read_only(normal * np.sign(normal[np.argmax(np.abs(normal))]))
+
     def __repr__(self):
         return f"Mesh({len(self.vertices)} vertices, {len(self.triangles)} triangles)"
 
     def _reject_line(self):
         """A flat mesh is fine (a 2D cut-out character rigs in its plane); one with no extent in two directions
         has no outline to rig."""
-        centred = self._used_points - self.centroid
-        variances = np.linalg.eigvalsh(centred.T @ centred)
+        variances = self._principal[0]
         if variances[2] <= 0:
             raise ValueError("mesh has zero size: every vertex of its triangles is at the same point")
         if variances[1] <= LINE_VARIANCE_RATIO * variances[2]:

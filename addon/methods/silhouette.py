@@ -73,14 +73,17 @@ class SilhouetteMethod(RigMethod):
         clock = StageClock()
         vertices, triangles = mesh.vertices, mesh.triangles
         axis = choose_axis(vertices, triangles) if view == "AUTO" else AXIS_NAMES.index(view)
-        sil, tri, graph = planar_axis(vertices, triangles, AXES[axis], resolution, outline_spacing, min_hole)
+        direction, flat = AXES[axis], mesh.flat_normal
+        if view == "AUTO" and flat is not None and abs(flat @ direction) < 1 - 1e-9:
+            direction = flat  # a flat mesh tilted off the axis planes: look straight at it, not edge-on
+        sil, tri, graph = planar_axis(vertices, triangles, direction, resolution, outline_spacing, min_hole)
         clock.lap("silhouette_cdt_axis")
 
         alive, merged, kept = _pruned_tree(graph, merge, prune, MIN_BRANCH * bone_length * mesh.scale)
         clock.lap("merge_prune")
 
         side = side_sil = side_graph = None
-        side_view = side_view and np.ptp(vertices @ sil.direction) > 0  # a flat mesh has nothing to hide in depth
+        side_view = side_view and flat is None  # a flat mesh has nothing to hide in depth
         if side_view:
             spread = _variances(vertices)
             side_axis = max((a for a in range(3) if a != axis), key=lambda a: spread.sum() - spread[a])
@@ -324,8 +327,8 @@ class _BoneBuilder:
 
     def add_blob(self, sil, point2d, radius):
         """An island whose axis is a single node (a round speck): one short bone through it, pointing up."""
-        layers = sil.layers(point2d[None])[0]
-        depth = 0.5 * (layers[0, 0] + layers[-1, 1]) if len(layers) else 0.0
+        front, back = sil.depth(point2d[None])
+        depth = 0.5 * (front[0] + back[0]) if not np.isnan(front[0]) else 0.0
         centre = sil.lift(point2d[None], [depth])[0]
         half = max(radius, sil.cell) * sil.v
         ends = np.array([centre - half, centre + half])

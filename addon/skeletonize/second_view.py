@@ -57,8 +57,8 @@ def hidden(sil, points, width):
     for longer than ``width`` — behind or along something, like a foot under a body or a leg seen end-on, not at the
     edge of a thin sheet."""
     offset = points - sil.origin
-    layers = sil.layers(np.stack([offset @ sil.u, offset @ sil.v], axis=1))
-    return np.array([len(layer) > 0 and layer[-1, 1] - layer[0, 0] > width for layer in layers], dtype=bool)
+    front, back = sil.depth(np.stack([offset @ sil.u, offset @ sil.v], axis=1))
+    return ~np.isnan(front) & (back - front > width)
 
 
 def _flattened(points, direction):
