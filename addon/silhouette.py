@@ -98,6 +98,12 @@ class Silhouette:
         """
         return self._trace.layers(_as_points(points))
 
+    def share_parts(self, other):
+        """Take for ``layers`` the welded connected parts that ``other``, a silhouette of the same mesh seen along
+        another direction, has found (finding them now if it has not): the parts belong to the mesh, not the view,
+        so the views of one mesh weld and join it once. ValueError if ``other`` traced a different mesh."""
+        self._trace.share_components(other._trace)
+
     def lift(self, points, depth):
         """3D positions of (P, 2) frame points at the given depths (scalar or (P,))."""
         pts = _as_points(points)

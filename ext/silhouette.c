@@ -149,6 +149,7 @@ const char *sil_error_message(int code)
     case SIL_ERR_ZERO_AREA: return "every triangle projects to zero area along this direction: there is no silhouette";
     case SIL_ERR_RESOLUTION: return "resolution is out of range";
     case SIL_ERR_TOLERANCE: return "tolerance must be between 0 and 1 (a fraction of a grid cell)";
+    case SIL_ERR_MISMATCH: return "the two traces come from different meshes";
     case SIL_ERR_INTERNAL: return "internal error in the silhouette tracer; please report it with the mesh";
     default: return "unknown error";
     }
@@ -2009,6 +2010,18 @@ static int build_components(SilTrace *t)
     t->vertex_comp = weld;
     free(table);
     free(parent);
+    return SIL_OK;
+}
+
+int sil_share_components(SilTrace *t, SilTrace *source)
+{
+    if (t->n_vertices != source->n_vertices || t->n_all != source->n_all) return SIL_ERR_MISMATCH;
+    if (t->vertex_comp) return SIL_OK;
+    int rc = build_components(source);
+    if (rc != SIL_OK) return rc;
+    t->vertex_comp = alloc_array(t->n_vertices, sizeof(int32_t));
+    if (!t->vertex_comp) return SIL_ERR_NOMEM;
+    memcpy(t->vertex_comp, source->vertex_comp, (size_t)t->n_vertices * sizeof(int32_t));
     return SIL_OK;
 }
 

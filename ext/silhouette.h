@@ -27,6 +27,7 @@ enum {
     SIL_ERR_ZERO_AREA,
     SIL_ERR_RESOLUTION,
     SIL_ERR_TOLERANCE,
+    SIL_ERR_MISMATCH,
     SIL_ERR_INTERNAL
 };
 
@@ -64,6 +65,11 @@ int sil_depth(SilTrace *trace, const double *points, int64_t n, double *front, d
  * *intervals (2 per interval: entry, exit) are malloc'ed; release both with sil_release. */
 int sil_layers(SilTrace *trace, const double *points, int64_t n, int64_t **offsets, double **intervals);
 void sil_release(void *memory);
+
+/* Give `trace` the welded connected components `source` has found (finding them now if it has not): they depend on
+ * the mesh, not on the view, so the views of one mesh find them once. Both must trace the same vertices and
+ * triangles (SIL_ERR_MISMATCH when their counts differ). */
+int sil_share_components(SilTrace *trace, SilTrace *source);
 
 #ifdef __cplusplus
 }

@@ -15,6 +15,7 @@ cdef extern from "silhouette.h":
     int SIL_ERR_NOMEM
     int SIL_ERR_EMPTY
     int SIL_ERR_INTERNAL
+    int SIL_ERR_MISMATCH
     int SIL_MIN_RESOLUTION
     int SIL_MAX_RESOLUTION
     const char *sil_error_message(int code)
@@ -29,6 +30,7 @@ cdef extern from "silhouette.h":
     int sil_depth(SilTrace *trace, const double *points, int64_t n, double *front, double *back)
     int sil_layers(SilTrace *trace, const double *points, int64_t n, int64_t **offsets, double **intervals)
     void sil_release(void *memory)
+    int sil_share_components(SilTrace *trace, SilTrace *source)
 
 
 MIN_RESOLUTION = SIL_MIN_RESOLUTION
@@ -85,6 +87,12 @@ cdef class Trace:
         if code != SIL_OK:
             raise_for(code)
         return front, back
+
+    def share_components(self, Trace source):
+        """Take the welded connected components ``source`` (a trace of the same mesh) has found, for ``layers``."""
+        cdef int code = sil_share_components(self.handle, source.handle)
+        if code != SIL_OK:
+            raise_for(code)
 
     def layers(self, const double[:, ::1] points):
         """Per (P, 2) frame point, a (K, 2) array of (entry, exit) depths where the ray is inside the mesh."""

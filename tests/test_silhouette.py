@@ -518,6 +518,24 @@ def test_layers_weld_split_vertices():
     assert np.allclose(sil.layers([[0.1, 0.2]])[0], [[-0.5, 0.5]])
 
 
+def test_layers_with_parts_shared_from_another_view_match_their_own():
+    """The welded parts are the mesh's, not the view's: a view that takes them from another gives the same layers."""
+    v, t = box((0, 0, 0), (1, 1, 1))
+    split = v[t].reshape(-1, 3)
+    mesh = combine((split, np.arange(len(split)).reshape(-1, 3)), box((0, 3, 0), (1, 4, 1)),
+                   box((0.2, 0.2, 0.2), (0.6, 0.6, 0.6)))
+    points = np.random.default_rng(3).uniform(-1, 1.5, (200, 2))
+    for direction in ("X", "Z", (1, 2, 3)):
+        own = silhouette.trace(*mesh, direction)
+        shared = silhouette.trace(*mesh, direction)
+        shared.share_parts(silhouette.trace(*mesh, "Y"))
+        for a, b in zip(own.layers(points), shared.layers(points)):
+            np.testing.assert_array_equal(a, b)
+    other = silhouette.trace(*box((0, 0, 0), (1, 1, 1)), "Y")
+    with pytest.raises(ValueError, match="different meshes"):
+        shared.share_parts(other)
+
+
 def test_layers_of_open_surfaces():
     """A single sheet is a zero-thickness layer; a tube open at both ends is entered and left."""
     sheet = (np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]]), np.array([[0, 1, 2], [0, 2, 3]]))

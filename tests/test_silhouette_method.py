@@ -217,6 +217,32 @@ def test_legs_hidden_under_the_body_come_from_the_perpendicular_view():
     assert inside_fraction(vertices, triangles, bone_samples(skeleton)) >= 0.9
 
 
+def fox():
+    """Ellipsoid parts, each a closed mesh: a body along Z (so the side view, along X, shows it widest), a head, two
+    ears on top whose side views overlap in one wide bump on the head, four legs and a tail."""
+    sphere, sphere_triangles = uv_sphere()
+    parts = [((0.0, 0.0, 0.0), (0.12, 0.12, 0.4)), ((0.0, 0.12, 0.5), (0.09, 0.09, 0.12)),   # body, head
+             ((0.06, 0.24, 0.5), (0.025, 0.08, 0.06)), ((-0.06, 0.24, 0.5), (0.025, 0.08, 0.06)),  # ears
+             ((0.0, 0.05, -0.65), (0.05, 0.05, 0.3))]                                       # tail
+    parts += [((x, -0.3, z), (0.03, 0.25, 0.03)) for x in (0.08, -0.08) for z in (0.3, -0.3)]  # legs
+    vertices = np.vstack([sphere * size + centre for centre, size in parts])
+    triangles = np.vstack([sphere_triangles + k * len(sphere) for k in range(len(parts))])
+    return vertices, triangles
+
+
+def test_ears_hidden_in_the_side_view_come_from_the_end_on_view():
+    """From the side both ears are one stubby bump, pruned; the end-on view (along the body) shows two."""
+    vertices, triangles = fox()
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    np.testing.assert_allclose(np.abs(skeleton.stages["view"]), [1, 0, 0])
+    joints = skeleton.joints()
+    for tip in ((0.06, 0.32, 0.5), (-0.06, 0.32, 0.5)):
+        assert np.linalg.norm(joints - tip, axis=1).min() < 0.02, f"no joint near the ear tip at {tip}"
+    without = rigger.rig_mesh(vertices, triangles, side_view=False)
+    assert np.linalg.norm(without.joints() - (0.06, 0.32, 0.5), axis=1).min() > 0.1  # the primary view alone: no ears
+    assert inside_fraction(vertices, triangles, bone_samples(skeleton)) >= 0.9
+
+
 @pytest.mark.parametrize("shape", ["sphere", "square"])
 def test_a_round_blob_gets_one_root_bone_through_its_middle(shape):
     if shape == "sphere":

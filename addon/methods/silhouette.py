@@ -6,7 +6,8 @@ branch point and cut the loops holes make, put every axis point inside the mesh 
 through several stacked parts, and asking the perpendicular view where the primary one is occluded), then cut the
 chains into bones at sharp turns and at a maximum length. Islands of the silhouette each get their own bones, parented
 to the nearest bone of the largest island. Last, limbs the primary view hides behind the body (a bird's legs under
-its spread wings) are taken from the perpendicular view's tree and hung from the nearest bone.
+its spread wings, a fox's ears seen from the side) are taken from the trees of the two perpendicular views (the side
+view, then the end-on view along the longest extent) and hung from the nearest bone.
 """
 
 import numpy as np
@@ -31,7 +32,12 @@ AXIS_NAMES = ("X", "Y", "Z")
 MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
 SAME_SHAPE = 0.6  # ... and get mirrored joints when their shapes agree this closely (in tolerances)
 SHAPE_SAMPLES = 9  # points along each chain compared for that
-HIDDEN_REACH = 1.0  # side-view limb tips this many bone lengths off the skeleton (seen from the side) are missing
+HIDDEN_REACH = 0.6  # perpendicular-view limb tips this many bone lengths off the skeleton (seen that way) are missing
+HIDDEN_PRUNE = 2 / 3  # the perpendicular views prune at this fraction of ``prune``: a limb they add must also be off the
+# primary skeleton and hidden in the primary view, so they can trust stubbier branches (a fox's ears)
+END_RESOLUTION = 1 / 3  # the end-on view (along the longest extent) only looks for limbs, at this fraction of the
+# resolution: limbs are coarse features, and its trace costs less
+MIN_RESOLUTION = 64  # the coarsest grid any view gets
 
 
 class SilhouetteMethod(RigMethod):
@@ -43,7 +49,7 @@ class SilhouetteMethod(RigMethod):
     params = (
         Param("view", "enum", "AUTO", items=("AUTO", "X", "Y", "Z"),
               description="Projection axis; AUTO picks the axis that shows the mesh widest"),
-        Param("resolution", "int", 384, min=64, max=8192,
+        Param("resolution", "int", 384, min=MIN_RESOLUTION, max=8192,
               description="Silhouette grid cells along the longest side; higher keeps thinner gaps apart"),
         Param("outline_spacing", "float", 0.01, min=0.001, max=0.1,
               description="Longest outline edge fed to the triangulation, as a fraction of the silhouette size"),
@@ -64,8 +70,8 @@ class SilhouetteMethod(RigMethod):
         Param("split_layers", "bool", True,
               description="Split chains whose view rays cross the mesh in separate parts (stacked legs)"),
         Param("side_view", "bool", True,
-              description="Use the perpendicular silhouette for depth where the primary view is occluded, and "
-                          "for the limbs it hides"),
+              description="Use the perpendicular silhouettes: for depth where the primary view is occluded, "
+                          "and for the limbs it hides"),
     )
 
     def rig(self, mesh, *, view, resolution, outline_spacing, min_hole, merge, prune, bone_angle, bone_length,
@@ -86,9 +92,10 @@ class SilhouetteMethod(RigMethod):
         side_view = side_view and flat is None  # a flat mesh has nothing to hide in depth
         if side_view:
             spread = _variances(vertices)
-            side_axis = max((a for a in range(3) if a != axis), key=lambda a: spread.sum() - spread[a])
+            side_axis, end_axis = sorted((a for a in range(3) if a != axis), key=lambda a: spread[a])
             side_sil, _, side_graph = planar_axis(vertices, triangles, AXES[side_axis], resolution, outline_spacing,
                                                   min_hole)
+            side_sil.share_parts(sil)
             side = SideAxis(side_sil, side_graph.points, side_graph.radius, sil.direction)
 
         plane = mirror_plane(vertices, 0.01 * mesh.scale)
@@ -100,8 +107,14 @@ class SilhouetteMethod(RigMethod):
             else:
                 builder.add_island(*placed[1:])
         if side_view:
-            builder.add_limbs(_hidden_limbs(sil, side_sil, side_graph, builder.lines, merge, prune,
-                                            bone_length * mesh.scale, split_layers))
+            hidden = dict(merge=merge, prune=HIDDEN_PRUNE * prune, bone_length=bone_length * mesh.scale,
+                          split_layers=split_layers)
+            builder.add_limbs(_hidden_limbs(sil, side_sil, side_graph, builder.lines, **hidden))
+            end_sil, _, end_graph = planar_axis(vertices, triangles, AXES[end_axis],
+                                                max(MIN_RESOLUTION, round(END_RESOLUTION * resolution)),
+                                                outline_spacing, min_hole)
+            end_sil.share_parts(sil)
+            builder.add_limbs(_hidden_limbs(sil, end_sil, end_graph, builder.lines, **hidden))
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()

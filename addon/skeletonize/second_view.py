@@ -1,10 +1,12 @@
 """Limbs the primary view hides: leaf chains of the perpendicular view that the primary skeleton does not reach.
 
 The primary view shows the mesh widest, which can hide limbs behind the body (a bird's legs under its spread wings,
-seen from above; a fish's side fins, seen from the side). The perpendicular view shows them. Its placed chains are
-compared with the primary skeleton in the perpendicular view's own plane: a leaf chain whose tip lies farther than
-``reach`` from every primary chain there is a limb the primary skeleton lacks; its part beyond the last point the
-primary skeleton comes within ``reach`` of is added. Parts both views show (a wing seen edge-on) are never doubled.
+seen from above; a fish's side fins or a fox's ears, seen from the side). A perpendicular view shows them. Its placed
+chains are compared with the primary skeleton in the perpendicular view's own plane: a leaf chain whose tip lies
+farther than ``reach`` from every primary chain there is a limb the primary skeleton lacks; its part beyond the last
+point the primary skeleton comes within ``reach`` of is added, from the first node outside that reach (the covered
+node's depth is the body's, often a merged blob's centre far behind the limb). Parts both views show (a wing seen
+edge-on) are never doubled.
 """
 import numpy as np
 
@@ -26,7 +28,7 @@ def uncovered_limbs(placed, primary_lines, primary_sil, direction, reach, min_le
         reach: how near (in projection) a primary chain must pass to cover a point.
         min_length: shorter uncovered parts are dropped.
 
-    Returns a list of (polyline, half-widths), each starting where the primary skeleton stops covering the limb.
+    Returns a list of (polyline, half-widths), each starting at its first node the primary skeleton does not cover.
     """
     starts, ends = _segments(primary_lines, direction)
     parents = {parent for _, parent, _ in placed}
@@ -39,7 +41,7 @@ def uncovered_limbs(placed, primary_lines, primary_sil, direction, reach, min_le
         if not hidden(primary_sil, line[-1:], 2 * OCCLUSION_RATIO * float(np.median(widths)))[0]:
             continue
         covered = np.flatnonzero(_distance_to_segments(_flattened(line, direction), starts, ends) <= reach)
-        first = int(covered[-1]) if len(covered) else 0
+        first = int(covered[-1]) + 1 if len(covered) else 0  # not the covered node: its depth is the body's
         part = line[first:]
         if len(part) >= 2 and length(part) >= min_length:
             limbs.append((part, widths[first:]))

@@ -66,31 +66,30 @@ def chains_of(nodes, links):
         neighbours[a].append(b)
         neighbours[b].append(a)
     keys = {n for n, adj in neighbours.items() if len(adj) != 2}
-    visited = set()
+    arrived = set()  # (key, node before it) of every chain walked: its far end, not to be walked back
     chains = []
     for start in sorted(keys):
         for first in neighbours[start]:
-            if (start, first) in visited:
-                continue
-            chains.append(_walk(start, first, neighbours, keys, visited))
+            if (start, first) not in arrived:
+                chains.append(_walk(start, first, neighbours, keys, arrived))
+    walked = {n for chain in chains for n in chain}
     for start in sorted(neighbours):  # pure cycles
-        if start in keys or any((start, n) in visited for n in neighbours[start]):
-            continue
-        keys.add(start)
-        chains.append(_walk(start, neighbours[start][0], neighbours, keys, visited))
+        if start not in keys and start not in walked:
+            keys.add(start)
+            chain = _walk(start, neighbours[start][0], neighbours, keys, arrived)
+            walked.update(chain)
+            chains.append(chain)
     return keys, chains
 
 
-def _walk(start, first, neighbours, keys, visited):
+def _walk(start, first, neighbours, keys, arrived):
     path = [start, first]
-    visited.add((start, first))
-    visited.add((first, start))
-    while path[-1] not in keys:
-        here, before = path[-1], path[-2]
-        step = neighbours[here][0] if neighbours[here][0] != before else neighbours[here][1]
-        visited.add((here, step))
-        visited.add((step, here))
-        path.append(step)
+    before, here = start, first
+    while here not in keys:
+        a, b = neighbours[here]
+        before, here = here, (a if a != before else b)
+        path.append(here)
+    arrived.add((here, before))
     return path
 
 
