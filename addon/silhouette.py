@@ -49,6 +49,7 @@ import numpy as np
 from . import _rigger_silhouette
 from .core.arrays import index_array, numeric_array, point_array
 
+NoSilhouette = _rigger_silhouette.NoSilhouette  # a ValueError: the mesh shows no area along the direction
 DEFAULT_RESOLUTION = 1024
 DEFAULT_TOLERANCE = 0.05
 AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
@@ -101,7 +102,8 @@ class Silhouette:
     def share_parts(self, other):
         """Take for ``layers`` the welded connected parts that ``other``, a silhouette of the same mesh seen along
         another direction, has found (finding them now if it has not): the parts belong to the mesh, not the view,
-        so the views of one mesh weld and join it once. ValueError if ``other`` traced a different mesh."""
+        so the views of one mesh weld and join it once. ValueError if ``other`` traced other triangles or another
+        number of vertices."""
         self._trace.share_components(other._trace)
 
     def lift(self, points, depth):
@@ -130,7 +132,8 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
 
     Raises:
         ValueError: wrong shapes, NaN or infinite coordinates, out-of-range indices, an empty mesh, a bad
-            direction or resolution or tolerance, or a mesh whose projection has zero area.
+            direction or resolution or tolerance; :class:`NoSilhouette` (a ValueError) for a mesh whose
+            projection has zero area.
     """
     verts = point_array(vertices, 3, "vertices")
     tris = index_array(triangles, 3, len(verts), name="triangles", item="triangle", target=("vertex", "vertices"),

@@ -68,7 +68,8 @@ void sil_release(void *memory);
 
 /* Give `trace` the welded connected components `source` has found (finding them now if it has not): they depend on
  * the mesh, not on the view, so the views of one mesh find them once. Both must trace the same vertices and
- * triangles (SIL_ERR_MISMATCH when their counts differ). */
+ * triangles (SIL_ERR_MISMATCH when the vertex counts or the triangles differ). A trace that has its components
+ * keeps them. */
 int sil_share_components(SilTrace *trace, SilTrace *source);
 
 #ifdef __cplusplus

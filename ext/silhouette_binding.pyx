@@ -16,6 +16,7 @@ cdef extern from "silhouette.h":
     int SIL_ERR_EMPTY
     int SIL_ERR_INTERNAL
     int SIL_ERR_MISMATCH
+    int SIL_ERR_ZERO_AREA
     int SIL_MIN_RESOLUTION
     int SIL_MAX_RESOLUTION
     const char *sil_error_message(int code)
@@ -37,8 +38,14 @@ MIN_RESOLUTION = SIL_MIN_RESOLUTION
 MAX_RESOLUTION = SIL_MAX_RESOLUTION
 
 
+class NoSilhouette(ValueError):
+    """Every triangle projects to zero area along the direction: the mesh shows nothing that way."""
+
+
 cdef raise_for(int code):
     message = sil_error_message(code).decode()
+    if code == SIL_ERR_ZERO_AREA:
+        raise NoSilhouette(message)
     if code == SIL_ERR_NOMEM:
         raise MemoryError(message)
     if code == SIL_ERR_INTERNAL:
@@ -88,7 +95,7 @@ cdef class Trace:
             raise_for(code)
         return front, back
 
-    def share_components(self, Trace source):
+    def share_components(self, Trace source not None):
         """Take the welded connected components ``source`` (a trace of the same mesh) has found, for ``layers``."""
         cdef int code = sil_share_components(self.handle, source.handle)
         if code != SIL_OK:

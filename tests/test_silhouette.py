@@ -531,9 +531,19 @@ def test_layers_with_parts_shared_from_another_view_match_their_own():
         shared.share_parts(silhouette.trace(*mesh, "Y"))
         for a, b in zip(own.layers(points), shared.layers(points)):
             np.testing.assert_array_equal(a, b)
+    nested = silhouette.trace(*mesh, "Z")
+    nested.share_parts(nested)  # its own parts: found once, kept
+    for a, b in zip(silhouette.trace(*mesh, "Z").layers(points), nested.layers(points)):
+        np.testing.assert_array_equal(a, b)
     other = silhouette.trace(*box((0, 0, 0), (1, 1, 1)), "Y")
     with pytest.raises(ValueError, match="different meshes"):
         shared.share_parts(other)
+    cube = box((0, 0, 0), (1, 1, 1))
+    turned = silhouette.trace(cube[0], cube[1][:, ::-1], "Y")  # the same vertices, other triangles
+    with pytest.raises(ValueError, match="different meshes"):
+        turned.share_parts(other)
+    with pytest.raises(TypeError):
+        shared._trace.share_components(None)
 
 
 def test_layers_of_open_surfaces():
@@ -614,7 +624,7 @@ def test_bad_input_is_a_value_error():
 
 def test_zero_area_message():
     flat = np.array([[0, 0, 0], [1, 0, 0], [0, 0, 1.0]])
-    with pytest.raises(ValueError, match="zero area"):
+    with pytest.raises(silhouette.NoSilhouette, match="zero area"):
         silhouette.trace(flat, [[0, 1, 2]], "X")
     assert len(silhouette.trace(flat, [[0, 1, 2]], "Y").loops) == 1
 

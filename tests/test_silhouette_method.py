@@ -230,7 +230,7 @@ def fox():
     return vertices, triangles
 
 
-def test_ears_hidden_in_the_side_view_come_from_the_end_on_view():
+def test_ears_hidden_in_the_primary_view_come_from_the_end_on_view():
     """From the side both ears are one stubby bump, pruned; the end-on view (along the body) shows two."""
     vertices, triangles = fox()
     skeleton = rigger.rig_mesh(vertices, triangles)
@@ -241,6 +241,20 @@ def test_ears_hidden_in_the_side_view_come_from_the_end_on_view():
     without = rigger.rig_mesh(vertices, triangles, side_view=False)
     assert np.linalg.norm(without.joints() - (0.06, 0.32, 0.5), axis=1).min() > 0.1  # the primary view alone: no ears
     assert inside_fraction(vertices, triangles, bone_samples(skeleton)) >= 0.9
+
+
+def test_an_open_tube_rigs_though_it_shows_nothing_end_on():
+    """Every face runs along the tube, so the end-on view has no area: that view finds no limbs, the rig goes on."""
+    angle = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    rings = [np.c_[0.1 * np.cos(angle), 0.1 * np.sin(angle), np.full(16, z)] for z in np.linspace(-1, 1, 11)]
+    vertices = np.vstack(rings)
+    triangles = [(r * 16 + k, r * 16 + (k + 1) % 16, (r + 1) * 16 + k) for r in range(10) for k in range(16)]
+    triangles += [(r * 16 + (k + 1) % 16, (r + 1) * 16 + (k + 1) % 16, (r + 1) * 16 + k)
+                  for r in range(10) for k in range(16)]
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    joints = skeleton.joints()
+    assert np.ptp(joints[:, 2]) > 1.5 and np.abs(joints[:, :2]).max() < 0.1  # along the tube, inside it
+    assert len(rigger.rig_mesh(vertices, triangles, side_view=False)) == len(skeleton)
 
 
 @pytest.mark.parametrize("shape", ["sphere", "square"])

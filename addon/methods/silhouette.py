@@ -7,7 +7,7 @@ through several stacked parts, and asking the perpendicular view where the prima
 chains into bones at sharp turns and at a maximum length. Islands of the silhouette each get their own bones, parented
 to the nearest bone of the largest island. Last, limbs the primary view hides behind the body (a bird's legs under
 its spread wings, a fox's ears seen from the side) are taken from the trees of the two perpendicular views (the side
-view, then the end-on view along the longest extent) and hung from the nearest bone.
+view, then the end-on one: along the longest extent when the view is AUTO) and hung from the nearest bone.
 """
 
 import numpy as np
@@ -35,9 +35,9 @@ SHAPE_SAMPLES = 9  # points along each chain compared for that
 HIDDEN_REACH = 0.6  # perpendicular-view limb tips this many bone lengths off the skeleton (seen that way) are missing
 HIDDEN_PRUNE = 2 / 3  # the perpendicular views prune at this fraction of ``prune``: a limb they add must also be off the
 # primary skeleton and hidden in the primary view, so they can trust stubbier branches (a fox's ears)
-END_RESOLUTION = 1 / 3  # the end-on view (along the longest extent) only looks for limbs, at this fraction of the
-# resolution: limbs are coarse features, and its trace costs less
-MIN_RESOLUTION = 64  # the coarsest grid any view gets
+END_RESOLUTION = 1 / 3  # the end-on view (the remaining axis of larger spread: along the longest extent when the view
+# is AUTO) only looks for limbs, at this fraction of the resolution: limbs are coarse features, and its trace costs less
+MIN_VIEW_RESOLUTION = 64  # the coarsest grid any view gets
 
 
 class SilhouetteMethod(RigMethod):
@@ -49,7 +49,7 @@ class SilhouetteMethod(RigMethod):
     params = (
         Param("view", "enum", "AUTO", items=("AUTO", "X", "Y", "Z"),
               description="Projection axis; AUTO picks the axis that shows the mesh widest"),
-        Param("resolution", "int", 384, min=MIN_RESOLUTION, max=8192,
+        Param("resolution", "int", 384, min=MIN_VIEW_RESOLUTION, max=8192,
               description="Silhouette grid cells along the longest side; higher keeps thinner gaps apart"),
         Param("outline_spacing", "float", 0.01, min=0.001, max=0.1,
               description="Longest outline edge fed to the triangulation, as a fraction of the silhouette size"),
@@ -88,15 +88,16 @@ class SilhouetteMethod(RigMethod):
         alive, merged, kept = _pruned_tree(graph, merge, prune, MIN_BRANCH * bone_length * mesh.scale)
         clock.lap("merge_prune")
 
-        side = side_sil = side_graph = None
-        side_view = side_view and flat is None  # a flat mesh has nothing to hide in depth
-        if side_view:
+        side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
+        if side_view and flat is None:  # a flat mesh has nothing to hide in depth
             spread = _variances(vertices)
             side_axis, end_axis = sorted((a for a in range(3) if a != axis), key=lambda a: spread[a])
-            side_sil, _, side_graph = planar_axis(vertices, triangles, AXES[side_axis], resolution, outline_spacing,
-                                                  min_hole)
-            side_sil.share_parts(sil)
-            side = SideAxis(side_sil, side_graph.points, side_graph.radius, sil.direction)
+            side_of = _other_view(vertices, triangles, sil, side_axis, resolution, outline_spacing, min_hole)
+            end_on = _other_view(vertices, triangles, sil, end_axis,
+                                 max(MIN_VIEW_RESOLUTION, round(END_RESOLUTION * resolution)), outline_spacing, min_hole)
+            if side_of is not None:
+                side = SideAxis(side_of[0], side_of[1].points, side_of[1].radius, sil.direction)
+            other_views = [view for view in (side_of, end_on) if view is not None]
 
         plane = mirror_plane(vertices, 0.01 * mesh.scale)
         builder = _BoneBuilder(np.radians(bone_angle), bone_length * mesh.scale, max_chain_bones, plane,
@@ -106,15 +107,10 @@ class SilhouetteMethod(RigMethod):
                 builder.add_blob(sil, *placed[1:])
             else:
                 builder.add_island(*placed[1:])
-        if side_view:
-            hidden = dict(merge=merge, prune=HIDDEN_PRUNE * prune, bone_length=bone_length * mesh.scale,
-                          split_layers=split_layers)
-            builder.add_limbs(_hidden_limbs(sil, side_sil, side_graph, builder.lines, **hidden))
-            end_sil, _, end_graph = planar_axis(vertices, triangles, AXES[end_axis],
-                                                max(MIN_RESOLUTION, round(END_RESOLUTION * resolution)),
-                                                outline_spacing, min_hole)
-            end_sil.share_parts(sil)
-            builder.add_limbs(_hidden_limbs(sil, end_sil, end_graph, builder.lines, **hidden))
+        limb_search = dict(merge=merge, prune=HIDDEN_PRUNE * prune, bone_length=bone_length * mesh.scale,
+                           split_layers=split_layers)
+        for view_sil, view_graph in other_views:
+            builder.add_limbs(_hidden_limbs(sil, view_sil, view_graph, builder.lines, **limb_search))
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()
@@ -162,19 +158,30 @@ def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):
         yield ("island",) + place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers)
 
 
-def _hidden_limbs(sil, side_sil, side_graph, lines, merge, prune, bone_length, split_layers):
-    """Limbs the primary view hides behind the body, from the perpendicular view's pruned tree (see
-    ``second_view``); its chains are placed in depth only when a leaf tip lies off the primary skeleton."""
+def _other_view(vertices, triangles, primary, axis, resolution, spacing, min_hole):
+    """(silhouette, chordal axis) along another axis, sharing the primary view's welded parts; None where the mesh
+    shows nothing that way (an open tube seen end-on)."""
+    try:
+        view_sil, _, view_graph = planar_axis(vertices, triangles, AXES[axis], resolution, spacing, min_hole)
+    except silhouette.NoSilhouette:
+        return None
+    view_sil.share_parts(primary)
+    return view_sil, view_graph
+
+
+def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, bone_length, split_layers):
+    """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``);
+    the view's chains are placed in depth only when a leaf tip lies off the primary skeleton."""
     reach, min_length = HIDDEN_REACH * bone_length, MIN_BRANCH * bone_length
-    alive, _, kept = _pruned_tree(side_graph, merge, prune, min_length)
+    alive, _, kept = _pruned_tree(view_graph, merge, prune, min_length)
     ends, count = np.unique(kept, return_counts=True)
-    tips = side_graph.points[ends[count == 1]]
-    if not uncovered(side_sil.lift(tips, 0.0), lines, side_sil.direction, reach).any():
-        return []  # every leaf tip is on the primary skeleton: no need to place the side chains in depth
+    tips = view_graph.points[ends[count == 1]]
+    if not uncovered(view_sil.lift(tips, 0.0), lines, view_sil.direction, reach).any():
+        return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
     limbs = []
-    for kind, _, placed in _placed_islands(side_sil, side_graph, alive, kept, SPECK * bone_length, None, split_layers):
+    for kind, _, placed in _placed_islands(view_sil, view_graph, alive, kept, SPECK * bone_length, None, split_layers):
         if kind == "island":
-            limbs += uncovered_limbs(placed, lines, sil, side_sil.direction, reach, min_length)
+            limbs += uncovered_limbs(placed, lines, sil, view_sil.direction, reach, min_length)
     return limbs
 
 

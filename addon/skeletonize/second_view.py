@@ -28,7 +28,8 @@ def uncovered_limbs(placed, primary_lines, primary_sil, direction, reach, min_le
         reach: how near (in projection) a primary chain must pass to cover a point.
         min_length: shorter uncovered parts are dropped.
 
-    Returns a list of (polyline, half-widths), each starting at its first node the primary skeleton does not cover.
+    Returns a list of (polyline, half-widths), each starting at the node past the last one the primary skeleton
+    covers.
     """
     starts, ends = _segments(primary_lines, direction)
     parents = {parent for _, parent, _ in placed}
@@ -36,11 +37,10 @@ def uncovered_limbs(placed, primary_lines, primary_sil, direction, reach, min_le
     for index, (line, _, widths) in enumerate(placed):
         if index in parents or len(line) < 2:
             continue
-        if _distance_to_segments(_flattened(line[-1:], direction), starts, ends)[0] <= reach:
+        near = _distance_to_segments(_flattened(line, direction), starts, ends) <= reach
+        if near[-1] or not hidden(primary_sil, line[-1:], 2 * OCCLUSION_RATIO * float(np.median(widths)))[0]:
             continue
-        if not hidden(primary_sil, line[-1:], 2 * OCCLUSION_RATIO * float(np.median(widths)))[0]:
-            continue
-        covered = np.flatnonzero(_distance_to_segments(_flattened(line, direction), starts, ends) <= reach)
+        covered = np.flatnonzero(near)
         first = int(covered[-1]) + 1 if len(covered) else 0  # not the covered node: its depth is the body's
         part = line[first:]
         if len(part) >= 2 and length(part) >= min_length:
