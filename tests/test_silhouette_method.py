@@ -195,16 +195,20 @@ def uv_sphere(rings=16, segments=32):
     return vertices, np.array(triangles)
 
 
-def bird():
-    """Ellipsoid parts, each a closed mesh: a body, wings spread along X (so the view from above, along Y, shows the
-    bird widest) and two legs hanging below the body, hidden behind it in that view."""
+def ellipsoids(parts):
+    """One closed UV-sphere mesh per (centre, semi-axes) part, all in one vertex and triangle array."""
     sphere, sphere_triangles = uv_sphere()
-    parts = [((0.0, 0.0, 0.0), (0.15, 0.15, 0.4)),                      # body, along Z
-             ((0.6, 0.05, 0.0), (0.5, 0.03, 0.2)), ((-0.6, 0.05, 0.0), (0.5, 0.03, 0.2)),  # wings
-             ((0.08, -0.3, 0.0), (0.03, 0.25, 0.03)), ((-0.08, -0.3, 0.0), (0.03, 0.25, 0.03))]  # legs
     vertices = np.vstack([sphere * size + centre for centre, size in parts])
     triangles = np.vstack([sphere_triangles + k * len(sphere) for k in range(len(parts))])
     return vertices, triangles
+
+
+def bird():
+    """Ellipsoid parts: a body, wings spread along X (so the view from above, along Y, shows the bird widest) and two
+    legs hanging below the body, hidden behind it in that view."""
+    return ellipsoids([((0.0, 0.0, 0.0), (0.15, 0.15, 0.4)),                      # body, along Z
+                       ((0.6, 0.05, 0.0), (0.5, 0.03, 0.2)), ((-0.6, 0.05, 0.0), (0.5, 0.03, 0.2)),  # wings
+                       ((0.08, -0.3, 0.0), (0.03, 0.25, 0.03)), ((-0.08, -0.3, 0.0), (0.03, 0.25, 0.03))])  # legs
 
 
 def test_legs_hidden_under_the_body_come_from_the_perpendicular_view():
@@ -218,16 +222,13 @@ def test_legs_hidden_under_the_body_come_from_the_perpendicular_view():
 
 
 def fox():
-    """Ellipsoid parts, each a closed mesh: a body along Z (so the side view, along X, shows it widest), a head, two
-    ears on top whose side views overlap in one wide bump on the head, four legs and a tail."""
-    sphere, sphere_triangles = uv_sphere()
+    """Ellipsoid parts: a body along Z (so the side view, along X, shows it widest), a head, two ears on top whose
+    side views overlap in one wide bump on the head, four legs and a tail."""
     parts = [((0.0, 0.0, 0.0), (0.12, 0.12, 0.4)), ((0.0, 0.12, 0.5), (0.09, 0.09, 0.12)),   # body, head
              ((0.06, 0.24, 0.5), (0.025, 0.08, 0.06)), ((-0.06, 0.24, 0.5), (0.025, 0.08, 0.06)),  # ears
              ((0.0, 0.05, -0.65), (0.05, 0.05, 0.3))]                                       # tail
     parts += [((x, -0.3, z), (0.03, 0.25, 0.03)) for x in (0.08, -0.08) for z in (0.3, -0.3)]  # legs
-    vertices = np.vstack([sphere * size + centre for centre, size in parts])
-    triangles = np.vstack([sphere_triangles + k * len(sphere) for k in range(len(parts))])
-    return vertices, triangles
+    return ellipsoids(parts)
 
 
 def test_ears_hidden_in_the_primary_view_come_from_the_end_on_view():

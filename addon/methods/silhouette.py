@@ -21,7 +21,7 @@ from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mi
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
 from ..skeletonize.polyline import resampled
-from ..skeletonize.second_view import segment_distances, uncovered, uncovered_limbs
+from ..skeletonize.second_view import Cover, segment_distances, uncovered_limbs
 from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chains
 
 AXES = np.eye(3)
@@ -85,7 +85,8 @@ class SilhouetteMethod(RigMethod):
         sil, tri, graph = planar_axis(vertices, triangles, direction, resolution, outline_spacing, min_hole)
         clock.lap("silhouette_cdt_axis")
 
-        alive, merged, kept = _pruned_tree(graph, merge, prune, MIN_BRANCH * bone_length * mesh.scale)
+        unit = bone_length * mesh.scale  # the bone length in mesh units
+        alive, merged, kept = _pruned_tree(graph, merge, prune, MIN_BRANCH * unit)
         clock.lap("merge_prune")
 
         side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
@@ -97,18 +98,16 @@ class SilhouetteMethod(RigMethod):
                                  max(MIN_VIEW_RESOLUTION, round(END_RESOLUTION * resolution)), outline_spacing, min_hole)
             if side_of is not None:
                 side = SideAxis(side_of[0], side_of[1].points, side_of[1].radius, sil.direction)
-            other_views = [view for view in (side_of, end_on) if view is not None]
+            other_views = [found for found in (side_of, end_on) if found is not None]
 
         plane = mirror_plane(vertices, 0.01 * mesh.scale)
-        builder = _BoneBuilder(np.radians(bone_angle), bone_length * mesh.scale, max_chain_bones, plane,
-                               MIRROR_TOLERANCE * mesh.scale)
-        for placed in _placed_islands(sil, graph, alive, kept, SPECK * bone_length * mesh.scale, side, split_layers):
+        builder = _BoneBuilder(np.radians(bone_angle), unit, max_chain_bones, plane, MIRROR_TOLERANCE * mesh.scale)
+        for placed in _placed_islands(sil, graph, alive, kept, SPECK * unit, side, split_layers):
             if placed[0] == "blob":
                 builder.add_blob(sil, *placed[1:])
             else:
                 builder.add_island(*placed[1:])
-        limb_search = dict(merge=merge, prune=HIDDEN_PRUNE * prune, bone_length=bone_length * mesh.scale,
-                           split_layers=split_layers)
+        limb_search = dict(merge=merge, prune=HIDDEN_PRUNE * prune, bone_length=unit, split_layers=split_layers)
         for view_sil, view_graph in other_views:
             builder.add_limbs(_hidden_limbs(sil, view_sil, view_graph, builder.lines, **limb_search))
         clock.lap("depth_bones")
@@ -176,12 +175,13 @@ def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, bone_length, s
     alive, _, kept = _pruned_tree(view_graph, merge, prune, min_length)
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]
-    if not uncovered(view_sil.lift(tips, 0.0), lines, view_sil.direction, reach).any():
+    cover = Cover(lines, view_sil.direction, reach)
+    if cover.covered(view_sil.lift(tips, 0.0)).all():
         return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
     limbs = []
     for kind, _, placed in _placed_islands(view_sil, view_graph, alive, kept, SPECK * bone_length, None, split_layers):
         if kind == "island":
-            limbs += uncovered_limbs(placed, lines, sil, view_sil.direction, reach, min_length)
+            limbs += uncovered_limbs(placed, cover, sil, min_length)
     return limbs
 
 

@@ -167,16 +167,16 @@ def mirror_chain_pairs(lines, plane, tolerance):
     ends = np.array([[line[0], line[-1]] for line in lines])  # (C, 2, 3)
     images = mirrored(ends, plane)
     side = np.array([_side(line, plane, tolerance) for line in lines])
-    pairs, taken = [], set()
+    pairs, taken = [], np.zeros(len(lines), bool)
     for i in range(len(lines)):
-        if i in taken or side[i] == 0:
+        if taken[i] or side[i] == 0:
             continue
         cost = np.linalg.norm(ends - images[i], axis=2).sum(axis=1)
-        cost[(side != -side[i]) | np.isin(np.arange(len(lines)), list(taken))] = np.inf
+        cost[(side != -side[i]) | taken] = np.inf
         j = int(np.argmin(cost))
         if cost[j] <= 2 * tolerance:
             pairs.append((i, j))
-            taken.update((i, j))
+            taken[[i, j]] = True
     return pairs
 
 

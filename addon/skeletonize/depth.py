@@ -201,7 +201,7 @@ class SideAxis:
 
     def __init__(self, side_sil, points, radius, primary_direction):
         """``points`` (n, 2) and ``radius`` (n,): the side view's chordal axis nodes in ``side_sil``'s plane."""
-        world = side_sil.origin + points[:, :1] * side_sil.u + points[:, 1:] * side_sil.v
+        world = side_sil.lift(points, 0.0)
         self.w_axis = np.cross(primary_direction, side_sil.direction)
         self.w = world @ self.w_axis
         self.along = world @ primary_direction

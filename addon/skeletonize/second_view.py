@@ -14,44 +14,48 @@ from .depth import OCCLUSION_RATIO
 from .polyline import length
 
 
-def uncovered_limbs(placed, primary_lines, primary_sil, direction, reach, min_length):
+class Cover:
+    """The primary skeleton as a perpendicular view sees it: its chains flattened along the view ``direction`` once,
+    and which points they cover (come within ``reach`` of, both projected along the direction)."""
+
+    def __init__(self, primary_lines, direction, reach):
+        self.direction, self.reach = direction, reach
+        self.starts, self.ends = _segments(primary_lines, direction)
+
+    def covered(self, points):
+        """Whether each of the 3D ``points`` lies within ``reach`` of a primary chain, seen along the direction."""
+        return _distance_to_segments(_flattened(points, self.direction), self.starts, self.ends) <= self.reach
+
+
+def uncovered_limbs(placed, cover, primary_sil, min_length):
     """The outer parts of the leaf chains in ``placed`` that the primary skeleton does not cover.
 
     Args:
         placed: the perpendicular view's chains, as ``depth.place_chains`` gives them: (polyline (k, 3), parent,
             half-widths (k,)).
-        primary_lines: the primary skeleton's chains, 3D polylines.
+        cover: the primary skeleton's ``Cover`` along the perpendicular view's direction.
         primary_sil: the primary ``Silhouette``: a limb counts only where it is hidden there, its tip's ray running
             through the mesh for much longer than the limb is wide (a foot under a body); a tip the primary view
             shows plainly (the edge of a thin sheet) was seen there and judged no limb.
-        direction: the perpendicular view's direction (unit); both are compared projected along it.
-        reach: how near (in projection) a primary chain must pass to cover a point.
         min_length: shorter uncovered parts are dropped.
 
     Returns a list of (polyline, half-widths), each starting at the node past the last one the primary skeleton
     covers.
     """
-    starts, ends = _segments(primary_lines, direction)
     parents = {parent for _, parent, _ in placed}
     limbs = []
     for index, (line, _, widths) in enumerate(placed):
         if index in parents or len(line) < 2:
             continue
-        near = _distance_to_segments(_flattened(line, direction), starts, ends) <= reach
-        if near[-1] or not hidden(primary_sil, line[-1:], 2 * OCCLUSION_RATIO * float(np.median(widths)))[0]:
+        tip = line[-1:]  # the cheap tests first: most leaf chains end on the primary skeleton
+        if cover.covered(tip)[0] or not hidden(primary_sil, tip, 2 * OCCLUSION_RATIO * float(np.median(widths)))[0]:
             continue
-        covered = np.flatnonzero(near)
+        covered = np.flatnonzero(cover.covered(line))
         first = int(covered[-1]) + 1 if len(covered) else 0  # not the covered node: its depth is the body's
         part = line[first:]
         if len(part) >= 2 and length(part) >= min_length:
             limbs.append((part, widths[first:]))
     return limbs
-
-
-def uncovered(points, primary_lines, direction, reach):
-    """Which 3D ``points`` lie farther than ``reach`` from every primary chain, both projected along ``direction``."""
-    starts, ends = _segments(primary_lines, direction)
-    return _distance_to_segments(_flattened(points, direction), starts, ends) > reach
 
 
 def hidden(sil, points, width):
