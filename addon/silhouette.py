@@ -112,6 +112,19 @@ class Silhouette:
         d = np.broadcast_to(np.asarray(depth, dtype=np.float64), (len(pts),))
         return self.origin + pts[:, :1] * self.u + pts[:, 1:] * self.v + d[:, None] * self.direction
 
+    def project(self, points):
+        """The frame points (P, 2) and depths (P,) of (P, 3) points: the inverse of ``lift``."""
+        offset = point_array(points, 3, "points") - self.origin
+        return np.stack([offset @ self.u, offset @ self.v], axis=1), offset @ self.direction
+
+    def encloses(self, points, slack=0.0):
+        """Which (P, 3) points lie within the mesh's hull as this view sees it: inside the silhouette and, give or
+        take ``slack``, between the nearest and farthest surface along their ray. Unlike ``layers`` this needs no
+        closed surface, so it holds on open and self-intersecting meshes; it cannot see gaps along the ray."""
+        frame, depth = self.project(points)
+        front, back = self.depth(frame)
+        return (depth >= front - slack) & (depth <= back + slack)  # NaN (a miss) compares False
+
 
 def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
     """Trace the silhouette of a triangle soup seen along ``direction``.

@@ -26,7 +26,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
 from benchkit import (SHARED_MODELS, cpu_model, described_commit, format_seconds, markdown_table,  # noqa: E402
                       table_cell)
-from rigger.skeletonize.second_view import segment_distances  # noqa: E402  (bpy-free)
+from rigger.skeletonize.polyline import segment_distances  # noqa: E402  (bpy-free)
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 MODELS_DIR = SHARED_MODELS / "gt"

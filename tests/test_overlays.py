@@ -10,7 +10,7 @@ import rigger  # noqa: E402
 from rigger.blender import overlays, samples  # noqa: E402
 from rigger.methods._template import TemplateMethod  # noqa: E402
 from rigger.skeletonize.chordal import ISOLATED, JUNCTION, SLEEVE, TERMINAL  # noqa: E402
-from rigger.skeletonize.second_view import segment_distances  # noqa: E402
+from rigger.skeletonize.polyline import segment_distances  # noqa: E402
 
 KINDS = [key for key, _, _ in overlays.OVERLAY_KINDS]
 LINE_KINDS = ("silhouette", "axis", "pruned", "chains")

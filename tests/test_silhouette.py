@@ -415,6 +415,22 @@ def test_frame_is_orthonormal_and_points_lift_back(direction):
     assert np.allclose(sil.direction, np.array(direction) / np.linalg.norm(direction))
     depth = (vertices - sil.origin) @ sil.direction
     assert np.allclose(sil.lift(frame_points(sil, vertices), depth), vertices)
+    frame, depth_again = sil.project(vertices)
+    assert np.allclose(sil.lift(frame, depth_again), vertices)
+
+
+def test_encloses_is_the_hull_seen_along_the_view():
+    """Within the silhouette and between the nearest and farthest surface: a gap across the view is outside, a gap
+    along it (between two boxes one behind the other) is not; so is an open sheet's own plane, given slack."""
+    near, far = box((0, 0, 0), (1, 1, 1)), box((0, 3, 0), (1, 4, 1))
+    beside = box((2, 0, 0), (3, 1, 1))
+    sil = silhouette.trace(*combine(near, far, beside), "Y")
+    points = [[0.5, 0.5, 0.5], [0.5, 2.0, 0.5], [0.5, 4.5, 0.5], [1.5, 0.5, 0.5], [2.5, 0.5, 0.5]]
+    assert sil.encloses(points).tolist() == [True, True, False, False, True]
+    square = np.array([[0, 0, 0.3], [1, 0, 0.3], [1, 1, 0.3], [0, 1, 0.3]], float)
+    sheet = silhouette.trace(square, [[0, 1, 2], [0, 2, 3]], "Z")
+    assert sheet.encloses([[0.5, 0.5, 0.3]], 1e-9).tolist() == [True]
+    assert sheet.encloses([[0.5, 0.5, 0.4]], 1e-9).tolist() == [False]
 
 
 # ------------------------------------------------------------------------------------------------ depth

@@ -244,6 +244,33 @@ def test_ears_hidden_in_the_primary_view_come_from_the_end_on_view():
     assert inside_fraction(vertices, triangles, bone_samples(skeleton)) >= 0.9
 
 
+def boxes(*corners):
+    """Closed axis-aligned boxes, (low corner, high corner) each, in one vertex and triangle array."""
+    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
+    faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                      [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    vertices = np.vstack([low + cube * (np.subtract(high, low)) for low, high in corners])
+    return vertices, np.vstack([faces + 8 * k for k in range(len(corners))])
+
+
+def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh():
+    """A foot at the bottom of a body whose nearest bone is in a hand hanging beside it, across a gap: the foot
+    hangs from the body's bone, farther but reached without leaving the mesh."""
+    from rigger.methods.silhouette import _BoneBuilder
+
+    vertices, triangles = boxes(((0, 0, 0), (1, 3, 1)), ((1.3, 0, 0), (1.6, 2, 1)))  # body and leg; hand
+    sil = rigger.silhouette.trace(vertices, triangles, "Z")
+    builder = _BoneBuilder(np.radians(40), 1.0, 0, None, 0.05)
+    body = np.array([[0.5, 2.8, 0.5], [0.5, 1.5, 0.5]])
+    hand = np.array([[1.45, 2.0, 0.5], [1.45, 0.2, 0.5]])
+    builder.add_island(body[0], [(body, -1, np.full(2, 0.4)), (hand, 0, np.full(2, 0.1))])
+    foot = np.array([[0.8, 0.3, 0.5], [0.8, 0.1, 0.9]])
+    builder.add_limbs([(foot, np.full(2, 0.1))], sil)
+    heads, _, parents = builder.arrays()
+    in_body = np.flatnonzero(heads[:, 0] < 1)
+    assert parents[-1] in in_body[:-1], "the foot hangs from the hand across the gap"
+
+
 def test_an_open_tube_rigs_though_it_shows_nothing_end_on():
     """Every face runs along the tube, so the end-on view has no area: that view finds no limbs, the rig goes on."""
     angle = np.linspace(0, 2 * np.pi, 16, endpoint=False)

@@ -20,7 +20,7 @@ from rigger import samples  # noqa: E402
 from rigger.blender import skinning  # noqa: E402
 from rigger.blender.armature import build_armature  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
-from rigger.skeletonize.second_view import segment_distances  # noqa: E402
+from rigger.skeletonize.polyline import segment_distances  # noqa: E402
 
 import rigdata  # noqa: E402
 

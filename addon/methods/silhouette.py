@@ -20,8 +20,8 @@ from ..core.timing import StageClock
 from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mirror_plane, mirrored
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
-from ..skeletonize.polyline import resampled
-from ..skeletonize.second_view import Cover, segment_distances, uncovered_limbs
+from ..skeletonize.polyline import nearest_on_segments, resampled, segment_distances
+from ..skeletonize.second_view import Cover, uncovered_limbs
 from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chains
 
 AXES = np.eye(3)
@@ -38,6 +38,7 @@ HIDDEN_PRUNE = 2 / 3  # the perpendicular views prune at this fraction of ``prun
 END_RESOLUTION = 1 / 3  # the end-on view (the remaining axis of larger spread: along the longest extent when the view
 # is AUTO) only looks for limbs, at this fraction of the resolution: limbs are coarse features, and its trace costs less
 MIN_VIEW_RESOLUTION = 64  # the coarsest grid any view gets
+PATH_SAMPLES = 16  # points tested along the path from a hidden limb to the bone it hangs from
 
 
 class SilhouetteMethod(RigMethod):
@@ -109,7 +110,7 @@ class SilhouetteMethod(RigMethod):
                 builder.add_island(*placed[1:])
         limb_search = dict(merge=merge, prune=HIDDEN_PRUNE * prune, bone_length=unit, split_layers=split_layers)
         for view_sil, view_graph in other_views:
-            builder.add_limbs(_hidden_limbs(sil, view_sil, view_graph, builder.lines, **limb_search))
+            builder.add_limbs(_hidden_limbs(sil, view_sil, view_graph, builder.lines, **limb_search), sil)
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()
@@ -292,13 +293,26 @@ class _BoneBuilder:
             added = self._add_chain(line, joints[i], up)
             first_bone[i], last_bone[i] = (added[0], added[-1]) if added else (up, up)
 
-    def add_limbs(self, limbs):
-        """Bones along extra chains, (polyline, half-widths) each, hung from the bone nearest their start."""
+    def add_limbs(self, limbs, sil):
+        """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone their start reaches
+        through the mesh (``sil``, the primary silhouette, tells inside from out)."""
         if not limbs:
             return
         joints = self._joints([(line, widths, True) for line, widths in limbs])
         for (line, _), along in zip(limbs, joints):
-            self._add_chain(line, along, self._attachment(line[0]))
+            self._add_chain(line, along, self._reached_bone(line[0], sil))
+
+    def _reached_bone(self, point, sil):
+        """The nearest bone that a straight path from ``point`` reaches within the mesh as ``sil`` sees it (a foot
+        under a hand that hangs beside the leg belongs to the body, not the hand), or the nearest bone when no
+        path does."""
+        heads, tails = np.array(self.heads), np.array(self.tails)
+        ends = nearest_on_segments(point[None], heads, tails)[0]
+        order = np.argsort(np.linalg.norm(ends - point, axis=1), kind="stable")
+        along = np.arange(1, PATH_SAMPLES + 1) / (PATH_SAMPLES + 1)
+        paths = point + along[None, :, None] * (ends[order] - point)[:, None, :]
+        within = sil.encloses(paths.reshape(-1, 3), sil.cell).reshape(len(order), PATH_SAMPLES).all(axis=1)
+        return int(order[np.argmax(within)]) if within.any() else int(order[0])
 
     def _joints(self, chains):
         """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror pairs made symmetric."""

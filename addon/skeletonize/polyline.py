@@ -1,4 +1,5 @@
-"""Measuring along polylines (axis-node chains, placed 3D chains): shared by the tree, second-view and bone steps."""
+"""Measuring along and to polylines (axis-node chains, placed 3D chains, bones): shared by the tree, second-view and
+bone steps."""
 import numpy as np
 
 
@@ -21,3 +22,16 @@ def resampled(line, count):
     """``count`` points evenly spaced by arc length along a polyline."""
     arc = arc_lengths(line)
     return point_at(line, arc, np.linspace(0.0, arc[-1], count))
+
+
+def nearest_on_segments(points, starts, ends):
+    """The (P, S, 3) points of each segment ``starts[k]``–``ends[k]`` nearest each of the (P, 3) ``points``."""
+    seg = ends - starts
+    length2 = np.maximum((seg * seg).sum(axis=1), 1e-300)
+    t = np.clip(((points[:, None, :] - starts[None]) * seg[None]).sum(axis=2) / length2, 0.0, 1.0)
+    return starts[None] + t[..., None] * seg[None]
+
+
+def segment_distances(points, starts, ends):
+    """(P, S) distances from each of the (P, 3) ``points`` to each segment ``starts[k]``–``ends[k]``."""
+    return np.linalg.norm(points[:, None, :] - nearest_on_segments(points, starts, ends), axis=2)

@@ -11,7 +11,7 @@ edge-on) are never doubled.
 import numpy as np
 
 from .depth import OCCLUSION_RATIO
-from .polyline import length
+from .polyline import length, segment_distances
 
 
 class Cover:
@@ -62,8 +62,7 @@ def hidden(sil, points, width):
     """Which 3D ``points`` are hidden in ``sil``: their view ray runs through the mesh, from first entry to last exit,
     for longer than ``width`` — behind or along something, like a foot under a body or a leg seen end-on, not at the
     edge of a thin sheet."""
-    offset = points - sil.origin
-    front, back = sil.depth(np.stack([offset @ sil.u, offset @ sil.v], axis=1))
+    front, back = sil.depth(sil.project(points)[0])
     return ~np.isnan(front) & (back - front > width)
 
 
@@ -75,15 +74,6 @@ def _segments(lines, direction):
     starts = np.concatenate([line[:-1] for line in lines if len(line) > 1] or [np.zeros((0, 3))])
     ends = np.concatenate([line[1:] for line in lines if len(line) > 1] or [np.zeros((0, 3))])
     return _flattened(starts, direction), _flattened(ends, direction)
-
-
-def segment_distances(points, starts, ends):
-    """(P, S) distances from each of the (P, 3) ``points`` to each segment ``starts[k]``–``ends[k]``."""
-    seg = ends - starts
-    length2 = np.maximum((seg * seg).sum(axis=1), 1e-300)
-    rel = points[:, None, :] - starts[None]
-    t = np.clip((rel * seg[None]).sum(axis=2) / length2, 0.0, 1.0)
-    return np.linalg.norm(rel - t[..., None] * seg[None], axis=2)
 
 
 def _distance_to_segments(points, starts, ends):
