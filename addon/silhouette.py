@@ -10,6 +10,8 @@ Example::
     front, back = sil.depth(sil.loops[0])                # nearest / farthest mesh depth along each ray
     sil.layers([(0.0, 1.2)])      # [(L, 2) array of (entry, exit) depths where the ray is inside the mesh]
     sil.lift(points, front)       # back to 3D: origin + x*u + y*v + depth*direction
+    sil.project(points3d)         # (points, depths) in the view's frame: the inverse of lift
+    sil.encloses(points3d)        # within the outline and between the nearest and farthest surface
 
 How it works, and why it cannot fail: the projected triangles are snapped to an integer lattice (65536 steps per
 grid cell) and every inside/outside decision is exact integer arithmetic under a symbolic perturbation, so no grid

@@ -7,7 +7,8 @@ through several stacked parts, and asking the perpendicular view where the prima
 chains into bones at sharp turns and at a maximum length. Islands of the silhouette each get their own bones, parented
 to the nearest bone of the largest island. Last, limbs the primary view hides behind the body (a bird's legs under
 its spread wings, a fox's ears seen from the side) are taken from the trees of the two perpendicular views (the side
-view, then the end-on one: along the longest extent when the view is AUTO) and hung from the nearest bone.
+view, then the end-on one: along the longest extent when the view is AUTO) and hung from the nearest bone they reach
+without leaving the mesh.
 """
 
 import numpy as np
