@@ -33,7 +33,7 @@ from .core.arrays import point_array
 DEFAULT_BONES_PER_POINT = 4
 DEFAULT_POWER = 4.0
 DEFAULT_FACING_PENALTY = 1.0
-MAX_BONES = 2**31 - 1  # bone indices are int32
+MAX_BONES = _rigger_weights.MAX_BONES  # bone indices and the bone tree's nodes are int32
 
 
 @dataclass(frozen=True, eq=False)

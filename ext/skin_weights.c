@@ -138,8 +138,9 @@ static double box_distance_squared(const Node *node, const double point[3])
 }
 
 /* The point's reach key for one bone: the distance to the segment plus facing_penalty times how far the segment's
- * nearest point lies in front of the surface (along the unit normal). Never less than the plain distance. */
-static double bone_key(const double point[3], const double *normal, const double *head, const double *tail,
+ * nearest point lies in front of the surface (along the unit normal, or NULL for none). Never less than the plain
+ * distance. */
+static double bone_key(const double point[3], const double *unit_normal, const double *head, const double *tail,
                        double facing_penalty)
 {
     double axis[3], along = 0.0, length_squared = 0.0;
@@ -155,16 +156,25 @@ static double bone_key(const double point[3], const double *normal, const double
         distance_squared += toward[k] * toward[k];
     }
     double distance = sqrt(distance_squared);
-    if (!normal || facing_penalty == 0.0)
+    if (!unit_normal || facing_penalty == 0.0)
         return distance;
-    double facing = 0.0, normal_squared = 0.0;
-    for (int k = 0; k < 3; k++) {
-        facing += normal[k] * toward[k];
-        normal_squared += normal[k] * normal[k];
-    }
-    if (!(facing > 0.0) || !(normal_squared > 0.0))
-        return distance;
-    return distance + facing_penalty * facing / sqrt(normal_squared);
+    double facing = 0.0;
+    for (int k = 0; k < 3; k++)
+        facing += unit_normal[k] * toward[k];
+    return facing > 0.0 ? distance + facing_penalty * facing : distance;
+}
+
+/* `normal` scaled to unit length into `unit`; NULL (no facing penalty) for a missing or zero normal. */
+static const double *unit_or_null(const double *normal, double unit[3])
+{
+    if (!normal)
+        return NULL;
+    double length = sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+    if (!(length > 0.0))
+        return NULL;
+    for (int k = 0; k < 3; k++)
+        unit[k] = normal[k] / length;
+    return unit;
 }
 
 /* Keep `best` sorted with at most `capacity` entries. */
@@ -185,7 +195,8 @@ static void offer(Keyed *best, int32_t *count, int32_t capacity, double key, int
  * first; a node is skipped when its box is farther than the worst key kept (the key is never below the distance, so
  * nothing better is lost). */
 static void nearest_bones(const Tree *tree, const double *heads, const double *tails, const double point[3],
-                          const double *normal, double facing_penalty, Keyed *best, int32_t capacity, Pending *stack)
+                          const double *unit_normal, double facing_penalty, Keyed *best, int32_t capacity,
+                          Pending *stack)
 {
     int32_t count = 0, top = 0;
     stack[top++] = (Pending){0, 0.0}; /* the root's distance is never read: nothing is kept yet when it is visited */
@@ -200,7 +211,7 @@ static void nearest_bones(const Tree *tree, const double *heads, const double *t
         if (node->count) {
             for (int32_t i = node->first; i < node->first + node->count; i++) {
                 int32_t bone = tree->order[i];
-                double key = bone_key(point, normal, heads + 3 * (int64_t)bone, tails + 3 * (int64_t)bone,
+                double key = bone_key(point, unit_normal, heads + 3 * (int64_t)bone, tails + 3 * (int64_t)bone,
                                       facing_penalty);
                 offer(best, &count, capacity, key, bone);
             }
@@ -258,7 +269,7 @@ int sw_bone_weights(const double *points, int64_t n_points, const double *normal
                     const double *tails, int32_t n_bones, int32_t per_point, double power, double facing_penalty,
                     int32_t *bones_out, double *weights_out)
 {
-    if (n_points < 0 || n_bones < 1 || per_point < 1 || !(power > 0.0) || !isfinite(power) ||
+    if (n_points < 0 || n_bones < 1 || n_bones > SW_MAX_BONES || per_point < 1 || !(power > 0.0) || !isfinite(power) ||
         !(facing_penalty >= 0.0) || !isfinite(facing_penalty))
         return SW_ERR_ARGUMENT;
     Tree tree;
@@ -276,8 +287,9 @@ int sw_bone_weights(const double *points, int64_t n_points, const double *normal
         return SW_ERR_NOMEM;
     }
     for (int64_t p = 0; p < n_points; p++) {
-        const double *normal = normals ? normals + 3 * p : NULL;
-        nearest_bones(&tree, heads, tails, points + 3 * p, normal, facing_penalty, best, capacity, stack);
+        double unit[3];
+        const double *unit_normal = unit_or_null(normals ? normals + 3 * p : NULL, unit);
+        nearest_bones(&tree, heads, tails, points + 3 * p, unit_normal, facing_penalty, best, capacity, stack);
         point_weights(best, capacity, used, per_point, power, bones_out + p * per_point, weights_out + p * per_point);
     }
     free(best);

@@ -7,10 +7,13 @@ from libc.stdint cimport int32_t, int64_t
 
 import numpy as np
 
+MAX_BONES = SW_MAX_BONES  # the most bones one call takes
+
 
 cdef extern from "skin_weights.h":
     int SW_OK
     int SW_ERR_NOMEM
+    int SW_MAX_BONES
     const char *sw_error_message(int code)
     int sw_bone_weights(const double *points, int64_t n_points, const double *normals, const double *heads,
                         const double *tails, int32_t n_bones, int32_t per_point, double power, double facing_penalty,
