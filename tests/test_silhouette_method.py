@@ -300,7 +300,7 @@ def test_a_round_blob_gets_one_root_bone_through_its_middle(shape):
 
 def test_rig_time_is_recorded_per_stage(default_rig):
     timings = default_rig("snake")[2].stages["timings"]
-    assert {"silhouette_cdt_axis", "merge_prune", "depth_bones", "total"} <= set(timings)
+    assert {"silhouette_cdt_axis", "merge_prune", "other_views", "depth_bones", "total"} <= set(timings)
     assert all(t >= 0 for t in timings.values())
 
 

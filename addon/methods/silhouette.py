@@ -101,6 +101,7 @@ class SilhouetteMethod(RigMethod):
             if side_of is not None:
                 side = SideAxis(side_of[0], side_of[1].points, side_of[1].radius, sil.direction)
             other_views = [found for found in (side_of, end_on) if found is not None]
+        clock.lap("other_views")
 
         plane = mirror_plane(vertices, 0.01 * mesh.scale)
         builder = _BoneBuilder(np.radians(bone_angle), unit, max_chain_bones, plane, MIRROR_TOLERANCE * mesh.scale)
