@@ -11,7 +11,7 @@ Example::
     sil.layers([(0.0, 1.2)])      # [(L, 2) array of (entry, exit) depths where the ray is inside the mesh]
     sil.lift(points, front)       # back to 3D: origin + x*u + y*v + depth*direction
     sil.project(points3d)         # (points, depths) in the view's frame: the inverse of lift
-    sil.encloses(points3d)        # within the outline and between the nearest and farthest surface
+    sil.encloses(points3d)        # the ray hits the mesh and the depth lies between its nearest and farthest hit
 
 How it works, and why it cannot fail: the projected triangles are snapped to an integer lattice (65536 steps per
 grid cell) and every inside/outside decision is exact integer arithmetic under a symbolic perturbation, so no grid
@@ -120,9 +120,10 @@ class Silhouette:
         return np.stack([offset @ self.u, offset @ self.v], axis=1), offset @ self.direction
 
     def encloses(self, points, slack=0.0):
-        """Which (P, 3) points lie within the mesh's hull as this view sees it: inside the silhouette and, give or
-        take ``slack``, between the nearest and farthest surface along their ray. Unlike ``layers`` this needs no
-        closed surface, so it holds on open and self-intersecting meshes; it cannot see gaps along the ray."""
+        """Which (P, 3) points lie within the mesh's depth span as this view sees it (its visual hull): their ray
+        hits the mesh and, give or take ``slack``, they lie between the nearest and farthest hit. Unlike ``layers``
+        this needs no closed surface, so it holds on open and self-intersecting meshes; it cannot see gaps along the
+        ray (another view can)."""
         frame, depth = self.project(points)
         front, back = self.depth(frame)
         return (depth >= front - slack) & (depth <= back + slack)  # NaN (a miss) compares False

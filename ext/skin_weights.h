@@ -29,10 +29,10 @@ enum {
 const char *sw_error_message(int code);
 
 /* Weights of `n_points` xyz points over `n_bones` bone segments heads[i] -> tails[i] (interleaved xyz).
- * `normals` (n_points xyz, may be NULL, need not be unit length) enables the facing penalty. `per_point` >= 1 bones
- * per point (at most n_bones are used), 1 <= n_bones <= SW_MAX_BONES, `power` > 0, `facing_penalty` >= 0. Outputs are n_points x per_point,
- * row-major: bone indices by decreasing weight, -1 with weight 0 past the bones that carry weight; each row's
- * weights sum to 1. */
+ * `normals` (n_points xyz, may be NULL, need not be unit length) enables the facing penalty. 1 <= n_bones <=
+ * SW_MAX_BONES; `per_point` >= 1 bones per point (at most n_bones are used), `power` > 0, `facing_penalty` >= 0.
+ * Outputs are n_points x per_point, row-major: bone indices by decreasing weight, -1 with weight 0 past the bones
+ * that carry weight; each row's weights sum to 1. */
 int sw_bone_weights(const double *points, int64_t n_points, const double *normals, const double *heads,
                     const double *tails, int32_t n_bones, int32_t per_point, double power, double facing_penalty,
                     int32_t *bones_out, double *weights_out);

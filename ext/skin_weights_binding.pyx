@@ -7,8 +7,6 @@ from libc.stdint cimport int32_t, int64_t
 
 import numpy as np
 
-MAX_BONES = SW_MAX_BONES  # the most bones one call takes
-
 
 cdef extern from "skin_weights.h":
     int SW_OK
@@ -18,6 +16,8 @@ cdef extern from "skin_weights.h":
     int sw_bone_weights(const double *points, int64_t n_points, const double *normals, const double *heads,
                         const double *tails, int32_t n_bones, int32_t per_point, double power, double facing_penalty,
                         int32_t *bones_out, double *weights_out) nogil
+
+MAX_BONES = SW_MAX_BONES  # the most bones one call takes
 
 
 def bone_weights(const double[:, ::1] points, const double[:, ::1] normals, const double[:, ::1] heads,

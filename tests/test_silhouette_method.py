@@ -265,7 +265,7 @@ def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh()
     hand = np.array([[1.45, 2.0, 0.5], [1.45, 0.2, 0.5]])
     builder.add_island(body[0], [(body, -1, np.full(2, 0.4)), (hand, 0, np.full(2, 0.1))])
     foot = np.array([[0.8, 0.3, 0.5], [0.8, 0.1, 0.9]])
-    builder.add_limbs([(foot, np.full(2, 0.1))], sil)
+    builder.add_limbs([(foot, np.full(2, 0.1))], (sil,))
     heads, _, parents = builder.arrays()
     in_body = np.flatnonzero(heads[:, 0] < 1)
     assert parents[-1] in in_body[:-1], "the foot hangs from the hand across the gap"

@@ -35,7 +35,7 @@ def mesh_arrays(mesh):
 
 
 def world_points(points, matrix_world):
-    """(N, 3) ``points`` mapped by an object's 4x4 ``matrix_world`` (a mathutils Matrix or an array)."""
+    """(..., 3) ``points`` mapped by an object's 4x4 ``matrix_world`` (a mathutils Matrix or an array)."""
     world = np.array(matrix_world, dtype=np.float64)
     return points @ world[:3, :3].T + world[:3, 3]
 

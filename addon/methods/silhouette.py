@@ -8,7 +8,7 @@ chains into bones at sharp turns and at a maximum length. Islands of the silhoue
 to the nearest bone of the largest island. Last, limbs the primary view hides behind the body (a bird's legs under
 its spread wings, a fox's ears seen from the side) are taken from the trees of the two perpendicular views (the side
 view, then the end-on one: along the longest extent when the view is AUTO) and hung from the nearest bone they reach
-without leaving the mesh.
+without leaving the mesh's depth span in the primary view and their own.
 """
 
 import numpy as np
@@ -21,7 +21,7 @@ from ..core.timing import StageClock
 from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mirror_plane, mirrored
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
-from ..skeletonize.polyline import nearest_on_segments, resampled, segment_distances
+from ..skeletonize.polyline import nearest_on_segments, resampled
 from ..skeletonize.second_view import Cover, uncovered_limbs
 from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chains
 
@@ -39,7 +39,7 @@ HIDDEN_PRUNE = 2 / 3  # the perpendicular views prune at this fraction of ``prun
 END_RESOLUTION = 1 / 3  # the end-on view (the remaining axis of larger spread: along the longest extent when the view
 # is AUTO) only looks for limbs, at this fraction of the resolution: limbs are coarse features, and its trace costs less
 MIN_VIEW_RESOLUTION = 64  # the coarsest grid any view gets
-PATH_SAMPLES = 16  # points tested along the path from a hidden limb to the bone it hangs from
+MAX_PATH_SAMPLES = 256  # points tested along a path from a hidden limb to a bone it may hang from (one per cell)
 
 
 class SilhouetteMethod(RigMethod):
@@ -112,7 +112,7 @@ class SilhouetteMethod(RigMethod):
                 builder.add_island(*placed[1:])
         limb_search = dict(merge=merge, prune=HIDDEN_PRUNE * prune, bone_length=unit, split_layers=split_layers)
         for view_sil, view_graph in other_views:
-            builder.add_limbs(_hidden_limbs(sil, view_sil, view_graph, builder.lines, **limb_search), sil)
+            builder.add_limbs(_hidden_limbs(sil, view_sil, view_graph, builder.lines, **limb_search), (sil, view_sil))
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()
@@ -295,26 +295,14 @@ class _BoneBuilder:
             added = self._add_chain(line, joints[i], up)
             first_bone[i], last_bone[i] = (added[0], added[-1]) if added else (up, up)
 
-    def add_limbs(self, limbs, sil):
+    def add_limbs(self, limbs, views):
         """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone their start reaches
-        through the mesh (``sil``, the primary silhouette, tells inside from out)."""
+        within the mesh as all the silhouettes ``views`` see it (the primary one and the one the limbs come from)."""
         if not limbs:
             return
         joints = self._joints([(line, widths, True) for line, widths in limbs])
         for (line, _), along in zip(limbs, joints):
-            self._add_chain(line, along, self._reached_bone(line[0], sil))
-
-    def _reached_bone(self, point, sil):
-        """The nearest bone that a straight path from ``point`` reaches within the mesh as ``sil`` sees it (a foot
-        under a hand that hangs beside the leg belongs to the body, not the hand), or the nearest bone when no
-        path does."""
-        heads, tails = np.array(self.heads), np.array(self.tails)
-        ends = nearest_on_segments(point[None], heads, tails)[0]
-        order = np.argsort(np.linalg.norm(ends - point, axis=1), kind="stable")
-        along = np.arange(1, PATH_SAMPLES + 1) / (PATH_SAMPLES + 1)
-        paths = point + along[None, :, None] * (ends[order] - point)[:, None, :]
-        within = sil.encloses(paths.reshape(-1, 3), sil.cell).reshape(len(order), PATH_SAMPLES).all(axis=1)
-        return int(order[np.argmax(within)]) if within.any() else int(order[0])
+            self._add_chain(line, along, self._attachment(line[0], views))
 
     def _joints(self, chains):
         """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror pairs made symmetric."""
@@ -370,11 +358,24 @@ class _BoneBuilder:
         ends = np.array([centre - half, centre + half])
         self._add_chain(ends, ends, self._attachment(centre))
 
-    def _attachment(self, point):
-        """The bone nearest ``point`` (for a new island), or -1 for the first island."""
+    def _attachment(self, point, views=()):
+        """The bone nearest ``point``, or -1 before the first island. With silhouettes ``views``, the nearest bone
+        that a straight path from ``point`` reaches within the mesh as each of them sees it (``Silhouette.encloses``,
+        sampled every grid cell: a foot beside a hanging hand belongs to the body, not the hand), falling back to
+        the nearest bone when no path does."""
         if not self.heads:
             return -1
-        return int(np.argmin(segment_distances(point[None], np.array(self.heads), np.array(self.tails))[0]))
+        targets = nearest_on_segments(point[None], np.array(self.heads), np.array(self.tails))[0]
+        distance = np.linalg.norm(targets - point, axis=1)
+        order = np.argsort(distance, kind="stable")
+        if views:
+            cell = min(view.cell for view in views)
+            for bone in order:
+                count = int(np.clip(np.ceil(distance[bone] / cell), 1, MAX_PATH_SAMPLES))
+                path = point + (np.arange(1, count + 1) / (count + 1))[:, None] * (targets[bone] - point)
+                if all(view.encloses(path, view.cell).all() for view in views):
+                    return int(bone)
+        return int(order[0])
 
     def arrays(self):
         return np.array(self.heads), np.array(self.tails), np.array(self.parents, dtype=np.int64)
