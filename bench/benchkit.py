@@ -1,5 +1,5 @@
-"""Helpers the benchmarks share: where the shared models are, the machine and commit, markdown tables, time
-formatting, mesh refinement."""
+"""Helpers the benchmarks share: where the checkout, the shared models and the results are, the machine and commit,
+markdown tables, time formatting, mesh refinement."""
 import os
 import pathlib
 import subprocess
@@ -9,6 +9,7 @@ import numpy as np
 REPO = pathlib.Path(__file__).resolve().parents[1]
 # The read-only shared data beside the checkout (RIGGER_SHARED overrides, as for the tests).
 SHARED_MODELS = pathlib.Path(os.environ.get("RIGGER_SHARED", REPO.parent / "shared")) / "models"
+RESULTS_DIR = REPO / "bench" / "results"  # where every benchmark writes its report and plots
 
 
 def cpu_model():

@@ -22,13 +22,11 @@ import sys
 import time
 from dataclasses import dataclass, field
 from importlib import metadata
-from pathlib import Path
 
 import numpy as np
 
-from benchkit import cpu_model, format_seconds
+from benchkit import RESULTS_DIR, cpu_model, format_seconds
 
-RESULTS = Path(__file__).resolve().parent / "results"
 FULL_SIZES = (1_000, 10_000, 100_000, 1_000_000)
 QUICK_SIZES = FULL_SIZES[:3]
 CASES = ("random", "smooth", "saw")
@@ -521,11 +519,11 @@ def main(argv=None):
         print(f"{title}: " + ", ".join(verdicts))
     print(f"1,000-vertex smooth outline < 1 ms: {small_outline_verdict(results)}")
 
-    RESULTS.mkdir(parents=True, exist_ok=True)
+    RESULTS_DIR.mkdir(parents=True, exist_ok=True)
     command = "python bench/cdt.py " + " ".join(sys.argv[1:] if argv is None else argv)
-    (RESULTS / "cdt.md").write_text(markdown(results, command.strip(), started, load_before, load_after))
-    plot(results, RESULTS / "cdt.png")
-    print(f"wrote {RESULTS / 'cdt.md'} and {RESULTS / 'cdt.png'}; took "
+    (RESULTS_DIR / "cdt.md").write_text(markdown(results, command.strip(), started, load_before, load_after))
+    plot(results, RESULTS_DIR / "cdt.png")
+    print(f"wrote {RESULTS_DIR / 'cdt.md'} and {RESULTS_DIR / 'cdt.png'}; took "
           f"{(datetime.datetime.now(datetime.timezone.utc) - started).total_seconds():.0f} s")
     broken = [key for key, cell in results.cells.items() if cell.note.startswith("BAD")]
     return 1 if broken else 0

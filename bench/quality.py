@@ -20,11 +20,9 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
-from benchkit import SHARED_MODELS, cpu_model, markdown_table, table_cell  # noqa: E402
+from benchkit import RESULTS_DIR, SHARED_MODELS, cpu_model, markdown_table, table_cell  # noqa: E402
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
 MODELS_DIR = SHARED_MODELS / "gt"
-RESULTS_DIR = REPO / "bench" / "results"
 DRAWN_MODELS = ("CesiumMan", "Quaternius_Fox", "rignet_2982")
 REFERENCE_CD_J2J = {"stick": 0.147, "skeletor": 0.076}
 TARGETS = {"mean_cd_j2j": 0.045, "stretch_cd_j2j": 0.040, "mean_cd_b2b": 0.028, "max_cd_j2j": 0.08,
@@ -147,8 +145,7 @@ class GroundTruth:
 
     def __init__(self, folder):
         self.name = folder.name
-        self.vertices, self.triangles = rigdata.load_obj(folder / f"{self.name}.obj")
-        self.rig = rigdata.load_rig(folder / f"{self.name}_rig.txt", len(self.vertices)).without_helpers()
+        self.vertices, self.triangles, self.rig = rigdata.load_ground_truth(folder)
         self.normalisation = rigdata.Normalisation.of_mesh(self.vertices)
         self.unit_vertices = self.normalisation.points(self.vertices)
         self.bones = self.rig.bones().mapped(self.normalisation)

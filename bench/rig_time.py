@@ -36,11 +36,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
-from benchkit import (SHARED_MODELS, cpu_model, described_commit, markdown_table,  # noqa: E402
-                      midpoint_subdivided, table_cell)
+from benchkit import (REPO, RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit,  # noqa: E402
+                      markdown_table, midpoint_subdivided, table_cell)
 
-REPO = Path(__file__).resolve().parents[1]
-RESULTS = REPO / "bench" / "results"
 GENERATE_FLAG = "--generate-characters"  # child-process mode: write the characters' arrays into a directory
 GENERATION_TIMEOUT_S = 300
 SKIN_LEVELS = (0, 1, 2)  # Catmull-Clark levels over the Skin hull; the last one is refined further
@@ -509,14 +507,14 @@ def main(argv=None):
         print(f"{title}: {verdict}")
     print(f"load average before {load_before[0]:.2f}, after {load_after[0]:.2f}")
 
-    RESULTS.mkdir(parents=True, exist_ok=True)
+    RESULTS_DIR.mkdir(parents=True, exist_ok=True)
     command = "python bench/rig_time.py " + " ".join(sys.argv[1:] if argv is None else argv)
     run = {"command": command.strip(), "started": started, "seconds": time.perf_counter() - clock,
            "load_before": load_before, "load_after": load_after}
     notes = {"characters": characters_note, "real": real_note}
-    (RESULTS / "rig_time.md").write_text(markdown(measurements, summary, profiles, notes, run))
-    plot(measurements, series, stages, RESULTS / "rig_time.png")
-    print(f"wrote {RESULTS / 'rig_time.md'} and {RESULTS / 'rig_time.png'} in {run['seconds']:.0f} s")
+    (RESULTS_DIR / "rig_time.md").write_text(markdown(measurements, summary, profiles, notes, run))
+    plot(measurements, series, stages, RESULTS_DIR / "rig_time.png")
+    print(f"wrote {RESULTS_DIR / 'rig_time.md'} and {RESULTS_DIR / 'rig_time.png'} in {run['seconds']:.0f} s")
     return 1 if any(m.failed for m in measurements) else 0
 
 

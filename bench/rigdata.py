@@ -1,7 +1,8 @@
 """Ground-truth rigs and how skeletons are scored against them (the RigNet convention of ../shared/README.md).
 
 Bench-only: reads OBJ meshes and RigNet ``rig_info`` files, normalises everything so the mesh's largest bounding-box
-extent is 1, and measures CD-J2J, CD-J2B, CD-B2B and the fraction of bone samples inside the mesh.
+extent is 1, and measures CD-J2J, CD-J2B, CD-B2B and the fraction of bone samples inside the mesh. For skinning, it
+also reads the weights of a Blender mesh object's vertex groups (without importing bpy: the object is passed in).
 """
 import re
 from dataclasses import dataclass
@@ -222,6 +223,14 @@ def load_rig(path, n_vertices=None):
     return Rig(tuple(names), np.array(positions, dtype=np.float64), parents, root, skin)
 
 
+def load_ground_truth(folder):
+    """Vertices, triangles and artist rig (helper joints dropped) of the ground-truth model in ``folder`` (a
+    ``pathlib.Path``): ``NAME/NAME.obj`` and ``NAME/NAME_rig.txt``, the skin sized to the mesh."""
+    vertices, triangles = load_obj(folder / f"{folder.name}.obj")
+    rig = load_rig(folder / f"{folder.name}_rig.txt", len(vertices)).without_helpers()
+    return vertices, triangles, rig
+
+
 def _check_acyclic(parents, source):
     for start in range(len(parents)):
         joint = start
@@ -361,3 +370,22 @@ def dominant_joints(rig):
     top = np.asarray(skin.argmax(axis=1)).ravel()
     weighted = np.asarray(skin.max(axis=1).todense()).ravel() > 0
     return np.where(weighted, weight_owners(rig.parents)[top], -1)
+
+
+def vertex_group_weights(obj, names):
+    """(vertex index, index into ``names``, weight) of every weight Blender mesh object ``obj`` holds in the vertex
+    groups ``names``, vertex by vertex and, within a vertex, in Blender's own order."""
+    column = {group.index: names.index(group.name) for group in obj.vertex_groups if group.name in names}
+    for vertex in obj.data.vertices:
+        for element in vertex.groups:
+            if element.group in column:
+                yield vertex.index, column[element.group], element.weight
+
+
+def vertex_weights(obj, names):
+    """(N, len(names)) weights of mesh object ``obj``'s vertices in the vertex groups ``names``, in that order (0
+    where a group is missing)."""
+    table = np.zeros((len(obj.data.vertices), len(names)))
+    for vertex, column, weight in vertex_group_weights(obj, names):
+        table[vertex, column] = weight
+    return table

@@ -24,14 +24,12 @@ from pathlib import Path
 
 import numpy as np
 
-from benchkit import SHARED_MODELS, cpu_model, format_seconds, midpoint_subdivided
+from benchkit import RESULTS_DIR, SHARED_MODELS, cpu_model, format_seconds, midpoint_subdivided
 from rigdata import load_obj
 from union_reference import exact_union, iou, traced_region
 
 from rigger import silhouette
 
-REPO = Path(__file__).resolve().parents[1]
-RESULTS = REPO / "bench" / "results"
 # (series name, model path under models/, subdivision levels to time)
 SERIES = (
     ("rignet_2586 (character)", "gt/rignet_2586/rignet_2586.obj", range(1, 6)),
@@ -290,11 +288,11 @@ def main(argv=None):
     if args.quick:
         print("quick run: results not written")
         return 0
-    RESULTS.mkdir(exist_ok=True)
+    RESULTS_DIR.mkdir(exist_ok=True)
     command = "python bench/silhouette.py"
-    (RESULTS / "silhouette.md").write_text(markdown(rows, accuracy, command, started, loads))
-    plot(rows, RESULTS / "silhouette.png")
-    print(f"wrote {RESULTS / 'silhouette.md'} and {RESULTS / 'silhouette.png'}")
+    (RESULTS_DIR / "silhouette.md").write_text(markdown(rows, accuracy, command, started, loads))
+    plot(rows, RESULTS_DIR / "silhouette.png")
+    print(f"wrote {RESULTS_DIR / 'silhouette.md'} and {RESULTS_DIR / 'silhouette.png'}")
     return 0
 
 

@@ -24,13 +24,11 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
-from benchkit import (SHARED_MODELS, cpu_model, described_commit, format_seconds, markdown_table,  # noqa: E402
-                      table_cell)
+from benchkit import (RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit, format_seconds,  # noqa: E402
+                      markdown_table, table_cell)
 from rigger.skeletonize.polyline import segment_distances  # noqa: E402  (bpy-free)
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
 MODELS_DIR = SHARED_MODELS / "gt"
-RESULTS_DIR = REPO / "bench" / "results"
 REPAIR_STAGES = ("welded bone heat", "island bone heat", "nearest bones")
 SKELETONS = ("artist", "rigger")
 SAMPLES_PER_BONE = 9  # points along each of Rigger's bones when finding the nearest true bone
@@ -51,8 +49,7 @@ class Model:
 
 
 def load_model(folder):
-    vertices, triangles = rigdata.load_obj(folder / f"{folder.name}.obj")
-    rig = rigdata.load_rig(folder / f"{folder.name}_rig.txt", len(vertices)).without_helpers()
+    vertices, triangles, rig = rigdata.load_ground_truth(folder)
     skeleton, head_joint = rigdata.armature_skeleton(rig)
     return Model(folder.name, vertices, triangles, skeleton, head_joint, rigdata.dominant_joints(rig))
 
@@ -85,14 +82,13 @@ def agreement(joint_of_bone, dominant_bone, artist_joint):
 
 
 def dominant_bones(obj, names):
-    """(V,) index into ``names`` of each vertex's largest weight (-1 where it has none)."""
-    column = {group.index: names.index(group.name) for group in obj.vertex_groups if group.name in names}
+    """(V,) index into ``names`` of each vertex's largest weight (-1 where it has none; of equal weights, the first
+    in Blender's order)."""
     best = np.full(len(obj.data.vertices), -1)
     best_weight = np.zeros(len(obj.data.vertices))
-    for vertex in obj.data.vertices:
-        for element in vertex.groups:
-            if element.group in column and element.weight > best_weight[vertex.index]:
-                best[vertex.index], best_weight[vertex.index] = column[element.group], element.weight
+    for vertex, column, weight in rigdata.vertex_group_weights(obj, names):
+        if weight > best_weight[vertex]:
+            best[vertex], best_weight[vertex] = column, weight
     return best
 
 
@@ -181,10 +177,19 @@ def percent(value):
     return "–" if value is None or np.isnan(value) else f"{100 * value:.1f}%"
 
 
+def unweighted_count(record):
+    """Vertices of one run left unweighted: the report's count plus the independent recount (0 for an error)."""
+    return record.get("unweighted", 0) + record.get("recounted_unweighted", 0)
+
+
+def totals(records):
+    """(unweighted vertices, errors) over all runs."""
+    return sum(unweighted_count(r) for r in records), sum("error" in r for r in records)
+
+
 def verdict(records):
     """The issue's target: no vertex left unweighted on any model, with either skeleton."""
-    unweighted = sum(r.get("unweighted", 0) + r.get("recounted_unweighted", 0) for r in records)
-    errors = sum("error" in r for r in records)
+    unweighted, errors = totals(records)
     passed = not unweighted and not errors
     return (f"Target, every vertex weighted everywhere: **{'PASS' if passed else 'FAIL'}**: {unweighted} unweighted "
             f"vertices and {errors} errors over {len(records)} runs (the count is the report's and, independently, "
@@ -197,7 +202,7 @@ def summary_rows(records, alone):
         own = [r for r in records if r["skeleton"] == kind]
         good = [r for r in own if "error" not in r]
         cells = [kind, str(len(own)), str(len(own) - len(good)),
-                 str(sum(r["unweighted"] + r["recounted_unweighted"] for r in good)),
+                 str(sum(unweighted_count(r) for r in good)),
                  str(sum(r["failed"] for r in good)), str(sum(r["left_by_bone_heat"] > 0 and not r["failed"]
                                                              for r in good))]
         for stage in REPAIR_STAGES:
@@ -258,7 +263,7 @@ def markdown(records, alone, speed, run):
             continue
         rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}", str(record["bones"]),
                      bone_heat_cell(record), *(stage_cell(record, stage) for stage in REPAIR_STAGES),
-                     str(record["unweighted"] + record["recounted_unweighted"]), format_seconds(record["seconds"]),
+                     str(unweighted_count(record)), format_seconds(record["seconds"]),
                      percent(record["agreement"]),
                      percent(alone.get(record["model"])) if record["skeleton"] == "artist" else ""])
     out += markdown_table(["model", "skeleton", "vertices", "bones", "bone heat", "welded", "islands", "nearest",
@@ -357,8 +362,7 @@ def main(argv=None):
     RESULTS_DIR.mkdir(parents=True, exist_ok=True)
     (RESULTS_DIR / "skinning.md").write_text(markdown(records, alone, speed, run), encoding="utf-8")
     plot(records, alone, speed, RESULTS_DIR / "skinning.png")
-    unweighted = sum(r.get("unweighted", 0) + r.get("recounted_unweighted", 0) for r in records)
-    errors = sum("error" in r for r in records)
+    unweighted, errors = totals(records)
     print(f"wrote {RESULTS_DIR / 'skinning.md'}: {len(records)} runs, {unweighted} unweighted vertices, "
           f"{errors} errors")
     return 1 if unweighted or errors else 0

@@ -61,10 +61,11 @@ def _write_characters(directory):
     """Child-process side: build every character with bpy and save its arrays into ``directory``."""
     with tempfile.TemporaryDirectory(prefix="rigger-blender-user-") as user_resources:
         os.environ.setdefault("BLENDER_USER_RESOURCES", user_resources)
-        import bpy
+        import bpy  # noqa: F401  (first: Blender's own modules, bmesh among them, import only once bpy is)
+        from conftest import empty_scene
         from rigger.blender.samples import character_arrays
 
-        bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+        empty_scene()
         for name in samples.CHARACTERS:
             vertices, triangles = character_arrays(name)
             np.savez(os.path.join(directory, f"{name}.npz"), vertices=vertices, triangles=triangles)

@@ -1,11 +1,11 @@
-"""Shared test fixtures: where the read-only shared data lives, and skipping when it is absent; one reader of a
-Blender mesh's vertex-group weights for the Blender tests."""
+"""Shared test fixtures: where the read-only shared data lives, and skipping when it is absent; for the Blender tests,
+a fresh empty scene and object activation (bpy is imported only when they are used, so ``import rigger`` and the
+pure-core tests stay bpy-free)."""
 import os
 import pathlib
 import sys
 import tempfile
 
-import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -13,7 +13,8 @@ SHARED = pathlib.Path(os.environ.get("RIGGER_SHARED", ROOT.parent / "shared"))
 sys.path.insert(0, str(ROOT / "bench"))  # bench/ is not a package; tests use its scorers and readers (rigdata, ...)
 
 # bpy reads user resources at import; keep every test run away from the real home directory.
-os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="rigger-blender-user-"))
+if "BLENDER_USER_RESOURCES" not in os.environ:  # a child process that set its own keeps it (and leaves no folder)
+    os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp(prefix="rigger-blender-user-")
 
 
 def shared_path(*parts):
@@ -24,13 +25,26 @@ def shared_path(*parts):
     return path
 
 
-def vertex_weights(obj, names):
-    """(N, len(names)) weights of mesh object ``obj``'s vertices in the vertex groups ``names``, in that order (0
-    where a group is missing)."""
-    column = {group.index: names.index(group.name) for group in obj.vertex_groups if group.name in names}
-    table = np.zeros((len(obj.data.vertices), len(names)))
-    for vertex in obj.data.vertices:
-        for element in vertex.groups:
-            if element.group in column:
-                table[vertex.index, column[element.group]] = element.weight
-    return table
+def empty_scene():
+    """Reset Blender to its factory-default empty file and return the scene."""
+    import bpy
+
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    return bpy.context.scene
+
+
+@pytest.fixture
+def scene():
+    """A fresh empty Blender scene for one test (only for modules that import bpy or skip without it)."""
+    return empty_scene()
+
+
+def activate(obj, *others):
+    """Select ``obj`` and ``others`` only, and make ``obj`` the active object."""
+    import bpy
+
+    for selected in bpy.context.view_layer.objects.selected:
+        selected.select_set(False)
+    for each in (obj, *others):
+        each.select_set(True)
+    bpy.context.view_layer.objects.active = obj

@@ -11,11 +11,13 @@ import numpy as np
 import pytest
 
 from characters import inside_fraction
-from conftest import vertex_weights
+from conftest import activate, empty_scene
+from rigdata import vertex_weights
 
 bpy = pytest.importorskip("bpy")
 
 import rigger  # noqa: E402
+from rigger.blender.meshdata import evaluated_arrays  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
 
 CHARACTERS = ("humanoid", "quadruped", "octopus", "tree", "snake")
@@ -29,17 +31,9 @@ def registered():
 
 
 @pytest.fixture
-def scene(registered):
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-    return bpy.context.scene
-
-
-def activate(obj, *others):
-    for selected in bpy.context.view_layer.objects.selected:
-        selected.select_set(False)
-    for each in (obj, *others):
-        each.select_set(True)
-    bpy.context.view_layer.objects.active = obj
+def scene(registered, scene):
+    """conftest's fresh empty scene, made after the add-on is registered."""
+    return scene
 
 
 def reports_of(operator, **kwargs):
@@ -48,11 +42,6 @@ def reports_of(operator, **kwargs):
     with contextlib.redirect_stdout(printed):
         result = operator(**kwargs)
     return result, printed.getvalue()
-
-
-def mesh_arrays(obj):
-    from rigger.blender.meshdata import evaluated_arrays
-    return evaluated_arrays(obj)
 
 
 # registration
@@ -105,7 +94,7 @@ def test_float_parameters_reach_the_method_as_typed_not_as_single_precision(regi
 @pytest.fixture(scope="module")
 def rigged(registered):
     """Every test character rigged and skinned through ``rigger.rig_skin``: name → (mesh object, reports)."""
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    empty_scene()
     results = {}
     for name in CHARACTERS:
         obj = build_character(name, subdivisions=1)
@@ -124,7 +113,7 @@ def test_rig_and_skin_every_character(rigged, name):
     assert sum(bone.parent is None for bone in bones) == 1  # one rooted tree
     assert armature.matrix_world == armature.matrix_world.Identity(4)
 
-    vertices, triangles = mesh_arrays(obj)
+    vertices, triangles = evaluated_arrays(obj)
     points = np.concatenate([np.array([bone.head_local for bone in bones]),
                              np.array([bone.tail_local for bone in bones])])
     inside = inside_fraction(vertices, triangles, points)
@@ -164,7 +153,7 @@ def test_the_rig_follows_the_objects_transform_and_modifiers(scene):
     assert bpy.ops.rigger.rig() == {'FINISHED'}
     armature = obj.rigger_armature
     heads = np.array([bone.head_local for bone in armature.data.bones])
-    vertices, triangles = mesh_arrays(obj)
+    vertices, triangles = evaluated_arrays(obj)
     assert len(vertices) > len(obj.data.vertices)  # the modifier was applied
     assert inside_fraction(vertices, triangles, heads) >= 0.9
     # the humanoid, 1.8 m tall along its own Z, is now 3.6 m tall and stands at z = 1
@@ -179,7 +168,7 @@ def test_the_rig_keeps_following_the_meshs_parent(scene):
     obj = build_character("snake", subdivisions=0)
     obj.parent = vehicle
     bpy.context.view_layer.update()
-    before, _ = mesh_arrays(obj)
+    before, _ = evaluated_arrays(obj)
     for _ in range(2):  # rigging again too
         activate(obj)
         assert bpy.ops.rigger.rig_skin() == {'FINISHED'}
@@ -188,7 +177,7 @@ def test_the_rig_keeps_following_the_meshs_parent(scene):
         np.testing.assert_allclose(np.array(armature.matrix_world), np.eye(4), atol=1e-6)
     vehicle.location.x += 10.0
     bpy.context.view_layer.update()
-    np.testing.assert_allclose(mesh_arrays(obj)[0], before + (10.0, 0.0, 0.0), atol=1e-4)
+    np.testing.assert_allclose(evaluated_arrays(obj)[0], before + (10.0, 0.0, 0.0), atol=1e-4)
 
 
 def test_rigging_again_replaces_the_previous_rig(scene):

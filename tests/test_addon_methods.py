@@ -10,19 +10,12 @@ import sys
 
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, activate, empty_scene
 
 bpy = pytest.importorskip("bpy")
 import addon_utils  # noqa: E402  (Blender's own module, importable once bpy is)
 
 from rigger.blender.samples import build_character  # noqa: E402
-
-
-def activate(obj):
-    for selected in bpy.context.view_layer.objects.selected:
-        selected.select_set(False)
-    obj.select_set(True)
-    bpy.context.view_layer.objects.active = obj
 
 
 @pytest.fixture
@@ -72,7 +65,7 @@ def test_a_method_file_dropped_into_the_folder_appears_after_re_enabling(addon_c
     registry = sys.modules["rigger_copy.api"].method_registry()
     assert "needs a library" in registry.failures["broken.py"]
 
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    empty_scene()
     obj = build_character("snake", subdivisions=0)
     activate(obj)
     bpy.context.scene.rigger.method = "dropped"

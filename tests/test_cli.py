@@ -91,11 +91,9 @@ def test_a_rigged_glb_rigged_again_holds_one_skin_of_its_own_mesh(rigged_glb, tm
     assert len(document["skins"]) == 1 and len(document["skins"][0]["joints"]) == len(report["bones"])
 
 
-def test_a_blend_is_rigged_as_its_scene_shows_it(tmp_path):
+def test_a_blend_is_rigged_as_its_scene_shows_it(scene, tmp_path):
     """Only the meshes the scene shows are rigged (not those in excluded or hidden collections, nor other scenes);
     an armature that already deformed them is replaced; cameras and lights stay."""
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-    scene = bpy.context.scene
     body = build_character("humanoid", subdivisions=0)
     old = build_armature(Skeleton(["old"], [(0, 0, 0)], [(0, 0, 1)], [-1]), "OldRig")
     body.vertex_groups.new(name="old").add(range(len(body.data.vertices)), 1.0, 'REPLACE')

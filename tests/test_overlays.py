@@ -4,6 +4,8 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
+from conftest import empty_scene
+
 bpy = pytest.importorskip("bpy")
 
 import rigger  # noqa: E402
@@ -15,19 +17,15 @@ from rigger.skeletonize.polyline import segment_distances  # noqa: E402
 KINDS = [key for key, _, _ in overlays.OVERLAY_KINDS]
 LINE_KINDS = ("silhouette", "axis", "pruned", "chains")
 ICO_VERTICES = 42  # an ico sphere of SPHERE_SUBDIVISIONS = 2
+pytestmark = pytest.mark.usefixtures("scene")  # every test starts from an empty scene
 
 
 @pytest.fixture(scope="module")
 def humanoid():
     """(vertices, triangles, stages) of the humanoid sample rigged by the silhouette method."""
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    empty_scene()
     vertices, triangles = samples.character_arrays("humanoid", subdivisions=1)
     return vertices, triangles, rigger.rig_mesh(vertices, triangles).stages
-
-
-@pytest.fixture(autouse=True)
-def empty_scene():
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
 
 
 def lift(stages, points):

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import shared_path, vertex_weights
+from conftest import shared_path
 
 bpy = pytest.importorskip("bpy")
 import bmesh  # noqa: E402  (Blender's own module, importable once bpy is)
@@ -19,6 +19,7 @@ import bmesh  # noqa: E402  (Blender's own module, importable once bpy is)
 from rigger import samples  # noqa: E402
 from rigger.blender import skinning  # noqa: E402
 from rigger.blender.armature import build_armature  # noqa: E402
+from rigger.blender.meshdata import world_points  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
 from rigger.skeletonize.polyline import segment_distances  # noqa: E402
 
@@ -26,12 +27,6 @@ import rigdata  # noqa: E402
 
 NEAR_FRACTION = 0.05  # a vertex's dominant bone is at most this fraction of the model's size farther than its nearest
 NEAREST_SHARE = 0.9  # at least this share of vertices is dominated by their nearest bone
-
-
-@pytest.fixture
-def scene():
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-    return bpy.context.scene
 
 
 def character_with_rig(name, subdivisions=1):
@@ -43,15 +38,12 @@ def bone_names(armature):
 
 
 def world_vertices(obj):
-    positions = np.array([vertex.co for vertex in obj.data.vertices])
-    matrix = np.array(obj.matrix_world)
-    return positions @ matrix[:3, :3].T + matrix[:3, 3]
+    return world_points(np.array([vertex.co for vertex in obj.data.vertices]), obj.matrix_world)
 
 
 def world_bones(armature, names):
-    matrix = np.array(armature.matrix_world)
     ends = np.array([[armature.data.bones[n].head_local, armature.data.bones[n].tail_local] for n in names])
-    ends = ends @ matrix[:3, :3].T + matrix[:3, 3]
+    ends = world_points(ends, armature.matrix_world)
     return ends[:, 0], ends[:, 1]
 
 
@@ -59,7 +51,7 @@ def assert_skinned(obj, armature, report, checked=slice(None), nearest_share=NEA
     """Every vertex weighted, weights normalised, one Armature modifier last, and the dominant bone of each
     ``checked`` vertex near it."""
     names = bone_names(armature)
-    table = vertex_weights(obj, names)
+    table = rigdata.vertex_weights(obj, names)
     assert report.unweighted == 0
     assert (table.max(axis=1) > 0).all(), f"{(table.max(axis=1) == 0).sum()} vertices unweighted"
     np.testing.assert_allclose(table.sum(axis=1), 1.0, atol=1e-5)
@@ -150,12 +142,12 @@ def test_hidden_and_unlinked_objects_are_skinned_too(scene):
 def test_skinning_again_replaces_the_modifier_and_groups(scene):
     obj, armature = character_with_rig("snake")
     first = skinning.skin(obj, armature)
-    weights = vertex_weights(obj, bone_names(armature))
+    weights = rigdata.vertex_weights(obj, bone_names(armature))
     obj.vertex_groups.new(name="user paint")
     second = skinning.skin(obj, armature)
     assert_skinned(obj, armature, second)
     assert sorted(g.name for g in obj.vertex_groups) == sorted(bone_names(armature) + ["user paint"])
-    np.testing.assert_allclose(vertex_weights(obj, bone_names(armature)), weights, atol=1e-6)
+    np.testing.assert_allclose(rigdata.vertex_weights(obj, bone_names(armature)), weights, atol=1e-6)
     assert first.summary().split(":")[0] == second.summary().split(":")[0]
 
     # a new armature with other bone names: the old groups go, the new ones come, still one modifier
@@ -266,7 +258,7 @@ def test_loose_parts_and_inner_shells_are_repaired_part_by_part_then_by_distance
     assert islands.note == "9 of 10 loose parts tried"  # a speck has no faces left
     assert_skinned(obj, armature, report)
     assert report.level == "WARNING" and "nearest bones 4" in report.summary()
-    table = vertex_weights(obj, bone_names(armature))
+    table = rigdata.vertex_weights(obj, bone_names(armature))
     assert len({tuple(row) for row in table[speck]}) == 1  # the four coincident vertices get the same weights
 
 
@@ -281,8 +273,7 @@ def mesh_object(name, vertices, triangles):
 def test_a_real_model_that_makes_bone_heat_fail_is_repaired_by_welding(scene):
     """Quaternius' fox (a glTF export, split along UV seams) with its artist skeleton: bone heat fails outright."""
     folder = shared_path("models", "gt", "Quaternius_Fox")
-    vertices, triangles = rigdata.load_obj(folder / "Quaternius_Fox.obj")
-    rig = rigdata.load_rig(folder / "Quaternius_Fox_rig.txt", len(vertices)).without_helpers()
+    vertices, triangles, rig = rigdata.load_ground_truth(folder)
     skeleton, head_joint = rigdata.armature_skeleton(rig)
     obj, armature = mesh_object("fox", vertices, triangles), build_armature(skeleton, "fox_rig")
     report = skinning.skin(obj, armature)
@@ -290,6 +281,6 @@ def test_a_real_model_that_makes_bone_heat_fail_is_repaired_by_welding(scene):
     assert stage_names(report) == ["bone heat", "welded bone heat"] and report.stages[0].weighted == 0
     assert_skinned(obj, armature, report, nearest_share=0.8)
     # the repaired weights mostly agree with the artist's: the dominant bone starts at the artist's dominant joint
-    ours = head_joint[vertex_weights(obj, bone_names(armature)).argmax(axis=1)]
+    ours = head_joint[rigdata.vertex_weights(obj, bone_names(armature)).argmax(axis=1)]
     artist = rigdata.dominant_joints(rig)
     assert (ours[artist >= 0] == artist[artist >= 0]).mean() > 0.7  # measured 0.74
