@@ -3,10 +3,16 @@
 The add-on lives in ``addon/`` and is imported as ``rigger``. Compiled modules get names unique to this project
 (``rigger._rigger_*``) because Blender shares one site-packages between add-ons.
 """
+import pathlib
 import sys
+import tomllib
 
 from Cython.Build import cythonize
 from setuptools import Extension, setup
+
+# One version for the package, the extension manifest and bl_info (tests/test_addon_zip.py checks the last two agree).
+MANIFEST = pathlib.Path(__file__).parent / "addon" / "blender_manifest.toml"
+VERSION = tomllib.loads(MANIFEST.read_text(encoding="utf-8"))["version"]
 
 # Exact geometric predicates need IEEE double arithmetic without fused multiply-add contraction or fast-math.
 if sys.platform == "win32":
@@ -24,7 +30,7 @@ EXTENSIONS = [
 
 setup(
     name="rigger",
-    version="0.1.0",
+    version=VERSION,
     description="Automatic rigging for Blender: skeleton extraction, armature building and skinning",
     license="GPL-3.0-or-later",
     python_requires=">=3.11",
