@@ -125,7 +125,7 @@ class Silhouette:
         this needs no closed surface, so it holds on open and self-intersecting meshes; it cannot see gaps along the
         ray (another view can)."""
         frame, depth = self.project(points)
-        front, back = self.depth(frame)
+        front, back = self._trace.depth(frame)  # frame points are valid already: skip depth()'s checks
         return (depth >= front - slack) & (depth <= back + slack)  # NaN (a miss) compares False
 
 

@@ -15,7 +15,6 @@ cdef extern from "silhouette.h":
     int SIL_ERR_NOMEM
     int SIL_ERR_EMPTY
     int SIL_ERR_INTERNAL
-    int SIL_ERR_MISMATCH
     int SIL_ERR_ZERO_AREA
     int SIL_MIN_RESOLUTION
     int SIL_MAX_RESOLUTION

@@ -138,8 +138,8 @@ static double box_distance_squared(const Node *node, const double point[3])
 }
 
 /* The point's reach key for one bone: the distance to the segment plus facing_penalty times how far the segment's
- * nearest point lies in front of the surface (along the unit normal, or NULL for none). Never less than the plain
- * distance. */
+ * nearest point lies in front of the surface (along the unit normal; NULL when there is no penalty). Never less than
+ * the plain distance. */
 static double bone_key(const double point[3], const double *unit_normal, const double *head, const double *tail,
                        double facing_penalty)
 {
@@ -156,7 +156,7 @@ static double bone_key(const double point[3], const double *unit_normal, const d
         distance_squared += toward[k] * toward[k];
     }
     double distance = sqrt(distance_squared);
-    if (!unit_normal || facing_penalty == 0.0)
+    if (!unit_normal)
         return distance;
     double facing = 0.0;
     for (int k = 0; k < 3; k++)
@@ -288,7 +288,8 @@ int sw_bone_weights(const double *points, int64_t n_points, const double *normal
     }
     for (int64_t p = 0; p < n_points; p++) {
         double unit[3];
-        const double *unit_normal = unit_or_null(normals ? normals + 3 * p : NULL, unit);
+        const double *normal = normals && facing_penalty > 0.0 ? normals + 3 * p : NULL; /* no penalty: no normal */
+        const double *unit_normal = unit_or_null(normal, unit);
         nearest_bones(&tree, heads, tails, points + 3 * p, unit_normal, facing_penalty, best, capacity, stack);
         point_weights(best, capacity, used, per_point, power, bones_out + p * per_point, weights_out + p * per_point);
     }

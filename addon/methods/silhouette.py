@@ -11,6 +11,8 @@ view, then the end-on one: along the longest extent when the view is AUTO) and h
 without leaving the mesh's depth span in the primary view and their own.
 """
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .. import cdt, silhouette
@@ -40,6 +42,18 @@ END_RESOLUTION = 1 / 3  # the end-on view (the remaining axis of larger spread: 
 # is AUTO) only looks for limbs, at this fraction of the resolution: limbs are coarse features, and its trace costs less
 MIN_VIEW_RESOLUTION = 64  # the coarsest grid any view gets
 MAX_PATH_SAMPLES = 256  # points tested along a path from a hidden limb to a bone it may hang from (one per cell)
+
+
+class Blob(NamedTuple):
+    """An island whose pruned axis is a single node (a round speck): that node's point (2D) and disc radius."""
+    point: np.ndarray
+    radius: float
+
+
+class PlacedIsland(NamedTuple):
+    """An island's chains placed in 3D (``depth.place_chains``): the root's point and (polyline, parent, widths)s."""
+    root_point: np.ndarray
+    chains: list
 
 
 class SilhouetteMethod(RigMethod):
@@ -99,17 +113,17 @@ class SilhouetteMethod(RigMethod):
             end_on = _other_view(vertices, triangles, sil, end_axis,
                                  max(MIN_VIEW_RESOLUTION, round(END_RESOLUTION * resolution)), outline_spacing, min_hole)
             if side_of is not None:
-                side = SideAxis(side_of[0], side_of[1].points, side_of[1].radius, sil.direction)
+                side = SideAxis(side_of[0], side_of[1].points, side_of[1].radius, sil)
             other_views = [found for found in (side_of, end_on) if found is not None]
         clock.lap("other_views")
 
         plane = mirror_plane(vertices, 0.01 * mesh.scale)
         builder = _BoneBuilder(np.radians(bone_angle), unit, max_chain_bones, plane, MIRROR_TOLERANCE * mesh.scale)
         for placed in _placed_islands(sil, graph, alive, kept, SPECK * unit, side, split_layers):
-            if placed[0] == "blob":
-                builder.add_blob(sil, *placed[1:])
+            if isinstance(placed, Blob):
+                builder.add_blob(sil, placed.point, placed.radius)
             else:
-                builder.add_island(*placed[1:])
+                builder.add_island(placed.root_point, placed.chains)
         limb_search = dict(merge=merge, prune=HIDDEN_PRUNE * prune, bone_length=unit, split_layers=split_layers)
         for view_sil, view_graph in other_views:
             builder.add_limbs(_hidden_limbs(sil, view_sil, view_graph, builder.lines, **limb_search), (sil, view_sil))
@@ -145,19 +159,19 @@ def _pruned_tree(graph, merge, prune, min_reach):
 
 
 def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):
-    """Per island of the pruned axis, largest first: ("island", root point, placed chains) in 3D, or ("blob", point,
-    radius) for an island that is a single node; islands other than the largest and smaller than ``speck`` are
-    skipped (skinning gives them to the nearest bone)."""
+    """Per island of the pruned axis, largest first: a ``PlacedIsland`` (its chains in 3D), or a ``Blob`` for an
+    island that is a single node; islands other than the largest and smaller than ``speck`` are skipped (skinning
+    gives them to the nearest bone)."""
     for number, (nodes, links, size) in enumerate(_islands(graph, alive, kept)):
         if number and size < speck:
             continue
         keys, island_chains = chains_of(nodes, links)
         if not island_chains:
             widest = nodes[int(np.argmax(graph.radius[nodes]))]
-            yield "blob", graph.points[widest], graph.radius[widest]
+            yield Blob(graph.points[widest], graph.radius[widest])
             continue
         root, rooted = rooted_chains(graph.points, keys, island_chains, graph.radius)
-        yield ("island",) + place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers)
+        yield PlacedIsland(*place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers))
 
 
 def _other_view(vertices, triangles, primary, axis, resolution, spacing, min_hole):
@@ -182,9 +196,9 @@ def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, bone_length, s
     if cover.covered(view_sil.lift(tips, 0.0)).all():
         return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
     limbs = []
-    for kind, _, placed in _placed_islands(view_sil, view_graph, alive, kept, SPECK * bone_length, None, split_layers):
-        if kind == "island":
-            limbs += uncovered_limbs(placed, cover, sil, min_length)
+    for placed in _placed_islands(view_sil, view_graph, alive, kept, SPECK * bone_length, None, split_layers):
+        if isinstance(placed, PlacedIsland):
+            limbs += uncovered_limbs(placed.chains, cover, sil, min_length)
     return limbs
 
 
@@ -247,10 +261,11 @@ def _outline(loops, spacing):
 def _islands(graph, alive, links):
     """(nodes, links, size) per island, the largest (most axis length) first."""
     result = []
-    for island in np.unique(graph.island[alive]):
-        nodes = alive[graph.island[alive] == island]
-        mask = np.isin(links[:, 0], nodes) if len(links) else np.zeros(0, bool)
-        sub = links[mask]
+    node_island = graph.island[alive]
+    link_island = graph.island[links[:, 0]] if len(links) else np.zeros(0, graph.island.dtype)  # links join live nodes
+    for island in np.unique(node_island):
+        nodes = alive[node_island == island]
+        sub = links[link_island == island]
         size = float(np.linalg.norm(graph.points[sub[:, 0]] - graph.points[sub[:, 1]], axis=1).sum())
         size += float(graph.radius[nodes].max())
         result.append((size, nodes.tolist(), sub))

@@ -199,23 +199,22 @@ class SideAxis:
     with side-view axis nodes at the same ``w``; their coordinate along the primary direction is the depth.
     """
 
-    def __init__(self, side_sil, points, radius, primary_direction):
-        """``points`` (n, 2) and ``radius`` (n,): the side view's chordal axis nodes in ``side_sil``'s plane."""
+    def __init__(self, side_sil, points, radius, primary_sil):
+        """``points`` (n, 2) and ``radius`` (n,): the side view's chordal axis nodes in ``side_sil``'s plane; depths
+        are in ``primary_sil``'s frame."""
         world = side_sil.lift(points, 0.0)
-        self.w_axis = np.cross(primary_direction, side_sil.direction)
+        self.w_axis = np.cross(primary_sil.direction, side_sil.direction)
         self.w = world @ self.w_axis
-        self.along = world @ primary_direction
+        self.depth = world @ primary_sil.direction - float(primary_sil.origin @ primary_sil.direction)
         self.radius = radius
         self.cell = side_sil.cell
 
     def depth_at(self, sil, point2d, radius, interval, previous):
-        """Depth (in ``sil``'s frame) of the side-view part matching a primary node, inside ``interval``: of the
-        side-view axis nodes at the node's height, the one nearest ``previous`` (ties to the closest width); None if
-        no side-view node fits."""
-        world = sil.origin + point2d[0] * sil.u + point2d[1] * sil.v
-        w0 = float(world @ self.w_axis)
-        base = float(sil.origin @ sil.direction)
-        depth = self.along - base
+        """Depth (in the primary view ``sil``'s frame) of the side-view part matching a primary node, inside
+        ``interval``: of the side-view axis nodes at the node's height, the one nearest ``previous`` (ties to the
+        closest width); None if no side-view node fits."""
+        w0 = float(sil.lift(point2d, 0.0)[0] @ self.w_axis)
+        depth = self.depth
         near = np.abs(self.w - w0) <= max(radius, self.cell)
         near &= (depth >= interval[0]) & (depth <= interval[1])
         if not near.any():

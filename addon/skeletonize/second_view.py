@@ -21,10 +21,17 @@ class Cover:
     def __init__(self, primary_lines, direction, reach):
         self.direction, self.reach = direction, reach
         self.starts, self.ends = _segments(primary_lines, direction)
+        self.low = np.minimum(self.starts, self.ends) - reach  # each segment's box, grown by the reach
+        self.high = np.maximum(self.starts, self.ends) + reach
 
     def covered(self, points):
-        """Whether each of the 3D ``points`` lies within ``reach`` of a primary chain, seen along the direction."""
-        return _distance_to_segments(_flattened(points, self.direction), self.starts, self.ends) <= self.reach
+        """Whether each of the 3D ``points`` lies within ``reach`` of a primary chain, seen along the direction
+        (segments whose grown box misses the points' box cannot cover any of them, and are not measured)."""
+        flat = _flattened(points, self.direction)
+        if not len(flat):
+            return np.zeros(0, bool)
+        near = ((self.low <= flat.max(axis=0)) & (self.high >= flat.min(axis=0))).all(axis=1)
+        return _distance_to_segments(flat, self.starts[near], self.ends[near]) <= self.reach
 
 
 def uncovered_limbs(placed, cover, primary_sil, min_length):
