@@ -11,12 +11,11 @@ import concurrent.futures
 import json
 import os
 import pathlib
-import shutil
 import subprocess
 import sys
 import time
 
-from .core.files import leftovers, replaced_on_success
+from .core.files import remove_leftovers, replaced_on_success
 
 INPUTS = (".obj", ".glb", ".gltf", ".fbx", ".blend")
 OUTPUTS = (".blend", ".glb", ".fbx")
@@ -211,7 +210,8 @@ def rig_in_child(source, output, report, extra, timeout=None):
     row = {"file": source.name, "seconds": round(time.perf_counter() - start, 2), "status": "failed", "bones": 0,
            "skinning": ""}
     if child is None or child.returncode:
-        _remove_leftovers(output, report)
+        for final in (output, report):  # what a killed child left half written
+            remove_leftovers(final)
         return {**row, "message": f"timed out after {timeout:g} s" if child is None else _child_failure(child)}
     try:
         data = json.loads(report.read_text())
@@ -219,17 +219,6 @@ def rig_in_child(source, output, report, extra, timeout=None):
         return {**row, "message": f"finished without a readable report: {error}"}
     return {**row, "status": "ok", "bones": len(data["bones"]), "skinning": data["skinning"]["summary"],
             "message": "; ".join(data["warnings"]), "output": output.name}
-
-
-def _remove_leftovers(*finals):
-    """Remove what a killed child left half written: the temporary files and folders named ".<final name>.*" that
-    it renames into place only on success."""
-    for final in finals:
-        for leftover in leftovers(final):
-            if leftover.is_dir():
-                shutil.rmtree(leftover)
-            else:
-                leftover.unlink()
 
 
 def _child_failure(child):

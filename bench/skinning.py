@@ -345,7 +345,8 @@ def main(argv=None):
         folders = [path for path in folders if any(text in path.name for text in wanted)]
         if not folders:
             raise SystemExit(f"No model name contains any of {wanted}.")
-    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="rigger-blender-user-"))
+    if "BLENDER_USER_RESOURCES" not in os.environ:  # bpy reads user resources at import: keep off the home folder
+        os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp(prefix="rigger-blender-user-")
     run = {"command": "python bench/skinning.py" + (" " + " ".join(argv or sys.argv[1:])).rstrip(),
            "started": datetime.datetime.now(datetime.timezone.utc), "load": os.getloadavg()}
     started = time.perf_counter()

@@ -27,6 +27,7 @@ from scipy.sparse.csgraph import connected_components
 
 from rigger import silhouette
 
+from meshes import box, combine
 from rigdata import load_obj
 from union_reference import exact_union, frame_points, iou, traced_region
 
@@ -35,15 +36,6 @@ BIG_FEATURE = 8  # islands and holes above this many square cells must match
 TOUCH = 0.01  # cells: parts meeting closer than this may merge or split
 
 # ------------------------------------------------------------------------------------------------ meshes
-
-
-def box(lo, hi):
-    """An axis-aligned box: 8 vertices, 12 outward triangles."""
-    (x0, y0, z0), (x1, y1, z1) = lo, hi
-    v = np.array([[x, y, z] for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)], float)
-    t = [[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-         [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]]
-    return v, np.array(t)
 
 
 def grid_surface(point, nu, nv, closed_v=True):
@@ -84,16 +76,6 @@ def sphere(center=(0, 0, 0), radius=1.0, n=24):
             else:
                 t += [[a, a + n, b + n], [a, b + n, b]]
     return v, np.array(t)
-
-
-def combine(*meshes):
-    """One soup from several meshes."""
-    vertices, triangles, offset = [], [], 0
-    for v, t in meshes:
-        vertices.append(v)
-        triangles.append(np.asarray(t) + offset)
-        offset += len(v)
-    return np.concatenate(vertices), np.concatenate(triangles)
 
 
 def prism(polygon, depth=0.2):

@@ -7,6 +7,7 @@ from hypothesis import strategies as st
 import rigger
 from cdt_checks import polygon_area
 from characters import inside_fraction, load_character
+from meshes import box, combine
 from rigger import samples
 
 from rigdata import chamfer_distance
@@ -158,13 +159,20 @@ def test_a_flat_cut_out_character_is_rigged_in_its_plane(default_rig):
     assert chamfer_distance(skeleton.joints()[:, drop_y], reference.joints()[:, drop_y]) / size < 0.03
 
 
+@pytest.fixture(scope="module")
+def front_cut_out(default_rig):
+    """The humanoid squashed onto its front plane (y = 0), its triangles and its rig."""
+    vertices, triangles, _ = default_rig("humanoid")
+    front = vertices * [1.0, 0.0, 1.0]
+    return front, triangles, rigger.rig_mesh(front, triangles)
+
+
 @pytest.mark.parametrize("normal", [(0.0, 1.0, 1.0), (1.0, 1.0, 0.0), (0.3, 1.0, 1.0)])
-def test_a_flat_cut_out_tilted_off_the_axis_planes_is_rigged_in_its_plane(default_rig, normal):
+def test_a_flat_cut_out_tilted_off_the_axis_planes_is_rigged_in_its_plane(default_rig, front_cut_out, normal):
     """A cut-out in a tilted plane (which may contain a coordinate axis: an edge-on view along it sees nothing) is
     seen face-on and rigged like the same cut-out lying in an axis plane, turned."""
     vertices, triangles, _ = default_rig("humanoid")
-    front = vertices * [1.0, 0.0, 1.0]
-    reference = rigger.rig_mesh(front, triangles)
+    front, _, reference = front_cut_out
     normal = np.array(normal) / np.linalg.norm(normal)
     axis = np.cross([0.0, 1.0, 0.0], normal)
     angle = np.arccos(normal[1])
@@ -198,9 +206,7 @@ def uv_sphere(rings=16, segments=32):
 def ellipsoids(parts):
     """One closed UV-sphere mesh per (centre, semi-axes) part, all in one vertex and triangle array."""
     sphere, sphere_triangles = uv_sphere()
-    vertices = np.vstack([sphere * size + centre for centre, size in parts])
-    triangles = np.vstack([sphere_triangles + k * len(sphere) for k in range(len(parts))])
-    return vertices, triangles
+    return combine(*((sphere * size + centre, sphere_triangles) for centre, size in parts))
 
 
 def bird():
@@ -244,21 +250,12 @@ def test_ears_hidden_in_the_primary_view_come_from_the_end_on_view():
     assert inside_fraction(vertices, triangles, bone_samples(skeleton)) >= 0.9
 
 
-def boxes(*corners):
-    """Closed axis-aligned boxes, (low corner, high corner) each, in one vertex and triangle array."""
-    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
-    faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-                      [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
-    vertices = np.vstack([low + cube * (np.subtract(high, low)) for low, high in corners])
-    return vertices, np.vstack([faces + 8 * k for k in range(len(corners))])
-
-
 def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh():
     """A foot at the bottom of a body whose nearest bone is in a hand hanging beside it, across a gap: the foot
     hangs from the body's bone, farther but reached without leaving the mesh."""
     from rigger.methods.silhouette import _BoneBuilder
 
-    vertices, triangles = boxes(((0, 0, 0), (1, 3, 1)), ((1.3, 0, 0), (1.6, 2, 1)))  # body and leg; hand
+    vertices, triangles = combine(box((0, 0, 0), (1, 3, 1)), box((1.3, 0, 0), (1.6, 2, 1)))  # body and leg; hand
     sil = rigger.silhouette.trace(vertices, triangles, "Z")
     builder = _BoneBuilder(np.radians(40), 1.0, 0, None, 0.05)
     body = np.array([[0.5, 2.8, 0.5], [0.5, 1.5, 0.5]])

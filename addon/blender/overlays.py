@@ -283,7 +283,7 @@ class _Lines:
         mesh.from_pydata(self.points.tolist(), self.edges.tolist(), [])
 
     def modifier_inputs(self, kind, radius):
-        return _tubes_group(), {"Radius": radius, "Material": _material(_material_name(kind), KIND_COLOURS[kind])}
+        return _tubes_group(), {"Radius": radius, "Material": _kind_material(kind)}
 
 
 class _Points:
@@ -297,7 +297,7 @@ class _Points:
 
     def modifier_inputs(self, kind, radius):
         return _spheres_group(), {"Radius": JOINT_SCALE * radius,
-                                  "Material": _material(_material_name(kind), KIND_COLOURS[kind])}
+                                  "Material": _kind_material(kind)}
 
 
 class _Triangles:
@@ -398,6 +398,10 @@ def _material_names():
     for code in CLASS_ORDER:
         names += [_material_name(CLASS_NAMES[code]), _material_name(CLASS_NAMES[code], faces=True)]
     return names
+
+
+def _kind_material(kind):
+    return _material(_material_name(kind), KIND_COLOURS[kind])
 
 
 def _class_material(code, faces=False):

@@ -344,9 +344,9 @@ def _world_normals(obj):
 def _world_bones(armature_obj, bone_names):
     """Heads and tails (B, 3) of the named bones in world space, rest pose."""
     bones = [armature_obj.data.bones[name] for name in bone_names]
-    local = np.array([point for bone in bones for point in (bone.head_local, bone.tail_local)], dtype=np.float64)
-    ends = world_points(local, armature_obj.matrix_world)
-    return ends[0::2], ends[1::2]
+    ends = world_points(np.array([(bone.head_local, bone.tail_local) for bone in bones], dtype=np.float64),
+                        armature_obj.matrix_world)
+    return ends[:, 0], ends[:, 1]
 
 
 def _welded(mesh, positions, triangles):

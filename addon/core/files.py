@@ -3,6 +3,7 @@ import contextlib
 import glob
 import os
 import pathlib
+import shutil
 import tempfile
 
 
@@ -22,7 +23,10 @@ def replaced_on_success(final):
         os.replace(path, final)
 
 
-def leftovers(final):
-    """What ``replaced_on_success`` leaves beside ``final`` when its process is killed before the rename."""
+def remove_leftovers(final):
+    """Remove the folders ``replaced_on_success`` leaves beside ``final`` when its process is killed before the
+    rename."""
     final = pathlib.Path(final)
-    return final.parent.glob(glob.escape(_LEFTOVER.format(final.name)) + "*")
+    for leftover in final.parent.glob(glob.escape(_LEFTOVER.format(final.name)) + "*"):
+        if leftover.is_dir():
+            shutil.rmtree(leftover)
