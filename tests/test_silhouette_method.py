@@ -250,9 +250,11 @@ def test_ears_hidden_in_the_primary_view_come_from_the_end_on_view():
     assert inside_fraction(vertices, triangles, bone_samples(skeleton)) >= 0.9
 
 
-def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh():
+@pytest.mark.parametrize("foot_depth", [0.5, 1.02], ids=["inside", "grazing the surface"])
+def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh(foot_depth):
     """A foot at the bottom of a body whose nearest bone is in a hand hanging beside it, across a gap: the foot
-    hangs from the body's bone, farther but reached without leaving the mesh."""
+    hangs from the body's bone, farther but reached without leaving the mesh (a path that only grazes the surface
+    near the foot still counts), through a bone across the distance between them."""
     from rigger.methods.silhouette import _BoneBuilder
 
     vertices, triangles = combine(box((0, 0, 0), (1, 3, 1)), box((1.3, 0, 0), (1.6, 2, 1)))  # body and leg; hand
@@ -261,11 +263,31 @@ def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh()
     body = np.array([[0.5, 2.8, 0.5], [0.5, 1.5, 0.5]])
     hand = np.array([[1.45, 2.0, 0.5], [1.45, 0.2, 0.5]])
     builder.add_island(body[0], [(body, -1, np.full(2, 0.4)), (hand, 0, np.full(2, 0.1))])
+    island_bones = len(builder.heads)
+    foot = np.array([[0.8, 0.3, foot_depth], [0.8, 0.1, 0.9]])
+    builder.add_limbs([(foot, np.full(2, 0.1))], (sil,))
+    heads, tails, parents = builder.arrays()
+    bridge = island_bones
+    assert heads[parents[bridge], 0] < 1, "the foot hangs from the hand across the gap"
+    np.testing.assert_allclose(tails[bridge], foot[0])
+    np.testing.assert_allclose(heads[bridge], [0.5, 1.5, 0.5])  # where the body's bone is nearest the foot
+    assert parents[bridge + 1] == bridge and len(heads) == bridge + 2
+
+
+def test_a_hidden_limb_near_its_bone_gets_no_bridge():
+    from rigger.methods.silhouette import _BoneBuilder
+
+    vertices, triangles = box((0, 0, 0), (1, 3, 1))
+    sil = rigger.silhouette.trace(vertices, triangles, "Z")
+    builder = _BoneBuilder(np.radians(40), 1.0, 0, None, 0.05)
+    body = np.array([[0.5, 2.8, 0.5], [0.5, 1.0, 0.5]])
+    builder.add_island(body[0], [(body, -1, np.full(2, 0.4))])
+    island_bones = len(builder.heads)
     foot = np.array([[0.8, 0.3, 0.5], [0.8, 0.1, 0.9]])
     builder.add_limbs([(foot, np.full(2, 0.1))], (sil,))
     heads, _, parents = builder.arrays()
-    in_body = np.flatnonzero(heads[:, 0] < 1)
-    assert parents[-1] in in_body[:-1], "the foot hangs from the hand across the gap"
+    assert len(heads) == island_bones + 1 and parents[-1] == island_bones - 1  # the body's lower bone
+    np.testing.assert_allclose(heads[-1], foot[0])
 
 
 def test_an_open_tube_rigs_though_it_shows_nothing_end_on():

@@ -8,7 +8,8 @@ chains into bones at sharp turns and at a maximum length. Islands of the silhoue
 to the nearest bone of the largest island. Last, limbs the primary view hides behind the body (a bird's legs under
 its spread wings, a fox's ears seen from the side) are taken from the trees of the two perpendicular views (the side
 view, then the end-on one: along the longest extent when the view is AUTO) and hung from the nearest bone they reach
-without leaving the mesh's depth span in the primary view and their own.
+without leaving the mesh's depth span in the primary view and their own, through a bone across the gap when that bone
+is far.
 """
 
 from typing import NamedTuple
@@ -42,6 +43,8 @@ END_RESOLUTION = 1 / 3  # the end-on view (the remaining axis of larger spread: 
 # is AUTO) only looks for limbs, at this fraction of the resolution: limbs are coarse features, and its trace costs less
 MIN_VIEW_RESOLUTION = 64  # the coarsest grid any view gets
 MAX_PATH_SAMPLES = 256  # points tested along a path from a hidden limb to a bone it may hang from (one per cell)
+PATH_SLACK = 0.15  # ... and that path may leave the mesh for this many bone lengths in all (grazing its surface)
+BRIDGE = 1.0  # a hidden limb starting farther than this many bone lengths from that bone gets a bone across the gap
 
 
 class Blob(NamedTuple):
@@ -297,7 +300,7 @@ class _BoneBuilder:
         order = [trunk] + [i for i in range(len(placed)) if i != trunk]
         inner = {parent for _, parent, _ in placed}
         joints = self._joints([(line, widths, i not in inner) for i, (line, _, widths) in enumerate(placed)])
-        attach = self._attachment(root_point)
+        attach, _ = self._attachment(root_point)
         last_bone, first_bone = {}, {}
         for i in order:
             line, parent, _ = placed[i]
@@ -312,12 +315,17 @@ class _BoneBuilder:
 
     def add_limbs(self, limbs, views):
         """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone their start reaches
-        within the mesh as all the silhouettes ``views`` see it (the primary one and the one the limbs come from)."""
+        within the mesh as all the silhouettes ``views`` see it (the primary one and the one the limbs come from);
+        a chain that starts far from that bone (a foot below a leg too stubby to show) first gets a bone along the
+        path, so the leg between them has a bone of its own."""
         if not limbs:
             return
         joints = self._joints([(line, widths, True) for line, widths in limbs])
         for (line, _), along in zip(limbs, joints):
-            self._add_chain(line, along, self._attachment(line[0], views))
+            up, target = self._attachment(line[0], views)
+            if np.linalg.norm(target - line[0]) > BRIDGE * self.bone_length:
+                line, along = np.vstack([target, line]), np.vstack([target, along])
+            self._add_chain(line, along, up)
 
     def _joints(self, chains):
         """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror pairs made symmetric."""
@@ -371,15 +379,16 @@ class _BoneBuilder:
         centre = sil.lift(point2d[None], [depth])[0]
         half = max(radius, sil.cell) * sil.v
         ends = np.array([centre - half, centre + half])
-        self._add_chain(ends, ends, self._attachment(centre))
+        self._add_chain(ends, ends, self._attachment(centre)[0])
 
     def _attachment(self, point, views=()):
-        """The bone nearest ``point``, or -1 before the first island. With silhouettes ``views``, the nearest bone
-        that a straight path from ``point`` reaches within the mesh as each of them sees it (``Silhouette.encloses``,
-        sampled every grid cell: a foot beside a hanging hand belongs to the body, not the hand), falling back to
-        the nearest bone when no path does."""
+        """(bone, where the path from ``point`` meets it): the bone nearest ``point``, or -1 before the first island.
+        With silhouettes ``views``, the nearest bone that a straight path from ``point`` reaches within the mesh as
+        each of them sees it (``Silhouette.encloses``, sampled every grid cell, up to ``PATH_SLACK`` outside: a foot
+        beside a hanging hand belongs to the body, not the hand); when no path does, the nearest bone, met at
+        ``point`` itself (no bridge may cross what no path crosses)."""
         if not self.heads:
-            return -1
+            return -1, point
         targets = nearest_on_segments(point[None], np.array(self.heads), np.array(self.tails))[0]
         distance = np.linalg.norm(targets - point, axis=1)
         order = np.argsort(distance, kind="stable")
@@ -388,9 +397,12 @@ class _BoneBuilder:
             for bone in order:
                 count = int(np.clip(np.ceil(distance[bone] / cell), 1, MAX_PATH_SAMPLES))
                 path = point + (np.arange(1, count + 1) / (count + 1))[:, None] * (targets[bone] - point)
-                if all(view.encloses(path, view.cell).all() for view in views):
-                    return int(bone)
-        return int(order[0])
+                outside = np.zeros(count, bool)
+                for view in views:
+                    outside |= ~view.encloses(path, view.cell)
+                if outside.sum() * distance[bone] / (count + 1) <= PATH_SLACK * self.bone_length:
+                    return int(bone), targets[bone]
+        return int(order[0]), point
 
     def arrays(self):
         return np.array(self.heads), np.array(self.tails), np.array(self.parents, dtype=np.int64)
