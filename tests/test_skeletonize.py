@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from rigger.skeletonize import depth
-from rigger.skeletonize.bones import chain_joints
+from rigger.skeletonize.bones import chain_joints, symmetric_joints
 from rigger.skeletonize.polyline import arc_lengths
 from rigger.skeletonize.tree import Chain, chains_of, rooted_chains
 
@@ -185,3 +185,22 @@ def test_one_node_seeing_two_legs_as_one_part_is_a_slip_not_an_occlusion():
     occluded = [leg] * 3 + [merged] * 3 + [leg] * 3
     depths = depth._resolve_occlusion(sil, points, radius, occluded, np.full(9, 3.0), FixedSide())
     np.testing.assert_array_equal(depths, [3, 3, 3, 0, 0, 0, 3, 3, 3])
+
+
+def test_mirror_pair_chains_get_mirror_image_joints():
+    """Two arms mirrored across x = 0 whose joints came out slightly apart get the average, mirrored; each keeps its
+    own first joint; a chain on the plane and a pair whose shapes differ (a leg stepping forward) are left alone."""
+    arm = np.array([[0.2, 1.0, 0.0], [0.6, 1.0, 0.0], [1.0, 1.0, 0.0]])
+    left, right = arm, arm * [-1, 1, 1]
+    leg = np.array([[0.2, 0.0, 0.0], [0.2, -0.5, 0.0], [0.2, -1.0, 0.0]])
+    stepping = np.array([[-0.2, 0.0, 0.0], [-0.2, -0.5, 0.3], [-0.2, -1.0, 0.0]])  # same ends, a knee bent forward
+    spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    lines = [spine, left, right, leg, stepping]
+    joints = [spine, left + [0, 0.02, 0], right + [0.01, -0.02, 0], leg, stepping]
+    result = symmetric_joints(joints, lines, (0, 0.0), 0.05)
+    np.testing.assert_allclose(result[1][0], joints[1][0])  # first joints stay where the chains attach
+    np.testing.assert_allclose(result[2][0], joints[2][0])
+    np.testing.assert_allclose(result[1][1:], (left + [-0.005, 0, 0])[1:], atol=1e-12)
+    np.testing.assert_allclose(result[2][1:], (right + [0.005, 0, 0])[1:], atol=1e-12)
+    for k in (0, 3, 4):
+        assert result[k] is joints[k]

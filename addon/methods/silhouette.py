@@ -21,10 +21,10 @@ from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
 from ..core.timing import StageClock
-from ..skeletonize.bones import bone_names, chain_joints, mirror_chain_pairs, mirror_plane, mirrored
+from ..skeletonize.bones import bone_names, chain_joints, mirror_plane, symmetric_joints
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
-from ..skeletonize.polyline import nearest_on_segments, resampled
+from ..skeletonize.polyline import nearest_on_segments
 from ..skeletonize.second_view import Cover, uncovered_limbs
 from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chains
 
@@ -34,8 +34,6 @@ SPREAD_SAMPLES = 100_000  # triangles sampled to choose the view
 MIN_BRANCH = 0.5  # branches sticking out less than this many bone lengths are dropped, however thin
 AXIS_NAMES = ("X", "Y", "Z")
 MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
-SAME_SHAPE = 0.6  # ... and get mirrored joints when their shapes agree this closely (in tolerances)
-SHAPE_SAMPLES = 9  # points along each chain compared for that
 HIDDEN_REACH = 0.6  # perpendicular-view limb tips this many bone lengths off the skeleton (seen that way) are missing
 HIDDEN_PRUNE = 2 / 3  # the perpendicular views prune at this fraction of ``prune``: a limb they add must also be off the
 # primary skeleton and hidden in the primary view, so they can trust stubbier branches (a fox's ears)
@@ -329,9 +327,11 @@ class _BoneBuilder:
 
     def _joints(self, chains):
         """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror pairs made symmetric."""
-        return self._symmetric([chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths,
-                                             leaf=leaf) for line, widths, leaf in chains],
-                               [line for line, _, _ in chains])
+        joints = [chain_joints(line, self.bone_angle, self.bone_length, self.max_bones, widths, leaf=leaf)
+                  for line, widths, leaf in chains]
+        if self.plane is None:
+            return joints
+        return symmetric_joints(joints, [line for line, _, _ in chains], self.plane, self.tolerance)
 
     def _add_chain(self, line, joints, up):
         """Bones between consecutive ``joints`` of one chain, the first hanging from bone ``up``; returns the
@@ -350,27 +350,6 @@ class _BoneBuilder:
             up = len(self.heads) - 1
             added.append(up)
         return added
-
-    def _symmetric(self, joints, lines):
-        """``joints`` per chain, with each mirror pair of chains given the average of one and the other's mirror
-        image (the one with more joints decides their count); each chain keeps its own first joint, where it
-        attaches to its parent."""
-        if self.plane is None:
-            return joints
-        for i, j in mirror_chain_pairs(lines, self.plane, self.tolerance):
-            image_of_j = mirrored(resampled(lines[j], SHAPE_SAMPLES), self.plane)
-            apart = np.linalg.norm(resampled(lines[i], SHAPE_SAMPLES) - image_of_j, axis=1).max()
-            if apart > SAME_SHAPE * self.tolerance:
-                continue  # ends that mirror, shapes that do not (a leg stepping forward): leave both as they are
-            a, b = joints[i], joints[j]
-            b_image = mirrored(b, self.plane)
-            if len(a) == len(b):
-                mean = (a + b_image) / 2
-            else:
-                mean = a if len(a) > len(b) else b_image
-            joints[i] = np.vstack([a[:1], mean[1:]])
-            joints[j] = np.vstack([b[:1], mirrored(mean, self.plane)[1:]])
-        return joints
 
     def add_blob(self, sil, point2d, radius):
         """An island whose axis is a single node (a round speck): one short bone through it, pointing up."""

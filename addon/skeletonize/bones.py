@@ -2,9 +2,11 @@
 import numpy as np
 
 from ..core.arrays import column_bounds
-from .polyline import arc_lengths, point_at
+from .polyline import arc_lengths, point_at, resampled
 
 LONGEST = 3.0  # no bone longer than this many bone lengths, whatever max_bones says (a straight leg gets a knee)
+SAME_SHAPE = 0.6  # mirror-pair chains get mirror-image joints when their shapes agree this closely (in tolerances)
+SHAPE_SAMPLES = 9  # points along each chain compared for that
 
 
 def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=False):
@@ -178,6 +180,27 @@ def mirror_chain_pairs(lines, plane, tolerance):
             pairs.append((i, j))
             taken[[i, j]] = True
     return pairs
+
+
+def symmetric_joints(joints, lines, plane, tolerance):
+    """``joints`` per chain (3D polylines ``lines``), with each mirror pair of chains (``mirror_chain_pairs``) given
+    the average of one and the other's mirror image (the one with more joints decides their count); each chain keeps
+    its own first joint, where it attaches to its parent. Pairs whose ends mirror but whose shapes do not (a leg
+    stepping forward) keep their own joints."""
+    joints = list(joints)
+    for i, j in mirror_chain_pairs(lines, plane, tolerance):
+        image_of_j = mirrored(resampled(lines[j], SHAPE_SAMPLES), plane)
+        if np.linalg.norm(resampled(lines[i], SHAPE_SAMPLES) - image_of_j, axis=1).max() > SAME_SHAPE * tolerance:
+            continue
+        a, b = joints[i], joints[j]
+        b_image = mirrored(b, plane)
+        if len(a) == len(b):
+            mean = (a + b_image) / 2
+        else:
+            mean = a if len(a) > len(b) else b_image
+        joints[i] = np.vstack([a[:1], mean[1:]])
+        joints[j] = np.vstack([b[:1], mirrored(mean, plane)[1:]])
+    return joints
 
 
 def _side(line, plane, tolerance):
