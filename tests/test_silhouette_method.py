@@ -250,28 +250,33 @@ def test_ears_hidden_in_the_primary_view_come_from_the_end_on_view():
     assert inside_fraction(vertices, triangles, bone_samples(skeleton)) >= 0.9
 
 
+@pytest.mark.parametrize("bone_length", [1.0, 0.3])
 @pytest.mark.parametrize("foot_depth", [0.5, 1.02], ids=["inside", "grazing the surface"])
-def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh(foot_depth):
+def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh(foot_depth, bone_length):
     """A foot at the bottom of a body whose nearest bone is in a hand hanging beside it, across a gap: the foot
     hangs from the body's bone, farther but reached without leaving the mesh (a path that only grazes the surface
-    near the foot still counts), through a bone across the distance between them."""
+    near the foot still counts), through bones across the distance between them, none longer than ``LONGEST``."""
     from rigger.methods.silhouette import _BoneBuilder
+    from rigger.skeletonize.bones import LONGEST
 
     vertices, triangles = combine(box((0, 0, 0), (1, 3, 1)), box((1.3, 0, 0), (1.6, 2, 1)))  # body and leg; hand
     sil = rigger.silhouette.trace(vertices, triangles, "Z")
-    builder = _BoneBuilder(np.radians(40), 1.0, 0, None, 0.05)
+    builder = _BoneBuilder(np.radians(40), bone_length, 0, None, 0.05)
     body = np.array([[0.5, 2.8, 0.5], [0.5, 1.5, 0.5]])
     hand = np.array([[1.45, 2.0, 0.5], [1.45, 0.2, 0.5]])
     builder.add_island(body[0], [(body, -1, np.full(2, 0.4)), (hand, 0, np.full(2, 0.1))])
-    island_bones = len(builder.heads)
+    first = len(builder.heads)
     foot = np.array([[0.8, 0.3, foot_depth], [0.8, 0.1, 0.9]])
     builder.add_limbs([(foot, np.full(2, 0.1))], (sil,))
     heads, tails, parents = builder.arrays()
-    bridge = island_bones
-    assert heads[parents[bridge], 0] < 1, "the foot hangs from the hand across the gap"
-    np.testing.assert_allclose(tails[bridge], foot[0])
-    np.testing.assert_allclose(heads[bridge], [0.5, 1.5, 0.5])  # where the body's bone is nearest the foot
-    assert parents[bridge + 1] == bridge and len(heads) == bridge + 2
+    assert heads[parents[first], 0] < 1, "the foot hangs from the hand across the gap"
+    np.testing.assert_allclose(heads[first], [0.5, 1.5, 0.5])  # where the body's bone is nearest the foot
+    bridge = first + np.flatnonzero(np.all(np.isclose(tails[first:], foot[0]), axis=1))
+    assert len(bridge) == 1, "no bridge bone ends at the foot"
+    np.testing.assert_array_equal(parents[first + 1:], np.arange(first, len(heads) - 1))  # one chain
+    gap = np.linalg.norm(foot[0] - heads[first])
+    assert bridge[0] - first + 1 == np.ceil(gap / (LONGEST * bone_length))
+    assert np.linalg.norm(tails - heads, axis=1).max() <= LONGEST * bone_length + 1e-9
 
 
 def test_a_hidden_limb_near_its_bone_gets_no_bridge():

@@ -21,7 +21,7 @@ from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
 from ..core.timing import StageClock
-from ..skeletonize.bones import bone_names, chain_joints, mirror_plane, symmetric_joints
+from ..skeletonize.bones import LONGEST, bone_names, chain_joints, mirror_plane, symmetric_joints
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
 from ..skeletonize.polyline import nearest_on_segments
@@ -315,14 +315,17 @@ class _BoneBuilder:
         """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone their start reaches
         within the mesh as all the silhouettes ``views`` see it (the primary one and the one the limbs come from);
         a chain that starts far from that bone (a foot below a leg too stubby to show) first gets a bone along the
-        path, so the leg between them has a bone of its own."""
+        path (more where it is longer than ``LONGEST`` bone lengths), so the leg between them has a bone of its own."""
         if not limbs:
             return
         joints = self._joints([(line, widths, True) for line, widths in limbs])
         for (line, _), along in zip(limbs, joints):
             up, target = self._attachment(line[0], views)
-            if np.linalg.norm(target - line[0]) > BRIDGE * self.bone_length:
-                line, along = np.vstack([target, line]), np.vstack([target, along])
+            gap = float(np.linalg.norm(line[0] - target))
+            if gap > BRIDGE * self.bone_length:
+                pieces = int(np.ceil(gap / (LONGEST * self.bone_length)))  # no bone longer than LONGEST either
+                bridge = target + (np.arange(pieces) / pieces)[:, None] * (line[0] - target)
+                line, along = np.vstack([bridge, line]), np.vstack([bridge, along])
             self._add_chain(line, along, up)
 
     def _joints(self, chains):
