@@ -250,49 +250,65 @@ def test_ears_hidden_in_the_primary_view_come_from_the_end_on_view():
     assert inside_fraction(vertices, triangles, bone_samples(skeleton)) >= 0.9
 
 
+def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):
+    """A box body (x in -0.5..0.5) with one bone down its middle, optionally a box hand hanging beside it across a
+    gap, and ``feet`` (polylines) added as hidden limbs seen from the front; returns the builder and how many bones
+    the body (and hand) got."""
+    from rigger.methods.silhouette import _BoneBuilder
+
+    parts = [box((-0.5, 0, 0), (0.5, 3, 1))] + ([box((0.8, 0, 0), (1.1, 2, 1))] if hand else [])
+    vertices, triangles = combine(*parts)
+    sil = rigger.silhouette.trace(vertices, triangles, "Z")
+    builder = _BoneBuilder(np.radians(40), bone_length, 0, plane, 0.05)
+    body = np.array([[0.0, 2.8, 0.5], [0.0, 1.5, 0.5]])
+    chains = [(body, -1, np.full(2, 0.4))]
+    if hand:
+        chains.append((np.array([[0.95, 2.0, 0.5], [0.95, 0.2, 0.5]]), 0, np.full(2, 0.1)))
+    builder.add_island(body[0], chains)
+    first = len(builder.heads)
+    builder.add_limbs([(foot, np.full(len(foot), 0.1)) for foot in feet], (sil,))
+    return builder, first
+
+
 @pytest.mark.parametrize("bone_length", [1.0, 0.3])
-@pytest.mark.parametrize("foot_depth", [0.5, 1.02], ids=["inside", "grazing the surface"])
+@pytest.mark.parametrize("foot_depth", [0.5, 1.01], ids=["inside", "grazing the surface"])
 def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh(foot_depth, bone_length):
     """A foot at the bottom of a body whose nearest bone is in a hand hanging beside it, across a gap: the foot
     hangs from the body's bone, farther but reached without leaving the mesh (a path that only grazes the surface
-    near the foot still counts), through bones across the distance between them, none longer than ``LONGEST``."""
-    from rigger.methods.silhouette import _BoneBuilder
+    near the foot still counts), its chain extended back to that bone with bones no longer than ``LONGEST``."""
     from rigger.skeletonize.bones import LONGEST
 
-    vertices, triangles = combine(box((0, 0, 0), (1, 3, 1)), box((1.3, 0, 0), (1.6, 2, 1)))  # body and leg; hand
-    sil = rigger.silhouette.trace(vertices, triangles, "Z")
-    builder = _BoneBuilder(np.radians(40), bone_length, 0, None, 0.05)
-    body = np.array([[0.5, 2.8, 0.5], [0.5, 1.5, 0.5]])
-    hand = np.array([[1.45, 2.0, 0.5], [1.45, 0.2, 0.5]])
-    builder.add_island(body[0], [(body, -1, np.full(2, 0.4)), (hand, 0, np.full(2, 0.1))])
-    first = len(builder.heads)
-    foot = np.array([[0.8, 0.3, foot_depth], [0.8, 0.1, 0.9]])
-    builder.add_limbs([(foot, np.full(2, 0.1))], (sil,))
+    foot = np.array([[0.3, 0.3, foot_depth], [0.3, 0.1, 0.9]])
+    builder, first = _body_with_feet([foot], hand=True, bone_length=bone_length)
     heads, tails, parents = builder.arrays()
-    assert heads[parents[first], 0] < 1, "the foot hangs from the hand across the gap"
-    np.testing.assert_allclose(heads[first], [0.5, 1.5, 0.5])  # where the body's bone is nearest the foot
-    bridge = first + np.flatnonzero(np.all(np.isclose(tails[first:], foot[0]), axis=1))
-    assert len(bridge) == 1, "no bridge bone ends at the foot"
+    assert heads[parents[first], 0] < 0.5, "the foot hangs from the hand across the gap"
+    np.testing.assert_allclose(heads[first], [0.0, 1.5, 0.5])  # where the body's bone is nearest the foot
     np.testing.assert_array_equal(parents[first + 1:], np.arange(first, len(heads) - 1))  # one chain
-    gap = np.linalg.norm(foot[0] - heads[first])
-    assert bridge[0] - first + 1 == np.ceil(gap / (LONGEST * bone_length))
+    np.testing.assert_allclose(tails[-1], foot[-1])
     assert np.linalg.norm(tails - heads, axis=1).max() <= LONGEST * bone_length + 1e-9
 
 
-def test_a_hidden_limb_near_its_bone_gets_no_bridge():
-    from rigger.methods.silhouette import _BoneBuilder
+def test_a_hidden_limb_near_its_bone_or_reaching_none_is_not_extended():
+    near = np.array([[0.3, 1.2, 0.5], [0.3, 0.9, 0.9]])
+    outside = np.array([[3.0, 0.3, 0.5], [3.0, 0.1, 0.9]])  # no path to any bone stays within the mesh
+    builder, first = _body_with_feet([near, outside])
+    heads, tails, parents = builder.arrays()
+    starts = first + np.flatnonzero(parents[first:] < first)
+    assert (parents[starts] == first - 1).all()  # both from the body's lower bone
+    np.testing.assert_allclose(heads[starts], [near[0], outside[0]])
 
-    vertices, triangles = box((0, 0, 0), (1, 3, 1))
-    sil = rigger.silhouette.trace(vertices, triangles, "Z")
-    builder = _BoneBuilder(np.radians(40), 1.0, 0, None, 0.05)
-    body = np.array([[0.5, 2.8, 0.5], [0.5, 1.0, 0.5]])
-    builder.add_island(body[0], [(body, -1, np.full(2, 0.4))])
-    island_bones = len(builder.heads)
-    foot = np.array([[0.8, 0.3, 0.5], [0.8, 0.1, 0.9]])
-    builder.add_limbs([(foot, np.full(2, 0.1))], (sil,))
-    heads, _, parents = builder.arrays()
-    assert len(heads) == island_bones + 1 and parents[-1] == island_bones - 1  # the body's lower bone
-    np.testing.assert_allclose(heads[-1], foot[0])
+
+def test_mirror_image_hidden_limbs_get_mirror_image_bones():
+    """Two feet mirrored across x = 0, both far below the body's bone: each hangs from the body (not the right foot
+    from the left one's extension, which passes nearer it) through mirror-image bones."""
+    left = np.array([[0.3, 0.3, 0.5], [0.3, 0.1, 0.9]])
+    builder, first = _body_with_feet([left, left * [-1, 1, 1]], plane=(0, 0.0))
+    heads, tails, parents = builder.arrays()
+    half = (len(heads) - first) // 2
+    assert len(heads) == first + 2 * half and half >= 2
+    assert parents[first] == parents[first + half] == first - 1
+    np.testing.assert_allclose(heads[first + half:], heads[first:first + half] * [-1, 1, 1], atol=1e-12)
+    np.testing.assert_allclose(tails[first + half:], tails[first:first + half] * [-1, 1, 1], atol=1e-12)
 
 
 def test_an_open_tube_rigs_though_it_shows_nothing_end_on():

@@ -204,3 +204,5 @@ def test_mirror_pair_chains_get_mirror_image_joints():
     np.testing.assert_allclose(result[2][1:], (right + [0.005, 0, 0])[1:], atol=1e-12)
     for k in (0, 3, 4):
         assert result[k] is joints[k]
+    fewer = symmetric_joints([left, right[::2]], [left, right], (0, 0.0), 0.05)  # the one with more joints decides
+    np.testing.assert_allclose(fewer[1], right)

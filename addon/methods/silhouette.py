@@ -21,7 +21,7 @@ from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
 from ..core.timing import StageClock
-from ..skeletonize.bones import LONGEST, bone_names, chain_joints, mirror_plane, symmetric_joints
+from ..skeletonize.bones import bone_names, chain_joints, mirror_plane, symmetric_joints
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
 from ..skeletonize.polyline import nearest_on_segments
@@ -42,7 +42,7 @@ END_RESOLUTION = 1 / 3  # the end-on view (the remaining axis of larger spread: 
 MIN_VIEW_RESOLUTION = 64  # the coarsest grid any view gets
 MAX_PATH_SAMPLES = 256  # points tested along a path from a hidden limb to a bone it may hang from (one per cell)
 PATH_SLACK = 0.15  # ... and that path may leave the mesh for this many bone lengths in all (grazing its surface)
-BRIDGE = 1.0  # a hidden limb starting farther than this many bone lengths from that bone gets a bone across the gap
+BRIDGE = 1.0  # a hidden limb starting farther than this many bone lengths from that bone is extended back to it
 
 
 class Blob(NamedTuple):
@@ -312,20 +312,20 @@ class _BoneBuilder:
             first_bone[i], last_bone[i] = (added[0], added[-1]) if added else (up, up)
 
     def add_limbs(self, limbs, views):
-        """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone their start reaches
-        within the mesh as all the silhouettes ``views`` see it (the primary one and the one the limbs come from);
-        a chain that starts far from that bone (a foot below a leg too stubby to show) first gets a bone along the
-        path (more where it is longer than ``LONGEST`` bone lengths), so the leg between them has a bone of its own."""
+        """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone already there that their
+        start reaches within the mesh as all the silhouettes ``views`` see it (the primary one and the one the limbs
+        come from); a chain starting far from that bone (a foot below a leg too stubby to show) is extended back
+        along the path to it, so the leg between them gets bones of its own, and mirror pairs stay mirror pairs."""
         if not limbs:
             return
-        joints = self._joints([(line, widths, True) for line, widths in limbs])
-        for (line, _), along in zip(limbs, joints):
-            up, target = self._attachment(line[0], views)
-            gap = float(np.linalg.norm(line[0] - target))
-            if gap > BRIDGE * self.bone_length:
-                pieces = int(np.ceil(gap / (LONGEST * self.bone_length)))  # no bone longer than LONGEST either
-                bridge = target + (np.arange(pieces) / pieces)[:, None] * (line[0] - target)
-                line, along = np.vstack([bridge, line]), np.vstack([bridge, along])
+        chains, ups = [], []
+        for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
+            up, meets = self._attachment(line[0], views)  # from the left one's extension, which passes nearer it)
+            if meets is not None and np.linalg.norm(line[0] - meets) > BRIDGE * self.bone_length:
+                line, widths = np.vstack([meets, line]), np.r_[0.0, widths]  # 0: no branch-point disc to leave
+            chains.append((line, widths, True))
+            ups.append(up)
+        for (line, _, _), along, up in zip(chains, self._joints(chains), ups):
             self._add_chain(line, along, up)
 
     def _joints(self, chains):
@@ -364,13 +364,14 @@ class _BoneBuilder:
         self._add_chain(ends, ends, self._attachment(centre)[0])
 
     def _attachment(self, point, views=()):
-        """(bone, where the path from ``point`` meets it): the bone nearest ``point``, or -1 before the first island.
-        With silhouettes ``views``, the nearest bone that a straight path from ``point`` reaches within the mesh as
-        each of them sees it (``Silhouette.encloses``, sampled every grid cell, up to ``PATH_SLACK`` outside: a foot
-        beside a hanging hand belongs to the body, not the hand); when no path does, the nearest bone, met at
-        ``point`` itself (no bridge may cross what no path crosses)."""
+        """(bone, where a path from ``point`` meets it): the bone nearest ``point``, or -1 before the first island,
+        met nowhere in particular (None). With silhouettes ``views``, the nearest bone that a straight path from
+        ``point`` reaches within the mesh as each of them sees it (``Silhouette.encloses``, sampled every grid cell,
+        up to ``PATH_SLACK`` bone lengths outside: a path may graze the surface, but a foot beside a hanging hand
+        belongs to the body, not the hand), and the point the path meets it at; the nearest bone, met nowhere (None),
+        when no path stays in."""
         if not self.heads:
-            return -1, point
+            return -1, None
         targets = nearest_on_segments(point[None], np.array(self.heads), np.array(self.tails))[0]
         distance = np.linalg.norm(targets - point, axis=1)
         order = np.argsort(distance, kind="stable")
@@ -384,7 +385,7 @@ class _BoneBuilder:
                     outside |= ~view.encloses(path, view.cell)
                 if outside.sum() * distance[bone] / (count + 1) <= PATH_SLACK * self.bone_length:
                     return int(bone), targets[bone]
-        return int(order[0]), point
+        return int(order[0]), None
 
     def arrays(self):
         return np.array(self.heads), np.array(self.tails), np.array(self.parents, dtype=np.int64)
