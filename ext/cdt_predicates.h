@@ -110,17 +110,15 @@ static int rg_scale(int elen, const double *e, double b, double *h) {
     return n;
 }
 
-/* h = e * f. h and scratch must each hold 2 * elen * flen doubles. Returns length. */
-static int rg_mul(int elen, const double *e, int flen, const double *f, double *h, double *scratch) {
+/* h = e * f. h and acc (the running sum) must each hold 2 * elen * flen doubles. Returns length. */
+static int rg_mul(int elen, const double *e, int flen, const double *f, double *h, double *acc) {
     double part[2 * 16];
-    double *acc = scratch;
     int n = 0;
     for (int j = 0; j < flen; j++) {
         int pn = rg_scale(elen, e, f[j], part);
         n = rg_sum(n, acc, pn, part, h);
         for (int i = 0; i < n; i++) acc[i] = h[i];
     }
-    for (int i = 0; i < n; i++) h[i] = acc[i];
     return n;
 }
 

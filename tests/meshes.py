@@ -1,4 +1,4 @@
-"""Small generated meshes the tests share: boxes and soups of several meshes."""
+"""Small generated meshes the tests share: boxes, UV spheres and ellipsoids, and soups of several meshes."""
 import numpy as np
 
 
@@ -19,3 +19,29 @@ def combine(*meshes):
         triangles.append(np.asarray(t) + offset)
         offset += len(v)
     return np.concatenate(vertices), np.concatenate(triangles)
+
+
+def uv_sphere(rings=16, segments=32):
+    """A closed unit UV sphere: ``rings`` bands from pole to pole, ``segments`` around."""
+    theta = np.linspace(0, np.pi, rings + 1)[1:-1]
+    phi = np.linspace(0, 2 * np.pi, segments, endpoint=False)
+    ring = np.stack([np.outer(np.sin(theta), np.cos(phi)), np.outer(np.sin(theta), np.sin(phi)),
+                     np.repeat(np.cos(theta)[:, None], segments, axis=1)], axis=2).reshape(-1, 3)
+    vertices = np.vstack([ring, [(0, 0, 1), (0, 0, -1)]])
+    top, bottom = len(ring), len(ring) + 1
+    triangles = []
+    for r in range(rings - 2):
+        for k in range(segments):
+            a, b = r * segments + k, r * segments + (k + 1) % segments
+            triangles += [(a, b + segments, b), (a, a + segments, b + segments)]
+    for k in range(segments):
+        triangles += [(top, k, (k + 1) % segments)]
+        last = (rings - 2) * segments
+        triangles += [(bottom, last + (k + 1) % segments, last + k)]
+    return vertices, np.array(triangles)
+
+
+def ellipsoids(parts):
+    """One closed UV-sphere mesh per (centre, semi-axes) part, all in one vertex and triangle array."""
+    sphere, sphere_triangles = uv_sphere()
+    return combine(*((sphere * size + centre, sphere_triangles) for centre, size in parts))

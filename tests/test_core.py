@@ -285,3 +285,12 @@ def test_param_declaration_is_validated(kwargs, fragment):
     with pytest.raises(ValueError) as error:
         Param(**kwargs)
     assert fragment in str(error.value)
+
+
+def test_concatenated_ranges_match_a_loop():
+    from rigger.core.arrays import concatenated_ranges
+
+    starts, counts = np.array([5, 0, 9, 2]), np.array([3, 0, 1, 2])
+    expected = np.concatenate([np.arange(s, s + c) for s, c in zip(starts, counts)])
+    np.testing.assert_array_equal(concatenated_ranges(starts, counts), expected)
+    assert len(concatenated_ranges(np.zeros(0, int), np.zeros(0, int))) == 0

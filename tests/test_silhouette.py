@@ -253,8 +253,8 @@ def check_against_union(vertices, triangles, direction, **options):
 @pytest.mark.parametrize("name,direction", [(n, d) for n, (_, ds) in GENERATED.items() for d in ds])
 def test_generated_shapes_match_the_exact_union(name, direction):
     (vertices, triangles), _ = GENERATED[name]
-    sil, iou, errors = check_against_union(vertices, triangles, direction)
-    assert iou >= MIN_IOU
+    sil, overlap, errors = check_against_union(vertices, triangles, direction)
+    assert overlap >= MIN_IOU
     assert errors == []
 
 
@@ -305,21 +305,21 @@ def test_loops_feed_the_triangulation():
 def test_real_models_match_the_exact_union(relative, direction):
     vertices, triangles = real_model(relative)
     try:
-        sil, iou, errors = check_against_union(vertices, triangles, direction)
+        sil, overlap, errors = check_against_union(vertices, triangles, direction)
     except ValueError as error:  # the flat models (woody, alligator) have no silhouette from the side
         assert "zero area" in str(error)
         assert np.ptp(vertices, axis=0).min() == 0
         return
-    assert iou >= MIN_IOU
+    assert overlap >= MIN_IOU
     assert errors == []
 
 
 @pytest.mark.parametrize("resolution,tolerance", [(64, 0.0), (256, 0.05), (2048, 0.05), (1024, 1.0)])
 def test_resolution_and_tolerance(resolution, tolerance):
     vertices, triangles = figure_with_hole()
-    sil, iou, errors = check_against_union(vertices, triangles, "Y", resolution=resolution, tolerance=tolerance)
+    sil, overlap, errors = check_against_union(vertices, triangles, "Y", resolution=resolution, tolerance=tolerance)
     assert sil.cell == pytest.approx((np.ptp(frame_points(sil, vertices), axis=0).max()) / resolution)
-    assert iou >= (0.99 if resolution <= 64 or tolerance == 1.0 else MIN_IOU)
+    assert overlap >= (0.99 if resolution <= 64 or tolerance == 1.0 else MIN_IOU)
     assert errors == []
 
 
@@ -338,8 +338,8 @@ def test_every_kind_of_soup():
     degenerate = [[0, 0, 1], [2, 2, 2], [5, 1, 5]]  # repeated corners
     fan = [[0, 3, 20], [0, 3, 30], [0, 3, 40]]  # one edge shared by five faces
     soup = np.concatenate([t, t[:5], t[:, ::-1][5:9], degenerate, fan])
-    sil, iou, errors = check_against_union(v, soup, (0.3, 1.0, 0.2))
-    assert iou >= MIN_IOU and errors == []
+    sil, overlap, errors = check_against_union(v, soup, (0.3, 1.0, 0.2))
+    assert overlap >= MIN_IOU and errors == []
 
 
 coordinates = st.one_of(st.integers(-3, 3).map(float), st.floats(-1, 1, allow_nan=False, width=32))

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 import rigger
 from cdt_checks import polygon_area
 from characters import inside_fraction, load_character
-from meshes import box, combine
+from meshes import box, combine, ellipsoids, uv_sphere
 from rigger import samples
 
 from rigdata import chamfer_distance
@@ -182,31 +182,6 @@ def test_a_flat_cut_out_tilted_off_the_axis_planes_is_rigged_in_its_plane(defaul
     np.testing.assert_allclose(skeleton.joints() @ normal, 0.0, atol=1e-9)
     size = np.ptp(vertices, axis=0).max()
     assert chamfer_distance(skeleton.joints() @ rotation, reference.joints()) / size < 0.03
-
-
-def uv_sphere(rings=16, segments=32):
-    theta = np.linspace(0, np.pi, rings + 1)[1:-1]
-    phi = np.linspace(0, 2 * np.pi, segments, endpoint=False)
-    ring = np.stack([np.outer(np.sin(theta), np.cos(phi)), np.outer(np.sin(theta), np.sin(phi)),
-                     np.repeat(np.cos(theta)[:, None], segments, axis=1)], axis=2).reshape(-1, 3)
-    vertices = np.vstack([ring, [(0, 0, 1), (0, 0, -1)]])
-    top, bottom = len(ring), len(ring) + 1
-    triangles = []
-    for r in range(rings - 2):
-        for k in range(segments):
-            a, b = r * segments + k, r * segments + (k + 1) % segments
-            triangles += [(a, b + segments, b), (a, a + segments, b + segments)]
-    for k in range(segments):
-        triangles += [(top, k, (k + 1) % segments)]
-        last = (rings - 2) * segments
-        triangles += [(bottom, last + (k + 1) % segments, last + k)]
-    return vertices, np.array(triangles)
-
-
-def ellipsoids(parts):
-    """One closed UV-sphere mesh per (centre, semi-axes) part, all in one vertex and triangle array."""
-    sphere, sphere_triangles = uv_sphere()
-    return combine(*((sphere * size + centre, sphere_triangles) for centre, size in parts))
 
 
 def bird():

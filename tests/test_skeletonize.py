@@ -168,7 +168,7 @@ def test_a_line_jittering_in_depth_gets_no_stub_bones():
 class FixedSide:
     """A stand-in for ``SideAxis`` that puts every occluded node at depth 0 (the body's middle)."""
 
-    def depth_at(self, sil, point, radius, interval, previous):
+    def depth_at(self, point, radius, interval, previous):
         return 0.0
 
 

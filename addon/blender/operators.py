@@ -9,7 +9,7 @@ import bpy
 
 from ..api import method_registry
 from . import overlays
-from .pipeline import rig_object, skin_meshes
+from .pipeline import rig_object, skin_meshes, skin_summary
 from .properties import ARMATURE_POINTER, NO_METHOD, SETTINGS_ATTRIBUTE, overlay_visibility, param_values
 
 
@@ -90,9 +90,8 @@ class _RiggerOperator:
 
     def skin(self, meshes, armature, progress):
         outcomes, warnings = skin_meshes(meshes, armature, progress)
-        summary = "; ".join(outcome.summary() for outcome in outcomes.values())  # each names its mesh
         warned = warnings or any(outcome.level == "WARNING" for outcome in outcomes.values())
-        self.report({'WARNING'} if warned else {'INFO'}, "; ".join([*warnings, summary]))
+        self.report({'WARNING'} if warned else {'INFO'}, "; ".join([*warnings, skin_summary(outcomes)]))
 
 
 class RIGGER_OT_rig(_RiggerOperator, bpy.types.Operator):

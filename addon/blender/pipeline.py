@@ -126,6 +126,11 @@ def skin_meshes(meshes, armature, progress=None):
     return outcomes, warnings
 
 
+def skin_summary(outcomes):
+    """One line for the ``skin_meshes`` reports: each report's summary (each names its mesh)."""
+    return "; ".join(outcome.summary() for outcome in outcomes.values())
+
+
 def remove_rig(obj):
     """Delete the armature Rigger made for ``obj`` earlier, and unbind every mesh made with it (their Armature
     modifiers, Rigger's vertex groups, the parenting; meshes keep their place). True when there was one."""

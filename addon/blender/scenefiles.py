@@ -8,7 +8,7 @@ import numpy as np
 from ..core.files import replaced_on_success
 from . import overlays, skinning
 from .armature import delete_armature
-from .pipeline import METHOD_PROPERTY, rig_object, skin_meshes
+from .pipeline import METHOD_PROPERTY, rig_object, skin_meshes, skin_summary
 from .properties import ARMATURE_POINTER
 
 # Blender's OBJ and glTF importers turn the file's Y-up frame into Blender's Z-up one with this rotation (file x, y,
@@ -100,7 +100,7 @@ def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warn
         warnings.append(f"rigged {len(meshes)} mesh objects together: {', '.join(m.name for m in meshes)}")
     skinning_outcome = {"summary": "not skinned", "meshes": {}}
     if outcomes is not None:
-        skinning_outcome = {"summary": "; ".join(report.summary() for report in outcomes.values()),
+        skinning_outcome = {"summary": skin_summary(outcomes),
                             "meshes": {name: report.as_dict() for name, report in outcomes.items()}}
         warnings += [warning for report in outcomes.values() for warning in report.warnings]
     stages = result.skeleton.stages

@@ -27,7 +27,7 @@ import bpy
 import bmesh
 import numpy as np
 
-from ..core.arrays import column_bounds
+from ..core.arrays import column_bounds, concatenated_ranges
 from ..core.graphs import components
 from ..weights import bone_weights
 from .meshdata import mesh_arrays, world_points
@@ -410,7 +410,7 @@ def _transfer(mesh_obj, bone_names, entries, targets, sources, weighted):
     last = np.searchsorted(copy_vertices, sources, side="right")
     found = last > first
     counts = (last - first)[found]
-    rows = np.repeat(first[found] - (np.cumsum(counts) - counts), counts) + np.arange(counts.sum())
+    rows = concatenated_ranges(first[found], counts)
     _write_weights(mesh_obj, bone_names, np.repeat(targets[found], counts), bones[rows], weights[rows])
     weighted[targets[found]] = True
     return int(found.sum())

@@ -52,3 +52,9 @@ def column_bounds(points):
     reduction over an (N, 3) array is ~40x slower."""
     columns = np.asarray(points).T
     return np.array([[column.min() for column in columns], [column.max() for column in columns]])
+
+
+def concatenated_ranges(starts, counts):
+    """``arange(starts[k], starts[k] + counts[k])`` for every k, end to end, without a Python loop."""
+    starts, counts = np.asarray(starts), np.asarray(counts)
+    return np.repeat(starts - (np.cumsum(counts) - counts), counts) + np.arange(counts.sum())

@@ -16,7 +16,8 @@ def components(count, links):
         apart = ra != rb
         if not apart.any():
             break
-        np.minimum.at(parent, np.maximum(ra[apart], rb[apart]), np.minimum(ra[apart], rb[apart]))
+        a, b, ra, rb = a[apart], b[apart], ra[apart], rb[apart]  # joined ends stay joined: drop those links
+        np.minimum.at(parent, np.maximum(ra, rb), np.minimum(ra, rb))
         while True:
             grand = parent[parent]
             if (grand == parent).all():

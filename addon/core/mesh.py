@@ -9,7 +9,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .arrays import column_bounds
+from .arrays import column_bounds, concatenated_ranges
 
 # A principal variance this small relative to the largest is none: two such make a line, one a flat mesh.
 LINE_VARIANCE_RATIO = 1e-12
@@ -103,9 +103,9 @@ def triangulate_polygons(faces):
         raise ValueError("face indices do not fit in 32 bits")
     triangle_counts = counts - 2
     face_starts = np.cumsum(counts) - counts
-    base = np.repeat(face_starts, triangle_counts)
-    offset = np.arange(triangle_counts.sum()) - np.repeat(np.cumsum(triangle_counts) - triangle_counts, triangle_counts)
-    return np.stack([flat[base], flat[base + offset + 1], flat[base + offset + 2]], axis=1).astype(np.int32)
+    base = np.repeat(face_starts, triangle_counts)  # a fan from each face's first corner
+    corner = concatenated_ranges(face_starts, triangle_counts)
+    return np.stack([flat[base], flat[corner + 1], flat[corner + 2]], axis=1).astype(np.int32)
 
 
 def _read_only(array):

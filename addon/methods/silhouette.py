@@ -114,7 +114,8 @@ class SilhouetteMethod(RigMethod):
             end_on = _other_view(vertices, triangles, sil, end_axis,
                                  max(MIN_VIEW_RESOLUTION, round(END_RESOLUTION * resolution)), outline_spacing, min_hole)
             if side_of is not None:
-                side = SideAxis(side_of[0], side_of[1].points, side_of[1].radius, sil)
+                side_sil, side_graph = side_of
+                side = SideAxis(side_sil, side_graph.points, side_graph.radius, sil)
             other_views = [found for found in (side_of, end_on) if found is not None]
         clock.lap("other_views")
 
@@ -125,9 +126,10 @@ class SilhouetteMethod(RigMethod):
                 builder.add_blob(sil, placed.point, placed.radius)
             else:
                 builder.add_island(placed.root_point, placed.chains)
-        limb_search = dict(merge=merge, prune=HIDDEN_PRUNE * prune, bone_length=unit, split_layers=split_layers)
         for view_sil, view_graph in other_views:
-            builder.add_limbs(_hidden_limbs(sil, view_sil, view_graph, builder.lines, **limb_search), (sil, view_sil))
+            limbs = _hidden_limbs(sil, view_sil, view_graph, builder.lines, merge, HIDDEN_PRUNE * prune, unit,
+                                  split_layers)
+            builder.add_limbs(limbs, (sil, view_sil))
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()

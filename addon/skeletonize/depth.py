@@ -185,7 +185,7 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
     thick &= np.r_[False, thick[:-1]] | np.r_[thick[1:], False]  # a single node is a tracing slip, not a body
     for i, interval in enumerate(chosen):
         if thick[i]:
-            found = side_axis.depth_at(sil, points[i], radius[i], interval, previous)
+            found = side_axis.depth_at(points[i], radius[i], interval, previous)
             if found is not None:
                 out[i] = found
         previous = out[i]
@@ -208,12 +208,13 @@ class SideAxis:
         self.depth = world @ primary_sil.direction - float(primary_sil.origin @ primary_sil.direction)
         self.radius = radius
         self.cell = side_sil.cell
+        self.primary = primary_sil
 
-    def depth_at(self, sil, point2d, radius, interval, previous):
-        """Depth (in the primary view ``sil``'s frame) of the side-view part matching a primary node, inside
+    def depth_at(self, point2d, radius, interval, previous):
+        """Depth (in the primary view's frame) of the side-view part matching a primary node at ``point2d``, inside
         ``interval``: of the side-view axis nodes at the node's height, the one nearest ``previous`` (ties to the
         closest width); None if no side-view node fits."""
-        w0 = float(sil.lift(point2d, 0.0)[0] @ self.w_axis)
+        w0 = float(self.primary.lift(point2d, 0.0)[0] @ self.w_axis)
         depth = self.depth
         near = np.abs(self.w - w0) <= max(radius, self.cell)
         near &= (depth >= interval[0]) & (depth <= interval[1])
