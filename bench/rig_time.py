@@ -38,6 +38,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
 from benchkit import (REPO, RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit,  # noqa: E402
                       markdown_table, midpoint_subdivided, table_cell)
+from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
 
 GENERATE_FLAG = "--generate-characters"  # child-process mode: write the characters' arrays into a directory
 GENERATION_TIMEOUT_S = 300
@@ -102,17 +103,16 @@ def generated_characters():
 
 def write_characters(directory):
     """Child-process side: every character at every Skin level, one .npz each."""
-    with tempfile.TemporaryDirectory(prefix="rigger-blender-user-") as user_resources:
-        os.environ.setdefault("BLENDER_USER_RESOURCES", user_resources)
-        import bpy
-        from rigger import samples
-        from rigger.blender.samples import character_arrays
+    temporary_user_folder()
+    import bpy
+    from rigger import samples
+    from rigger.blender.samples import character_arrays
 
-        bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-        for name in samples.CHARACTERS:
-            for level in SKIN_LEVELS:
-                vertices, triangles = character_arrays(name, subdivisions=level)
-                np.savez(os.path.join(directory, f"{name}_{level}.npz"), vertices=vertices, triangles=triangles)
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    for name in samples.CHARACTERS:
+        for level in SKIN_LEVELS:
+            vertices, triangles = character_arrays(name, subdivisions=level)
+            np.savez(os.path.join(directory, f"{name}_{level}.npz"), vertices=vertices, triangles=triangles)
 
 
 def character_ladder(name, arrays, max_vertices):

@@ -16,7 +16,6 @@ import pathlib
 import platform
 import statistics
 import sys
-import tempfile
 import time
 from dataclasses import dataclass
 
@@ -26,6 +25,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
 from benchkit import (RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit, format_seconds,  # noqa: E402
                       markdown_table, table_cell)
+from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
 from rigger.skeletonize.polyline import segment_distances  # noqa: E402  (bpy-free)
 
 MODELS_DIR = SHARED_MODELS / "gt"
@@ -345,8 +345,7 @@ def main(argv=None):
         folders = [path for path in folders if any(text in path.name for text in wanted)]
         if not folders:
             raise SystemExit(f"No model name contains any of {wanted}.")
-    if "BLENDER_USER_RESOURCES" not in os.environ:  # bpy reads user resources at import: keep off the home folder
-        os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp(prefix="rigger-blender-user-")
+    temporary_user_folder()
     run = {"command": "python bench/skinning.py" + (" " + " ".join(argv or sys.argv[1:])).rstrip(),
            "started": datetime.datetime.now(datetime.timezone.utc), "load": os.getloadavg()}
     started = time.perf_counter()

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from rigger import samples
+from rigger.blender.headless import temporary_user_folder
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "bench"))
 import rigdata  # noqa: E402  (bench/ is no package)
@@ -59,16 +60,15 @@ def inside_fraction(vertices, triangles, points):
 
 def _write_characters(directory):
     """Child-process side: build every character with bpy and save its arrays into ``directory``."""
-    with tempfile.TemporaryDirectory(prefix="rigger-blender-user-") as user_resources:
-        os.environ.setdefault("BLENDER_USER_RESOURCES", user_resources)
-        import bpy  # noqa: F401  (first: Blender's own modules, bmesh among them, import only once bpy is)
-        from conftest import empty_scene
-        from rigger.blender.samples import character_arrays
+    temporary_user_folder()
+    import bpy  # noqa: F401  (first: Blender's own modules, bmesh among them, import only once bpy is)
+    from conftest import empty_scene
+    from rigger.blender.samples import character_arrays
 
-        empty_scene()
-        for name in samples.CHARACTERS:
-            vertices, triangles = character_arrays(name)
-            np.savez(os.path.join(directory, f"{name}.npz"), vertices=vertices, triangles=triangles)
+    empty_scene()
+    for name in samples.CHARACTERS:
+        vertices, triangles = character_arrays(name)
+        np.savez(os.path.join(directory, f"{name}.npz"), vertices=vertices, triangles=triangles)
 
 
 if __name__ == "__main__":

@@ -4,17 +4,16 @@ pure-core tests stay bpy-free)."""
 import os
 import pathlib
 import sys
-import tempfile
 
 import pytest
+
+from rigger.blender.headless import temporary_user_folder
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SHARED = pathlib.Path(os.environ.get("RIGGER_SHARED", ROOT.parent / "shared"))
 sys.path.insert(0, str(ROOT / "bench"))  # bench/ is not a package; tests use its scorers and readers (rigdata, ...)
 
-# bpy reads user resources at import; keep every test run away from the real home directory.
-if "BLENDER_USER_RESOURCES" not in os.environ:  # a child process that set its own keeps it (and leaves no folder)
-    os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp(prefix="rigger-blender-user-")
+temporary_user_folder()  # before any test imports bpy; the Blender child processes share the folder
 
 
 def shared_path(*parts):

@@ -9,12 +9,12 @@ it through the add-on's Blender layer, and writes:
 """
 import json
 import math
-import os
 import pathlib
 import sys
-import tempfile
 
 import numpy as np
+
+from rigger.blender.headless import temporary_user_folder
 
 OUT = pathlib.Path(__file__).resolve().parents[1] / "out"
 RENDER_SIZE = (960, 1080)
@@ -25,9 +25,8 @@ SKIN_COLOUR = (0.8, 0.8, 0.8, 0.2)  # Workbench draws material alpha as transpar
 
 
 def main(name="humanoid"):
-    with tempfile.TemporaryDirectory(prefix="rigger-blender-user-") as user_resources:
-        os.environ.setdefault("BLENDER_USER_RESOURCES", user_resources)
-        _demo(name)
+    temporary_user_folder()
+    _demo(name)
 
 
 def _demo(name):

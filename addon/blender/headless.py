@@ -1,0 +1,19 @@
+"""Blender as a Python module outside Blender: bpy reads and writes a user folder (preferences, add-ons, caches) at
+import, so the demo, the tests and the benchmarks give it a temporary one and neither change nor depend on the
+user's own Blender set-up. Needs no bpy: it runs before the first ``import bpy``."""
+import atexit
+import os
+import shutil
+import tempfile
+
+VARIABLE = "BLENDER_USER_RESOURCES"
+
+
+def temporary_user_folder():
+    """Point bpy at a new temporary user folder, removed when the process exits, unless one is set already (a parent
+    process chose it; its children share it). Returns the folder."""
+    if VARIABLE not in os.environ:
+        folder = tempfile.mkdtemp(prefix="rigger-blender-user-")
+        atexit.register(shutil.rmtree, folder, ignore_errors=True)
+        os.environ[VARIABLE] = folder
+    return os.environ[VARIABLE]
