@@ -149,7 +149,7 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
     Raises:
         ValueError: wrong shapes, NaN or infinite coordinates, out-of-range indices, an empty mesh, a bad
             direction or resolution or tolerance; :class:`NoSilhouette` (a ValueError) for a mesh whose
-            projection has zero area.
+            projection has zero area or covers no grid cell (tiny parts far apart).
     """
     verts = point_array(vertices, 3, "vertices")
     tris = index_array(triangles, 3, len(verts), name="triangles", item="triangle", target=("vertex", "vertices"),
@@ -167,7 +167,12 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
     handle = _rigger_silhouette.trace(verts, tris, view, int(res), float(tol))
     origin, u, v, unit = handle.frame()
     _, cell, _, _ = handle.grid()
-    return Silhouette(handle.loops(), origin, u, v, unit, cell, handle)
+    loops = handle.loops()
+    if not loops:
+        raise NoSilhouette(f"no part of the mesh covers a grid cell seen along {tuple(float(c) for c in view)} "
+                           f"({res} cells along the projection's longest side): its parts are too small for "
+                           f"the space between them; rig them separately or raise the resolution")
+    return Silhouette(loops, origin, u, v, unit, cell, handle)
 
 
 def _as_direction(direction):

@@ -6,6 +6,7 @@ the operators on the project's generated characters, whose Skin-modifier constru
 import contextlib
 import io
 import json
+import types
 
 import numpy as np
 import pytest
@@ -389,7 +390,7 @@ def test_the_report_is_plain_json_whatever_numbers_a_method_records(scene):
 def test_operators_are_undoable_and_scriptable_by_name(registered):
     from rigger.blender.operators import CLASSES
     assert sorted(cls.bl_idname for cls in CLASSES) == [
-        "rigger.clear_overlays", "rigger.rig", "rigger.rig_skin", "rigger.skin"]
+        "rigger.clear_overlays", "rigger.direction_from_view", "rigger.rig", "rigger.rig_skin", "rigger.skin"]
     assert all(cls.bl_options == {'REGISTER', 'UNDO'} for cls in CLASSES)
 
 
@@ -409,6 +410,7 @@ class RecordingLayout:
 
     def operator(self, idname, **kwargs):
         self.log.append(("operator", idname))
+        return types.SimpleNamespace()  # the button's operator properties, which the caller may set
 
     def label(self, text="", **kwargs):
         self.log.append(("label", text))
@@ -428,6 +430,36 @@ def test_the_panel_shows_method_parameters_actions_and_overlay_toggles(registere
     assert {f"show_{kind}" for kind, _, _ in OVERLAY_KINDS} <= set(props)
     assert [name for kind, name in log if kind == "operator"] == [
         "rigger.rig", "rigger.skin", "rigger.rig_skin", "rigger.clear_overlays"]
+
+
+def test_the_direction_view_offers_to_look_along_the_3d_view(registered, scene):
+    from rigger.blender.panel import RIGGER_PT_main
+    settings = scene.rigger
+    settings.method = "silhouette"
+    settings.methods.silhouette.view = "DIRECTION"
+    panel = type("Drawn", (), {"layout": RecordingLayout()})()
+    RIGGER_PT_main.draw(panel, bpy.context)
+    assert ("operator", "rigger.direction_from_view") in panel.layout.log
+    assert bpy.ops.rigger.direction_from_view.poll() is False  # no 3D view headless
+
+
+def test_from_view_sets_the_direction_the_view_looks_along(registered, scene):
+    """The operator run as the sidebar runs it, in a 3D view turned to look along +X (view_rotation maps the
+    camera's -Z there)."""
+    from mathutils import Quaternion
+
+    from rigger.blender.operators import RIGGER_OT_direction_from_view, looking_along
+    np.testing.assert_allclose(looking_along(Quaternion()), (0.0, 0.0, -1.0))
+    scene.rigger.method = "silhouette"
+    view = types.SimpleNamespace(view_rotation=Quaternion((0.0, 1.0, 0.0), -np.pi / 2))
+    context = types.SimpleNamespace(scene=scene, space_data=types.SimpleNamespace(type='VIEW_3D', region_3d=view))
+    reports = []
+    operator = types.SimpleNamespace(param="view_direction", report=lambda kind, text: reports.append(text))
+    assert RIGGER_OT_direction_from_view.execute(operator, context) == {'FINISHED'}
+    np.testing.assert_allclose(scene.rigger.methods.silhouette.view_direction, (1.0, 0.0, 0.0), atol=1e-6)
+    operator.param = "resolution"  # not a vector
+    assert RIGGER_OT_direction_from_view.execute(operator, context) == {'CANCELLED'}
+    assert reports == ["silhouette has no direction parameter 'resolution'"]
 
 
 def test_a_method_draw_hook_that_raises_is_shown_in_the_panel_not_raised():

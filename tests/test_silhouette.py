@@ -626,6 +626,14 @@ def test_zero_area_message():
     assert len(silhouette.trace(flat, [[0, 1, 2]], "Y").loops) == 1
 
 
+def test_parts_smaller_than_a_cell_give_no_silhouette_not_an_empty_one():
+    """Two unit cubes 1e5 apart: at 384 cells each covers no cell, so there is no outline to give."""
+    far_apart = combine(box((0, 0, 0), (1, 1, 1)), box((1e5, 0, 0), (1e5 + 1, 1, 1)))
+    with pytest.raises(silhouette.NoSilhouette, match="too small for the space between them"):
+        silhouette.trace(*far_apart, "Y", resolution=384)
+    assert len(silhouette.trace(*far_apart, "X", resolution=384).loops) == 1  # end-on they overlap
+
+
 def test_read_only_arrays_are_accepted():
     """Meshes arrive as read-only views (rigger.core.mesh.Mesh); the binding must not ask for writable buffers."""
     vertices, triangles = box((0, 0, 0), (1, 2, 3))

@@ -147,6 +147,47 @@ def test_same_skeleton_when_moved_rotated_or_scaled(default_rig, seed):
         assert chamfer_distance(back, reference.joints()) / size < 0.03
 
 
+def _turned(angle_degrees, axis):
+    """The rotation by ``angle_degrees`` about the unit ``axis`` (Rodrigues)."""
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]], float)
+    angle = np.radians(angle_degrees)
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
+
+
+@pytest.mark.parametrize("name", ["humanoid", "quadruped"])
+def test_a_tilted_model_seen_along_its_own_front_rigs_as_when_upright(default_rig, name):
+    """Tilted 25 degrees about the axis across its view, looked at along its own (tilted) front: the rig is the
+    upright one tilted, and its stages are in world space."""
+    vertices, triangles, upright = default_rig(name)
+    front = np.abs(upright.stages["view"])
+    across = np.roll(front, 1)  # another axis: tilting about it turns the front
+    rotation = _turned(25.0, across)
+    skeleton = rigger.rig_mesh(vertices @ rotation.T, triangles, view="DIRECTION", view_direction=rotation @ front)
+    assert len(skeleton) == len(upright)
+    back = np.hstack([skeleton.heads, skeleton.tails]) @ np.kron(np.eye(2), rotation)
+    gaps = np.linalg.norm(back[:, None] - np.hstack([upright.heads, upright.tails])[None], axis=2)
+    assert gaps.min(axis=0).max() < 1e-6 * np.ptp(vertices)  # the same bones (chains may be numbered otherwise:
+    assert gaps.min(axis=1).max() < 1e-6 * np.ptp(vertices)  # equal candidates tie, and rounding breaks the tie)
+    np.testing.assert_allclose(np.abs(skeleton.stages["view"]), np.abs(rotation @ front), atol=1e-12)
+    np.testing.assert_allclose(skeleton.stages["chains"][0] @ rotation, upright.stages["chains"][0],
+                               atol=1e-6 * np.ptp(vertices))  # the trunk
+    assert np.allclose(skeleton.stages["frame"] @ skeleton.stages["frame"].T, np.eye(3))
+
+
+def test_a_direction_along_an_axis_is_that_axis_view(default_rig):
+    vertices, triangles, _ = default_rig("snake")
+    along_y = rigger.rig_mesh(vertices, triangles, view="Y")
+    direction = rigger.rig_mesh(vertices, triangles, view="DIRECTION", view_direction="0,-3,0")
+    np.testing.assert_array_equal(direction.heads, along_y.heads)
+    np.testing.assert_array_equal(direction.stages["frame"], np.eye(3))
+
+
+def test_a_zero_view_direction_is_refused():
+    vertices, triangles = load_character("snake")
+    with pytest.raises(ValueError, match="view_direction must not be zero"):
+        rigger.rig_mesh(vertices, triangles, view="DIRECTION", view_direction=(0, 0, 0))
+
+
 def test_a_flat_cut_out_character_is_rigged_in_its_plane(default_rig):
     """A 2D cut-out (the humanoid squashed onto its front plane) rigs like the humanoid seen from the front."""
     vertices, triangles, reference = default_rig("humanoid")
@@ -328,6 +369,21 @@ def test_rig_time_is_recorded_per_stage(default_rig):
 def test_bad_meshes_get_a_clear_error(vertices, triangles, message):
     with pytest.raises(ValueError, match=message):
         rigger.rig_mesh(vertices, triangles)
+
+
+def test_parts_too_small_for_their_spacing_get_a_clear_error():
+    vertices, triangles = combine(box((0, 0, 0), (1, 1, 1)), box((1e5, 1e5, 1e5), (1e5 + 1, 1e5 + 1, 1e5 + 1)))
+    with pytest.raises(ValueError, match="too small for the space between them"):
+        rigger.rig_mesh(vertices, triangles)
+
+
+def test_auto_view_skips_an_axis_the_mesh_shows_nothing_along():
+    """Two triangles standing edge-on to X (the axis of widest spread) still rig, seen along another axis."""
+    vertices, triangles = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], [[0, 1, 2], [0, 1, 3]]
+    with pytest.raises(ValueError, match="zero area"):
+        rigger.rig_mesh(vertices, triangles, view="X")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert len(skeleton) >= 1 and skeleton.stages["view"][0] == 0
 
 
 def test_unknown_parameter_is_rejected():

@@ -1,4 +1,5 @@
-"""The operators ``rigger.rig``, ``rigger.skin``, ``rigger.rig_skin`` and ``rigger.clear_overlays``.
+"""The operators ``rigger.rig``, ``rigger.skin``, ``rigger.rig_skin``, ``rigger.clear_overlays`` and
+``rigger.direction_from_view``.
 
 They read their settings from ``scene.rigger``, act on the active object (a mesh, or the armature Rigger made for
 one), report problems through ``self.report`` rather than tracebacks, and show progress on the window manager.
@@ -6,6 +7,7 @@ one), report problems through ``self.report`` rather than tracebacks, and show p
 import traceback
 
 import bpy
+from mathutils import Vector
 
 from ..api import method_registry
 from . import overlays
@@ -162,4 +164,42 @@ class RIGGER_OT_clear_overlays(bpy.types.Operator):
         return {'FINISHED'}
 
 
-CLASSES = (RIGGER_OT_rig, RIGGER_OT_skin, RIGGER_OT_rig_skin, RIGGER_OT_clear_overlays)
+class RIGGER_OT_direction_from_view(bpy.types.Operator):
+    """Set a direction parameter of the chosen method to the direction the 3D view looks along"""
+
+    bl_idname = "rigger.direction_from_view"
+    bl_label = "From View"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    param: bpy.props.StringProperty(name="Parameter", description="The method's vector parameter to set")
+
+    @classmethod
+    def poll(cls, context):
+        if view_of(context) is None:
+            cls.poll_message_set("Only from a 3D view")
+            return False
+        return True
+
+    def execute(self, context):
+        settings = getattr(context.scene, SETTINGS_ATTRIBUTE)
+        props = getattr(settings.methods, settings.method, None)
+        method = method_registry().methods.get(settings.method)
+        if props is None or not any(p.name == self.param and p.type == "vector" for p in getattr(method, "params", ())):
+            self.report({'ERROR'}, f"{settings.method} has no direction parameter {self.param!r}")
+            return {'CANCELLED'}
+        setattr(props, self.param, looking_along(view_of(context).view_rotation))
+        return {'FINISHED'}
+
+
+def view_of(context):
+    """The RegionView3D of the 3D view ``context`` belongs to (its sidebar too), else None."""
+    space = context.space_data
+    return space.region_3d if space is not None and space.type == 'VIEW_3D' else None
+
+
+def looking_along(view_rotation):
+    """The unit direction a 3D view with this rotation (a quaternion) looks along: its camera's -Z."""
+    return tuple(view_rotation @ Vector((0.0, 0.0, -1.0)))
+
+
+CLASSES = (RIGGER_OT_rig, RIGGER_OT_skin, RIGGER_OT_rig_skin, RIGGER_OT_clear_overlays, RIGGER_OT_direction_from_view)

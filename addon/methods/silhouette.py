@@ -17,6 +17,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import cdt, silhouette
+from ..core.mesh import Mesh
 from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
@@ -64,8 +65,11 @@ class SilhouetteMethod(RigMethod):
     label = "Silhouette (Pan 2009)"
     description = "Chordal axis of the 3D silhouette, centred inside the mesh in depth"
     params = (
-        Param("view", "enum", "AUTO", items=("AUTO", "X", "Y", "Z"),
-              description="Projection axis; AUTO picks the axis that shows the mesh widest"),
+        Param("view", "enum", "AUTO", items=("AUTO", "X", "Y", "Z", "DIRECTION"),
+              description="Projection axis; AUTO picks the axis that shows the mesh widest, DIRECTION looks "
+                          "along the view direction (a model tilted off the axes, seen from its front)"),
+        Param("view_direction", "vector", (0.0, 1.0, 0.0),
+              description="The direction to look along when the view is DIRECTION (its length does not matter)"),
         Param("resolution", "int", 384, min=MIN_VIEW_RESOLUTION, max=8192,
               description="Silhouette grid cells along the longest side; higher keeps thinner gaps apart"),
         Param("outline_spacing", "float", 0.01, min=0.001, max=0.1,
@@ -91,15 +95,22 @@ class SilhouetteMethod(RigMethod):
                           "and for the limbs it hides"),
     )
 
-    def rig(self, mesh, *, view, resolution, outline_spacing, min_hole, merge, prune, bone_angle, bone_length,
-            max_chain_bones, split_layers, side_view):
+    def draw(self, layout, props):
+        """Looking along a direction: a button takes it from the 3D view."""
+        if props.view == "DIRECTION":
+            layout.operator("rigger.direction_from_view", icon='VIEW_CAMERA').param = "view_direction"
+
+    def rig(self, mesh, *, view, view_direction, resolution, outline_spacing, min_hole, merge, prune, bone_angle,
+            bone_length, max_chain_bones, split_layers, side_view):
         clock = StageClock()
-        vertices, triangles = mesh.vertices, mesh.triangles
-        axis = choose_axis(vertices, triangles) if view == "AUTO" else AXIS_NAMES.index(view)
-        direction, flat = AXES[axis], mesh.flat_normal
-        if view == "AUTO" and flat is not None and abs(flat @ direction) < 1 - 1e-9:
-            direction = flat  # a flat mesh tilted off the axis planes: look straight at it, not edge-on
-        sil, tri, graph = planar_axis(vertices, triangles, direction, resolution, outline_spacing, min_hole)
+        frame = None
+        if view == "DIRECTION":
+            frame, axis = view_frame(view_direction)
+            view = AXIS_NAMES[axis]
+            if frame is not None:  # rig in the frame where the view is that axis, then map the result back
+                mesh = Mesh(mesh.vertices @ frame.T, mesh.triangles)
+        vertices, triangles, flat = mesh.vertices, mesh.triangles, mesh.flat_normal
+        axis, (sil, tri, graph) = _primary_view(mesh, view, resolution, outline_spacing, min_hole)
         clock.lap("silhouette_cdt_axis")
 
         unit = bone_length * mesh.scale  # the bone length in mesh units
@@ -148,9 +159,43 @@ class SilhouetteMethod(RigMethod):
             "chains": builder.lines,
             "joints": np.unique(np.concatenate([heads, tails]), axis=0),
             "mirror_plane": plane,
+            "frame": np.eye(3) if frame is None else frame,
             "timings": clock.laps,
         }
+        if frame is not None:
+            heads, tails = heads @ frame, tails @ frame
+            _to_world(stages, frame)
         return Skeleton(names, heads, tails, parents, stages=stages)
+
+
+def view_frame(direction):
+    """(frame, axis) to rig along ``direction``: ``frame`` rows are orthonormal axes in world coordinates, number
+    ``axis`` being the direction (signed to point along that world axis, the nearest one to it) and the others as
+    near their world axes as that allows; None for the world frame when the direction is a world axis."""
+    vector = np.asarray(direction, dtype=np.float64)
+    axis = int(np.argmax(np.abs(vector)))
+    if vector[axis] == 0:
+        raise ValueError("view_direction must not be zero when the view is DIRECTION")
+    vector = vector / vector[axis]  # along the nearest axis's positive end, its largest component 1 (no overflow)
+    frame = np.eye(3)
+    frame[axis] = vector / np.linalg.norm(vector)
+    for other in (a for a in range(3) if a != axis):  # Gram-Schmidt from the view direction on: right-handed
+        row = np.eye(3)[other]
+        for done in [axis] + [a for a in range(other) if a != axis]:
+            row = row - (row @ frame[done]) * frame[done]
+        frame[other] = row / np.linalg.norm(row)
+    return (None if np.array_equal(frame, np.eye(3)) else frame), axis
+
+
+def _to_world(stages, frame):
+    """Map the 3D stage data of a rig in ``frame`` (rows: its axes in world coordinates) back to the world;
+    ``mirror_plane`` stays in the frame, whose axis it names."""
+    silhouette_stage = stages["silhouette"]
+    for key in ("origin", "u", "v", "direction"):
+        silhouette_stage[key] = silhouette_stage[key] @ frame
+    stages["view"] = silhouette_stage["direction"]
+    stages["chains"] = [line @ frame for line in stages["chains"]]
+    stages["joints"] = np.unique(stages["joints"] @ frame, axis=0)
 
 
 def _pruned_tree(graph, merge, prune, min_reach):
@@ -205,11 +250,32 @@ def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, bone_length, s
     return limbs
 
 
-def choose_axis(vertices, triangles):
-    """The axis whose projection spreads the surface widest: the largest sum of the variances of the other two
-    coordinates, over triangle centroids weighted by area (so dense regions do not dominate)."""
+def _primary_view(mesh, view, resolution, spacing, min_hole):
+    """(axis, ``planar_axis`` of the primary view): along the chosen axis, or for AUTO along the first of the
+    ``axes_by_spread`` that shows the mesh at all (triangles all standing edge-on to one axis show nothing along
+    it); a flat mesh tilted off the axis planes is seen straight on, not edge-on."""
+    if view != "AUTO":
+        axis = AXIS_NAMES.index(view)
+        return axis, planar_axis(mesh.vertices, mesh.triangles, AXES[axis], resolution, spacing, min_hole)
+    order = axes_by_spread(mesh.vertices, mesh.triangles)
+    flat = mesh.flat_normal
+    if flat is not None:
+        direction = flat if abs(flat @ AXES[order[0]]) < 1 - 1e-9 else AXES[order[0]]
+        return order[0], planar_axis(mesh.vertices, mesh.triangles, direction, resolution, spacing, min_hole)
+    first_error = None
+    for axis in order:
+        try:
+            return axis, planar_axis(mesh.vertices, mesh.triangles, AXES[axis], resolution, spacing, min_hole)
+        except silhouette.NoSilhouette as error:
+            first_error = first_error or error
+    raise first_error
+
+
+def axes_by_spread(vertices, triangles):
+    """The axes by how wide their projection spreads the surface, widest first: the sum of the variances of the
+    other two coordinates, over triangle centroids weighted by area (so dense regions do not dominate)."""
     variances = _variances(vertices, triangles)
-    return int(np.argmax([variances.sum() - variances[a] for a in range(3)]))
+    return [int(a) for a in np.argsort([-(variances.sum() - variances[a]) for a in range(3)], kind="stable")]
 
 
 def _variances(vertices, triangles=None):
