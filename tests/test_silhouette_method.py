@@ -315,16 +315,35 @@ def test_a_hidden_limb_near_its_bone_or_reaching_none_is_not_extended():
 
 
 def test_mirror_image_hidden_limbs_get_mirror_image_bones():
-    """Two feet mirrored across x = 0, both far below the body's bone: each hangs from the body (not the right foot
-    from the left one's extension, which passes nearer it) through mirror-image bones."""
+    """Two feet mirrored across x = 0, both far below the body's bone and two bone lengths apart: each hangs from
+    the body (not the right foot from the left one's extension, which passes nearer it) through mirror-image
+    bones."""
     left = np.array([[0.3, 0.3, 0.5], [0.3, 0.1, 0.9]])
-    builder, first = _body_with_feet([left, left * [-1, 1, 1]], plane=(0, 0.0))
+    builder, first = _body_with_feet([left, left * [-1, 1, 1]], plane=(0, 0.0), bone_length=0.3)
     heads, tails, parents = builder.arrays()
     half = (len(heads) - first) // 2
     assert len(heads) == first + 2 * half and half >= 2
     assert parents[first] == parents[first + half] == first - 1
     np.testing.assert_allclose(heads[first + half:], heads[first:first + half] * [-1, 1, 1], atol=1e-12)
     np.testing.assert_allclose(tails[first + half:], tails[first:first + half] * [-1, 1, 1], atol=1e-12)
+
+
+def test_hidden_limbs_starting_together_share_their_extension():
+    """Two ears starting at one point far below the body's bone (as the end-on view places a pair): one chain runs
+    to them, both hang from its end, and no two bones lie on each other."""
+    from rigger.skeletonize.bones import bone_names
+
+    ear = np.array([[0.0, 0.3, 0.5], [0.3, 0.1, 0.9]])
+    builder, first = _body_with_feet([ear, ear * [-1, 1, 1]], plane=(0, 0.0))
+    heads, tails, parents = builder.arrays()
+    names = bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, (0, 0.0), 0.05)
+    segments = np.hstack([heads, tails])
+    gaps = np.linalg.norm(segments[:, None] - segments[None], axis=2) + np.diag(np.full(len(heads), np.inf))
+    assert gaps.min() > 0.1
+    sided = [name.endswith((".L", ".R")) for name in names]
+    carried = [b for b in range(first, len(heads)) if sided[b] and not sided[parents[b]]]  # each ear's first bone
+    assert len(carried) == 2 and parents[carried[0]] == parents[carried[1]] >= first  # both from the shared chain
+    np.testing.assert_allclose(tails[parents[carried[0]]], ear[0])
 
 
 def test_an_open_tube_rigs_though_it_shows_nothing_end_on():

@@ -383,18 +383,51 @@ class _BoneBuilder:
         """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone already there that their
         start reaches within the mesh as all the silhouettes ``views`` see it (the primary one and the one the limbs
         come from); a chain starting far from that bone (a foot below a leg too stubby to show) is extended back
-        along the path to it, so the leg between them gets bones of its own, and mirror pairs stay mirror pairs."""
+        along the path to it, so the leg between them gets bones of its own, and mirror pairs stay mirror pairs.
+        Limbs starting close together that far from one place on one bone (a pair of ears, two legs from one hip)
+        share that extension: one chain to the middle of their starts, from which each hangs (through a bone to
+        its own start), instead of two bones lying on each other."""
         if not limbs:
             return
-        chains, ups = [], []
+        chains, ups, bridges = [], [], []  # bridges: [up, meets, [limb numbers]]; limbs hang from bridge chains
         for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
             up, meets = self._attachment(line[0], views)  # from the left one's extension, which passes nearer it)
             if meets is not None and np.linalg.norm(line[0] - meets) > BRIDGE * self.bone_length:
-                line, widths = np.vstack([meets, line]), np.r_[0.0, widths]  # 0: no branch-point disc to leave
+                twin = next((bridge for bridge in bridges if bridge[0] == up and self._together(
+                    [bridge[1], meets], [limbs[k][0][0] for k in bridge[2]] + [line[0]])), None)
+                if twin is None:
+                    bridges.append([up, meets, [len(chains)]])
+                else:
+                    twin[2].append(len(chains))
             chains.append((line, widths, True))
             ups.append(up)
-        for (line, _, _), along, up in zip(chains, self._joints(chains), ups):
-            self._add_chain(line, along, up)
+        ends = {}  # limb number -> where its bridge chain ends
+        for up, meets, members in bridges:
+            end = np.mean([chains[k][0][0] for k in members], axis=0) if len(members) > 1 else None
+            for k in members:
+                line, widths, _ = chains[k]
+                start = meets if end is None else end
+                if np.linalg.norm(line[0] - start) > 1e-9 * self.bone_length:
+                    chains[k] = (np.vstack([start, line]), np.r_[0.0, widths], True)  # 0: no disc to leave
+                if end is not None:
+                    ends[k] = len(chains)
+            if end is not None:
+                chains.append((np.vstack([meets, end]), np.zeros(2), False))
+                ups.append(up)
+        joints = self._joints(chains)
+        last_bone = {}
+        for c in sorted(range(len(chains)), key=lambda c: c in ends):  # bridge chains before the limbs they carry
+            line, along = chains[c][0], joints[c]
+            up = last_bone[ends[c]] if c in ends else ups[c]
+            added = self._add_chain(line, along, up)
+            last_bone[c] = added[-1] if added else up
+
+    def _together(self, meets, starts):
+        """Do limbs starting at ``starts``, extended to bone points ``meets``, share one extension? Their meeting
+        points and their starts each lie within half a bone length of their middle."""
+        reach = 0.5 * self.bone_length
+        return all(np.linalg.norm(points - np.mean(points, axis=0), axis=1).max() <= reach
+                   for points in (np.asarray(meets), np.asarray(starts)))
 
     def _joints(self, chains):
         """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror pairs made symmetric."""
