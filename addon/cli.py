@@ -122,8 +122,12 @@ def _run_rig(args):
     try:
         report = scenefiles.rig_file(source, output, method.name, params, skin=not args.no_skin)
         if args.report is not None:
-            with replaced_on_success(args.report) as path:
-                path.write_text(json.dumps(report, indent=2))
+            try:
+                with replaced_on_success(args.report) as path:
+                    path.write_text(json.dumps(report, indent=2))
+            except OSError:  # all or nothing: no rigged file without the report asked for
+                output.unlink(missing_ok=True)
+                raise
     except ValueError as error:
         raise CliError(str(error)) from None
     except RuntimeError as error:  # a Blender operator failed (an exporter, say)
@@ -137,18 +141,32 @@ def _run_rig(args):
 
 
 def _check_destinations(source, output, report):
-    """Refuse outputs that would overwrite the input or each other, or that are folders, before any slow work."""
+    """Refuse outputs that would overwrite the input or each other, that are folders, or whose folder cannot be
+    made or written in, before any slow work."""
     named = {"the input": source, "the output": output, "the report": report}
     seen = {}
     for role, path in named.items():
         if path is None:
             continue
-        if role != "the input" and path.is_dir():
-            raise CliError(f"{path}: is a folder; {role} needs a file name")
+        if role != "the input":
+            if path.is_dir():
+                raise CliError(f"{path}: is a folder; {role} needs a file name")
+            _check_folder(path.parent, role)
         key = os.path.normcase(path.resolve())
         if key in seen:
             raise CliError(f"{path}: {role} would overwrite {seen[key]}; choose another file name")
         seen[key] = role
+
+
+def _check_folder(folder, role):
+    """CliError unless ``folder`` is, or can be made as, a folder to write ``role`` in."""
+    existing = folder.absolute()
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise CliError(f"{existing}: is not a folder, so {role} cannot go in {folder}")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise CliError(f"{existing}: cannot write there, so {role} cannot go in {folder}")
 
 
 def _run_batch(args):

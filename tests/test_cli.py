@@ -124,7 +124,11 @@ def test_outputs_never_overwrite_the_input_or_each_other(rigged_glb, tmp_path):
     source = tmp_path / "model.glb"
     source.write_bytes((rigged_glb[1] / "humanoid.glb").read_bytes())
     (tmp_path / "taken.glb").mkdir()
+    (tmp_path / "a_file").write_text("")
     for extra, message in [(("-o", source), "the output would overwrite the input"),
+                           (("-o", tmp_path / "a_file" / "out.blend"), "a_file: is not a folder, so the output"),
+                           (("-o", tmp_path / "out.blend", "--report", tmp_path / "a_file" / "deeper" / "r.json"),
+                            "a_file: is not a folder, so the report"),
                            (("-o", tmp_path / "out.blend", "--report", source), "the report would overwrite the input"),
                            (("-o", tmp_path / "out.blend", "--report", tmp_path / "out.blend"),
                             "the report would overwrite the output"),
@@ -132,7 +136,7 @@ def test_outputs_never_overwrite_the_input_or_each_other(rigged_glb, tmp_path):
         result = run("rig", source, *extra)
         assert result.returncode == 1 and message in result.stderr, result.stderr
     assert source.read_bytes() == (rigged_glb[1] / "humanoid.glb").read_bytes()
-    assert sorted(leaves_nothing(tmp_path)) == ["model.glb", "taken.glb"]
+    assert sorted(leaves_nothing(tmp_path)) == ["a_file", "model.glb", "taken.glb"]
 
 
 def test_no_skin_and_fbx_output(humanoid_obj, tmp_path):
