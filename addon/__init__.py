@@ -2,8 +2,8 @@
 
 Importable outside Blender as ``rigger``: the geometry core (``rigger.cdt``, ``rigger.silhouette``, methods) needs
 only numpy and the bundled compiled modules. Inside Blender, ``register()`` loads the Blender layer
-(``rigger.blender``): the generated method properties, the operators ``rigger.rig|skin|rig_skin|clear_overlays``
-and the panel in View3D > Sidebar > Rigger.
+(``rigger.blender``): the generated method properties, the operators
+``rigger.rig|skin|rig_skin|clear_overlays|direction_from_view`` and the panel in View3D > Sidebar > Rigger.
 """
 
 bl_info = {

@@ -122,12 +122,8 @@ def _run_rig(args):
     try:
         report = scenefiles.rig_file(source, output, method.name, params, skin=not args.no_skin)
         if args.report is not None:
-            try:
-                with replaced_on_success(args.report) as path:
-                    path.write_text(json.dumps(report, indent=2))
-            except OSError:  # all or nothing: no rigged file without the report asked for
-                output.unlink(missing_ok=True)
-                raise
+            with replaced_on_success(args.report) as path:
+                path.write_text(json.dumps(report, indent=2))
     except ValueError as error:
         raise CliError(str(error)) from None
     except RuntimeError as error:  # a Blender operator failed (an exporter, say)
@@ -161,9 +157,13 @@ def _check_destinations(source, output, report):
 def _check_folder(folder, role):
     """CliError unless ``folder`` is, or can be made as, a folder to write ``role`` in."""
     existing = folder.absolute()
-    while not existing.exists() and existing != existing.parent:
-        existing = existing.parent
-    if not existing.is_dir():
+    try:
+        while not existing.exists() and existing != existing.parent:
+            existing = existing.parent
+        is_folder = existing.is_dir()
+    except OSError as error:  # a folder on the way that may not be searched
+        raise CliError(f"{folder}: {error.strerror or error}, so {role} cannot go there") from None
+    if not is_folder:
         raise CliError(f"{existing}: is not a folder, so {role} cannot go in {folder}")
     if not os.access(existing, os.W_OK | os.X_OK):
         raise CliError(f"{existing}: cannot write there, so {role} cannot go in {folder}")

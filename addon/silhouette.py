@@ -52,6 +52,12 @@ from . import _rigger_silhouette
 from .core.arrays import index_array, numeric_array, point_array
 
 NoSilhouette = _rigger_silhouette.NoSilhouette  # a ValueError: the mesh shows no area along the direction
+
+
+class PartsTooSmall(NoSilhouette):
+    """The mesh shows area along the direction, but no part of it covers a grid cell: its parts are tiny for the
+    space between them (another direction would not help)."""
+
 DEFAULT_RESOLUTION = 1024
 DEFAULT_TOLERANCE = 0.05
 AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
@@ -149,7 +155,8 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
     Raises:
         ValueError: wrong shapes, NaN or infinite coordinates, out-of-range indices, an empty mesh, a bad
             direction or resolution or tolerance; :class:`NoSilhouette` (a ValueError) for a mesh whose
-            projection has zero area or covers no grid cell (tiny parts far apart).
+            projection has zero area, or :class:`PartsTooSmall` (one too) for one that covers no grid cell (tiny
+            parts far apart).
     """
     verts = point_array(vertices, 3, "vertices")
     tris = index_array(triangles, 3, len(verts), name="triangles", item="triangle", target=("vertex", "vertices"),
@@ -169,7 +176,7 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
     _, cell, _, _ = handle.grid()
     loops = handle.loops()
     if not loops:
-        raise NoSilhouette(f"no part of the mesh covers a grid cell seen along {tuple(float(c) for c in view)} "
+        raise PartsTooSmall(f"no part of the mesh covers a grid cell seen along {tuple(float(c) for c in view)} "
                            f"({res} cells along the projection's longest side): its parts are too small for "
                            f"the space between them; rig them separately or raise the resolution")
     return Silhouette(loops, origin, u, v, unit, cell, handle)

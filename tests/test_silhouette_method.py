@@ -9,6 +9,7 @@ from cdt_checks import polygon_area
 from characters import inside_fraction, load_character
 from meshes import box, combine, ellipsoids, uv_sphere
 from rigger import samples
+from rigger.skeletonize.bones import bone_names
 
 from rigdata import chamfer_distance
 
@@ -182,6 +183,14 @@ def test_a_direction_along_an_axis_is_that_axis_view(default_rig):
     np.testing.assert_array_equal(direction.stages["frame"], np.eye(3))
 
 
+def test_a_view_direction_off_an_axis_by_single_precision_noise_is_that_axis(default_rig):
+    """What a 3D view looking from the front gives (Blender works in single precision)."""
+    vertices, triangles, _ = default_rig("snake")
+    skeleton = rigger.rig_mesh(vertices, triangles, view="DIRECTION", view_direction=(0.0, 0.99999994, -5.96e-8))
+    np.testing.assert_array_equal(skeleton.stages["frame"], np.eye(3))
+    np.testing.assert_array_equal(skeleton.heads, rigger.rig_mesh(vertices, triangles, view="Y").heads)
+
+
 def test_a_zero_view_direction_is_refused():
     vertices, triangles = load_character("snake")
     with pytest.raises(ValueError, match="view_direction must not be zero"):
@@ -315,24 +324,26 @@ def test_a_hidden_limb_near_its_bone_or_reaching_none_is_not_extended():
 
 
 def test_mirror_image_hidden_limbs_get_mirror_image_bones():
-    """Two feet mirrored across x = 0, both far below the body's bone and two bone lengths apart: each hangs from
-    the body (not the right foot from the left one's extension, which passes nearer it) through mirror-image
-    bones."""
+    """Two feet mirrored across x = 0, both far below the body's bone and 0.6 bone lengths apart (too far to share
+    an extension), each hangs from the body (not the right foot from the left one's extension, which passes nearer
+    it) through mirror-image bones; so do they with a tail between them, whichever order they come in."""
     left = np.array([[0.3, 0.3, 0.5], [0.3, 0.1, 0.9]])
-    builder, first = _body_with_feet([left, left * [-1, 1, 1]], plane=(0, 0.0), bone_length=0.3)
-    heads, tails, parents = builder.arrays()
-    half = (len(heads) - first) // 2
-    assert len(heads) == first + 2 * half and half >= 2
-    assert parents[first] == parents[first + half] == first - 1
-    np.testing.assert_allclose(heads[first + half:], heads[first:first + half] * [-1, 1, 1], atol=1e-12)
-    np.testing.assert_allclose(tails[first + half:], tails[first:first + half] * [-1, 1, 1], atol=1e-12)
+    tail = np.array([[0.0, 0.3, 0.5], [0.0, 0.1, 0.9]])
+    for feet in ([left, left * [-1, 1, 1]], [left, tail, left * [-1, 1, 1]], [tail, left, left * [-1, 1, 1]]):
+        builder, first = _body_with_feet(feet, plane=(0, 0.0))
+        names = bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, (0, 0.0), 0.05)
+        heads, tails, parents = builder.arrays()
+        sides = {name[-2:]: [b for b in range(first, len(heads)) if names[b].endswith(name[-2:])]
+                 for name in (".L", ".R")}
+        assert len(sides[".L"]) == len(sides[".R"]) >= 2
+        assert parents[sides[".L"][0]] == parents[sides[".R"][0]] == first - 1
+        for points in (heads, tails):
+            np.testing.assert_allclose(points[sides[".R"]], points[sides[".L"]] * [-1, 1, 1], atol=1e-12)
 
 
 def test_hidden_limbs_starting_together_share_their_extension():
     """Two ears starting at one point far below the body's bone (as the end-on view places a pair): one chain runs
     to them, both hang from its end, and no two bones lie on each other."""
-    from rigger.skeletonize.bones import bone_names
-
     ear = np.array([[0.0, 0.3, 0.5], [0.3, 0.1, 0.9]])
     builder, first = _body_with_feet([ear, ear * [-1, 1, 1]], plane=(0, 0.0))
     heads, tails, parents = builder.arrays()
@@ -391,7 +402,8 @@ def test_bad_meshes_get_a_clear_error(vertices, triangles, message):
 
 
 def test_parts_too_small_for_their_spacing_get_a_clear_error():
-    vertices, triangles = combine(box((0, 0, 0), (1, 1, 1)), box((1e5, 1e5, 1e5), (1e5 + 1, 1e5 + 1, 1e5 + 1)))
+    """Not a rig of the two seen end-on, where they overlap: another view would not make them any bigger."""
+    vertices, triangles = combine(box((0, 0, 0), (1, 1, 1)), box((1e5, 0, 0), (1e5 + 1, 1, 1)))
     with pytest.raises(ValueError, match="too small for the space between them"):
         rigger.rig_mesh(vertices, triangles)
 

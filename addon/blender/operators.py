@@ -171,7 +171,8 @@ class RIGGER_OT_direction_from_view(bpy.types.Operator):
     bl_label = "From View"
     bl_options = {'REGISTER', 'UNDO'}
 
-    param: bpy.props.StringProperty(name="Parameter", description="The method's vector parameter to set")
+    param: bpy.props.StringProperty(name="Parameter", description="The method's vector parameter to set",
+                                    options={'HIDDEN', 'SKIP_SAVE'})
 
     @classmethod
     def poll(cls, context):
@@ -192,9 +193,12 @@ class RIGGER_OT_direction_from_view(bpy.types.Operator):
 
 
 def view_of(context):
-    """The RegionView3D of the 3D view ``context`` belongs to (its sidebar too), else None."""
+    """The RegionView3D of the 3D view ``context`` belongs to (the quadrant under the mouse in quad view; from its
+    sidebar, the main one), else None."""
     space = context.space_data
-    return space.region_3d if space is not None and space.type == 'VIEW_3D' else None
+    if space is None or space.type != 'VIEW_3D':
+        return None
+    return getattr(context, "region_data", None) or space.region_3d
 
 
 def looking_along(view_rotation):

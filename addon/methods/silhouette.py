@@ -1,6 +1,6 @@
 """The silhouette rigging method (Pan et al. 2009, "Automatic rigging for animation characters with 3D silhouette").
 
-Pipeline: project the mesh along the axis that shows it widest, trace its silhouette, triangulate it (CDT), take the
+Pipeline: project the mesh along the axis that shows it widest (or a chosen axis or direction), trace its silhouette, triangulate it (CDT), take the
 chordal axis of the triangles, merge round blobs and prune outline-noise spurs, root the tree at its most central
 branch point and cut the loops holes make, put every axis point inside the mesh in depth (splitting chains that run
 through several stacked parts, and asking the perpendicular view where the primary one is occluded), then cut the
@@ -17,6 +17,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import cdt, silhouette
+from ..core.graphs import components
 from ..core.mesh import Mesh
 from ..core.params import Param
 from ..core.registry import RigMethod
@@ -44,6 +45,7 @@ MIN_VIEW_RESOLUTION = 64  # the coarsest grid any view gets
 MAX_PATH_SAMPLES = 256  # points tested along a path from a hidden limb to a bone it may hang from (one per cell)
 PATH_SLACK = 0.15  # ... and that path may leave the mesh for this many bone lengths in all (grazing its surface)
 BRIDGE = 1.0  # a hidden limb starting farther than this many bone lengths from that bone is extended back to it
+AXIS_SNAP = 1e-6  # view_direction components this small beside its largest are zero
 
 
 class Blob(NamedTuple):
@@ -110,7 +112,12 @@ class SilhouetteMethod(RigMethod):
             if frame is not None:  # rig in the frame where the view is that axis, then map the result back
                 mesh = Mesh(mesh.vertices @ frame.T, mesh.triangles)
         vertices, triangles, flat = mesh.vertices, mesh.triangles, mesh.flat_normal
-        axis, (sil, tri, graph) = _primary_view(mesh, view, resolution, outline_spacing, min_hole)
+        try:
+            axis, (sil, tri, graph) = _primary_view(mesh, view, resolution, outline_spacing, min_hole)
+        except silhouette.NoSilhouette as error:
+            if frame is None:
+                raise
+            raise type(error)(f"along view_direction {tuple(view_direction)}: {error}") from None
         clock.lap("silhouette_cdt_axis")
 
         unit = bone_length * mesh.scale  # the bone length in mesh units
@@ -177,6 +184,7 @@ def view_frame(direction):
     if vector[axis] == 0:
         raise ValueError("view_direction must not be zero when the view is DIRECTION")
     vector = vector / vector[axis]  # along the nearest axis's positive end, its largest component 1 (no overflow)
+    vector[np.abs(vector) < AXIS_SNAP] = 0.0  # single-precision noise (a 3D view's front): the axis itself
     frame = np.eye(3)
     frame[axis] = vector / np.linalg.norm(vector)
     for other in (a for a in range(3) if a != axis):  # Gram-Schmidt from the view direction on: right-handed
@@ -266,6 +274,8 @@ def _primary_view(mesh, view, resolution, spacing, min_hole):
     for axis in order:
         try:
             return axis, planar_axis(mesh.vertices, mesh.triangles, AXES[axis], resolution, spacing, min_hole)
+        except silhouette.PartsTooSmall:
+            raise  # along every axis alike
         except silhouette.NoSilhouette as error:
             first_error = first_error or error
     raise first_error
@@ -384,36 +394,33 @@ class _BoneBuilder:
         start reaches within the mesh as all the silhouettes ``views`` see it (the primary one and the one the limbs
         come from); a chain starting far from that bone (a foot below a leg too stubby to show) is extended back
         along the path to it, so the leg between them gets bones of its own, and mirror pairs stay mirror pairs.
-        Limbs starting close together that far from one place on one bone (a pair of ears, two legs from one hip)
-        share that extension: one chain to the middle of their starts, from which each hangs (through a bone to
-        its own start), instead of two bones lying on each other."""
+        Limbs that far from one bone whose starts, and the points where they meet the bone, all lie within half a
+        bone length of each other (a pair of ears, horns on a neck) share that extension: one chain from the middle
+        of those points to the middle of their starts, from which each hangs (through a bone to its own start when
+        apart), instead of bones lying on each other. Which limbs share does not depend on their order, so mirror
+        pairs stay mirror pairs."""
         if not limbs:
             return
-        chains, ups, bridges = [], [], []  # bridges: [up, meets, [limb numbers]]; limbs hang from bridge chains
+        chains, ups, far = [], [], []  # far: (limb number, meets) of the limbs to extend
         for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
             up, meets = self._attachment(line[0], views)  # from the left one's extension, which passes nearer it)
             if meets is not None and np.linalg.norm(line[0] - meets) > BRIDGE * self.bone_length:
-                twin = next((bridge for bridge in bridges if bridge[0] == up and self._together(
-                    [bridge[1], meets], [limbs[k][0][0] for k in bridge[2]] + [line[0]])), None)
-                if twin is None:
-                    bridges.append([up, meets, [len(chains)]])
-                else:
-                    twin[2].append(len(chains))
+                far.append((len(chains), meets))
             chains.append((line, widths, True))
             ups.append(up)
-        ends = {}  # limb number -> where its bridge chain ends
-        for up, meets, members in bridges:
-            end = np.mean([chains[k][0][0] for k in members], axis=0) if len(members) > 1 else None
+        ends, meets_of = {}, dict(far)  # ends: limb number -> the bridge chain it hangs from
+        for members in self._sharing(list(meets_of), ups, [line[0] for line, _, _ in chains], meets_of):
+            meets = np.mean([meets_of[k] for k in members], axis=0)
+            start = meets if len(members) == 1 else np.mean([chains[k][0][0] for k in members], axis=0)
             for k in members:
                 line, widths, _ = chains[k]
-                start = meets if end is None else end
                 if np.linalg.norm(line[0] - start) > 1e-9 * self.bone_length:
                     chains[k] = (np.vstack([start, line]), np.r_[0.0, widths], True)  # 0: no disc to leave
-                if end is not None:
+                if len(members) > 1:
                     ends[k] = len(chains)
-            if end is not None:
-                chains.append((np.vstack([meets, end]), np.zeros(2), False))
-                ups.append(up)
+            if len(members) > 1:
+                chains.append((np.vstack([meets, start]), np.zeros(2), False))
+                ups.append(ups[members[0]])
         joints = self._joints(chains)
         last_bone = {}
         for c in sorted(range(len(chains)), key=lambda c: c in ends):  # bridge chains before the limbs they carry
@@ -422,12 +429,24 @@ class _BoneBuilder:
             added = self._add_chain(line, along, up)
             last_bone[c] = added[-1] if added else up
 
-    def _together(self, meets, starts):
-        """Do limbs starting at ``starts``, extended to bone points ``meets``, share one extension? Their meeting
-        points and their starts each lie within half a bone length of their middle."""
+    def _sharing(self, limbs, ups, starts, meets):
+        """The ``limbs`` to extend in groups that share one extension: linked when they hang from the same bone and
+        their starts and meeting points each lie within half a bone length; a linked group is kept only when every
+        two of its limbs are linked (else each goes alone), so the groups do not depend on the limbs' order."""
         reach = 0.5 * self.bone_length
-        return all(np.linalg.norm(points - np.mean(points, axis=0), axis=1).max() <= reach
-                   for points in (np.asarray(meets), np.asarray(starts)))
+
+        def linked(a, b):
+            return (ups[a] == ups[b] and np.linalg.norm(starts[a] - starts[b]) <= reach
+                    and np.linalg.norm(meets[a] - meets[b]) <= reach)
+
+        pairs = [(i, j) for i in range(len(limbs)) for j in range(i) if linked(limbs[i], limbs[j])]
+        labels = components(len(limbs), np.array(pairs, dtype=np.int64).reshape(-1, 2))
+        groups = []
+        for label in np.unique(labels):
+            members = [limbs[i] for i in np.flatnonzero(labels == label)]
+            whole = all(linked(a, b) for a in members for b in members)
+            groups += [members] if whole else [[k] for k in members]
+        return groups
 
     def _joints(self, chains):
         """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror pairs made symmetric."""
