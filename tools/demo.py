@@ -25,11 +25,7 @@ SKIN_COLOUR = (0.8, 0.8, 0.8, 0.2)  # Workbench draws material alpha as transpar
 
 
 def main(name="humanoid"):
-    temporary_user_folder()
-    _demo(name)
-
-
-def _demo(name):
+    temporary_user_folder()  # before bpy reads one
     import bpy
 
     import rigger

@@ -1,15 +1,15 @@
 """The silhouette rigging method (Pan et al. 2009, "Automatic rigging for animation characters with 3D silhouette").
 
-Pipeline: project the mesh along the axis that shows it widest (or a chosen axis or direction), trace its silhouette, triangulate it (CDT), take the
-chordal axis of the triangles, merge round blobs and prune outline-noise spurs, root the tree at its most central
-branch point and cut the loops holes make, put every axis point inside the mesh in depth (splitting chains that run
-through several stacked parts, and asking the perpendicular view where the primary one is occluded), then cut the
-chains into bones at sharp turns and at a maximum length. Islands of the silhouette each get their own bones, parented
-to the nearest bone of the largest island. Last, limbs the primary view hides behind the body (a bird's legs under
-its spread wings, a fox's ears seen from the side) are taken from the trees of the two perpendicular views (the side
-view, then the end-on one: along the longest extent when the view is AUTO) and hung from the nearest bone they reach
-without leaving the mesh's depth span in the primary view and their own, through a bone across the gap when that bone
-is far.
+Pipeline: project the mesh along the axis that shows it widest (or a chosen axis or direction), trace its silhouette,
+triangulate it (CDT), take the chordal axis of the triangles, merge round blobs and prune outline-noise spurs, root
+the tree at its most central branch point and cut the loops holes make, put every axis point inside the mesh in depth
+(splitting chains that run through several stacked parts, and asking the perpendicular view where the primary one is
+occluded), then cut the chains into bones at sharp turns and at a maximum length. Islands of the silhouette each get
+their own bones, parented to the nearest bone of the largest island. Last, limbs the primary view hides behind the
+body (a bird's legs under its spread wings, a fox's ears seen from the side) are taken from the trees of the two
+perpendicular views (the side view, then the end-on one: along the longest extent when the view is AUTO) and hung
+from the nearest bone they reach without leaving the mesh's depth span in the primary view and their own, through a
+bone across the gap when that bone is far.
 """
 
 from typing import NamedTuple
@@ -37,8 +37,8 @@ MIN_BRANCH = 0.5  # branches sticking out less than this many bone lengths are d
 AXIS_NAMES = ("X", "Y", "Z")
 MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
 HIDDEN_REACH = 0.6  # perpendicular-view limb tips this many bone lengths off the skeleton (seen that way) are missing
-HIDDEN_PRUNE = 2 / 3  # the perpendicular views prune at this fraction of ``prune``: a limb they add must also be off the
-# primary skeleton and hidden in the primary view, so they can trust stubbier branches (a fox's ears)
+HIDDEN_PRUNE = 2 / 3  # the perpendicular views prune at this fraction of ``prune``: a limb they add must also be off
+# the primary skeleton and hidden in the primary view, so they can trust stubbier branches (a fox's ears)
 END_RESOLUTION = 1 / 3  # the end-on view (the remaining axis of larger spread: along the longest extent when the view
 # is AUTO) only looks for limbs, at this fraction of the resolution: limbs are coarse features, and its trace costs less
 MIN_VIEW_RESOLUTION = 64  # the coarsest grid any view gets
@@ -129,8 +129,8 @@ class SilhouetteMethod(RigMethod):
             spread = _variances(vertices)
             side_axis, end_axis = sorted((a for a in range(3) if a != axis), key=lambda a: spread[a])
             side_of = _other_view(vertices, triangles, sil, side_axis, resolution, outline_spacing, min_hole)
-            end_on = _other_view(vertices, triangles, sil, end_axis,
-                                 max(MIN_VIEW_RESOLUTION, round(END_RESOLUTION * resolution)), outline_spacing, min_hole)
+            end_resolution = max(MIN_VIEW_RESOLUTION, round(END_RESOLUTION * resolution))
+            end_on = _other_view(vertices, triangles, sil, end_axis, end_resolution, outline_spacing, min_hole)
             if side_of is not None:
                 side_sil, side_graph = side_of
                 side = SideAxis(side_sil, side_graph.points, side_graph.radius, sil)
@@ -409,16 +409,16 @@ class _BoneBuilder:
             chains.append((line, widths, True))
             ups.append(up)
         ends, meets_of = {}, dict(far)  # ends: limb number -> the bridge chain it hangs from
-        for members in self._sharing(list(meets_of), ups, [line[0] for line, _, _ in chains], meets_of):
+        for members in self._sharing(meets_of, ups, [line[0] for line, _, _ in chains]):
             meets = np.mean([meets_of[k] for k in members], axis=0)
-            start = meets if len(members) == 1 else np.mean([chains[k][0][0] for k in members], axis=0)
+            shared = len(members) > 1
+            start = np.mean([chains[k][0][0] for k in members], axis=0) if shared else meets
             for k in members:
                 line, widths, _ = chains[k]
                 if np.linalg.norm(line[0] - start) > 1e-9 * self.bone_length:
                     chains[k] = (np.vstack([start, line]), np.r_[0.0, widths], True)  # 0: no disc to leave
-                if len(members) > 1:
-                    ends[k] = len(chains)
-            if len(members) > 1:
+            if shared:
+                ends.update(dict.fromkeys(members, len(chains)))
                 chains.append((np.vstack([meets, start]), np.zeros(2), False))
                 ups.append(ups[members[0]])
         joints = self._joints(chains)
@@ -429,11 +429,13 @@ class _BoneBuilder:
             added = self._add_chain(line, along, up)
             last_bone[c] = added[-1] if added else up
 
-    def _sharing(self, limbs, ups, starts, meets):
-        """The ``limbs`` to extend in groups that share one extension: linked when they hang from the same bone and
-        their starts and meeting points each lie within half a bone length; a linked group is kept only when every
-        two of its limbs are linked (else each goes alone), so the groups do not depend on the limbs' order."""
+    def _sharing(self, meets, ups, starts):
+        """The limbs to extend (the keys of ``meets``, where each meets its bone) in groups that share one
+        extension: linked when they hang from the same bone and their starts and meeting points each lie within half
+        a bone length; a linked group is kept only when every two of its limbs are linked (else each goes alone), so
+        the groups do not depend on the limbs' order."""
         reach = 0.5 * self.bone_length
+        limbs = list(meets)
 
         def linked(a, b):
             return (ups[a] == ups[b] and np.linalg.norm(starts[a] - starts[b]) <= reach
