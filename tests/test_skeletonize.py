@@ -5,7 +5,7 @@ import pytest
 from rigger.skeletonize import depth
 from rigger.skeletonize.bones import chain_joints, symmetric_joints
 from rigger.skeletonize.polyline import arc_lengths
-from rigger.skeletonize.tree import Chain, chains_of, rooted_chains
+from rigger.skeletonize.tree import Chain, chains_of, prune_spurs, rooted_chains
 
 
 def rooted_path(radius):
@@ -30,6 +30,21 @@ def test_a_path_with_a_body_is_rooted_at_the_body():
     assert root == 12
     assert sorted(len(chain.nodes) for chain in chains) == [8, 13]
     assert all(chain.nodes[0] == 12 and chain.parent == -1 for chain in chains)
+
+
+def test_a_wide_branch_reaching_far_is_a_limb_not_a_bump():
+    """A cow's neck with its head, seen from the side: it leaves the shoulders wide (2 across) and reaches 2.6
+    beyond their disc, less than prune (1.35) times its width, so it reads as a bump; reaching past ``max_reach``
+    keeps it. Two thin legs make the shoulders a branch point."""
+    neck = [(x, 0.0, 1.0) for x in np.linspace(1.3, 3.2, 8)] + [(3.5, 0.0, 0.3)]
+    legs = [[(0.0, -y, 0.2) for y in range(1, 7)], [(-x, 0.0, 0.2) for x in range(1, 7)]]
+    nodes = np.array([(0.0, 0.0, 1.2)] + neck + legs[0] + legs[1])
+    points, radius = nodes[:, :2], nodes[:, 2]
+    chains = [[0] + list(range(1, 10)), [0] + list(range(10, 16)), [0] + list(range(16, 22))]
+    kept = {tuple(link) for link in prune_spurs(points, radius, chains, 1.35, 0.5, max_reach=2.5)}
+    assert (8, 9) in kept and len(kept) == 21
+    bumped = {tuple(link) for link in prune_spurs(points, radius, chains, 1.35, 0.5)}
+    assert (8, 9) not in bumped and len(bumped) == 12
 
 
 def layers(*intervals):
@@ -185,6 +200,21 @@ def test_one_node_seeing_two_legs_as_one_part_is_a_slip_not_an_occlusion():
     occluded = [leg] * 3 + [merged] * 3 + [leg] * 3
     depths = depth._resolve_occlusion(sil, points, radius, occluded, np.full(9, 3.0), FixedSide())
     np.testing.assert_array_equal(depths, [3, 3, 3, 0, 0, 0, 3, 3, 3])
+
+
+def test_split_legs_keep_their_sides_where_they_merge_into_the_hips():
+    """A leg pair seen from the side, one part per leg at depths -3 and 3, merging with the hips into one thick
+    interval near the body: a side view that puts the merged nodes at the body's middle must not pull both copies
+    onto one line there; each keeps its side."""
+    count = 20
+    node_layers = [layers((-3.5, 3.5))] * 5 + [layers((-3.5, -2.5), (2.5, 3.5))] * 15
+    sil = FlatSilhouette(node_layers)
+    sil.cell = 0.01
+    points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
+    _, placed = depth.place_chains(sil, points, np.full(count, 0.5), 0, [Chain(list(range(count)), -1)],
+                                   FixedSide())
+    assert len(placed) == 2
+    np.testing.assert_array_equal(sorted(line[1, 2] for line, _, _ in placed), [-3.0, 3.0])
 
 
 def test_mirror_pair_chains_get_mirror_image_joints():

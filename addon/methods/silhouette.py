@@ -34,6 +34,7 @@ AXES = np.eye(3)
 SPECK = 0.25  # islands whose axis is shorter than this many bone lengths get no bones of their own
 SPREAD_SAMPLES = 100_000  # triangles sampled to choose the view
 MIN_BRANCH = 0.5  # branches sticking out less than this many bone lengths are dropped, however thin
+KEEP_REACH = 2.5  # ... and those sticking out more are kept, however wide (a cow's short thick neck with its head)
 AXIS_NAMES = ("X", "Y", "Z")
 MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
 HIDDEN_REACH = 0.6  # perpendicular-view limb tips this many bone lengths off the skeleton (seen that way) are missing
@@ -121,7 +122,7 @@ class SilhouetteMethod(RigMethod):
         clock.lap("silhouette_cdt_axis")
 
         unit = bone_length * mesh.scale  # the bone length in mesh units
-        alive, merged, kept = _pruned_tree(graph, merge, prune, MIN_BRANCH * unit)
+        alive, merged, kept = _pruned_tree(graph, merge, prune, unit)
         clock.lap("merge_prune")
 
         side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
@@ -206,12 +207,13 @@ def _to_world(stages, frame):
     stages["joints"] = np.unique(stages["joints"] @ frame, axis=0)
 
 
-def _pruned_tree(graph, merge, prune, min_reach):
+def _pruned_tree(graph, merge, prune, bone_length):
     """Blob merging and spur pruning of a chordal axis: (alive nodes, merged links, kept links)."""
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
     alive = np.unique(representative)
     _, chains = chains_of(alive.tolist(), merged)
-    return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, min_reach)
+    return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, MIN_BRANCH * bone_length,
+                                      KEEP_REACH * bone_length)
 
 
 def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):
@@ -245,7 +247,7 @@ def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, bone_length, s
     """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``);
     the view's chains are placed in depth only when a leaf tip lies off the primary skeleton."""
     reach, min_length = HIDDEN_REACH * bone_length, MIN_BRANCH * bone_length
-    alive, _, kept = _pruned_tree(view_graph, merge, prune, min_length)
+    alive, _, kept = _pruned_tree(view_graph, merge, prune, bone_length)
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]
     cover = Cover(lines, view_sil.direction, reach)

@@ -58,10 +58,11 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
         parents = ends_of[chain.parent]
         for part, count in pieces:
             first = len(placed)
+            followed = [_follow((parts if count > 1 else node_layers)[part], copy, count, end_depth[chain.parent])
+                        for copy in range(count)]
             for copy in range(count):
-                depths = _follow((parts if count > 1 else node_layers)[part], copy, count, end_depth[chain.parent])
-                depths = _resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part], depths,
-                                            side_axis)
+                depths = _resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
+                                            followed[copy], side_axis, followed[:copy] + followed[copy + 1:])
                 line = sil.lift(chain_points[part], depths)
                 parent = -1
                 if parents:
@@ -167,12 +168,14 @@ def _track(node_layers, order, previous, depths, stay=False):
         depths[i] = previous
 
 
-def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
+def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis, siblings=()):
     """Where a node's interval is much thicker than its part is wide, take the depth from the side view instead,
     choosing among the side-view candidates the one closest to the previous node's depth (so a chain never
     hops between two legs that the side view shows at the same height). A thick interval at one node alone, between
     nodes that see the part by itself, is a slip of the ray casting (hits paired across two legs), not an arm in
-    front of the body: it is left alone."""
+    front of the body: it is left alone. So is one that holds a ``siblings`` depth, the other copies of a split
+    chain: there the parts merge (a cow's thighs into its hips) and each copy keeps its own side, rather than two of
+    them taking the same side-view part."""
     if side_axis is None:
         return depths
     out = depths.copy()
@@ -183,6 +186,8 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis):
               if len(layer) else None for layer, depth in zip(node_layers, depths.tolist())]
     thick = np.array([c is not None and c[1] - c[0] > limit for c, limit in zip(chosen, limits)])
     thick &= np.r_[False, thick[:-1]] | np.r_[thick[1:], False]  # a single node is a tracing slip, not a body
+    for other in siblings:
+        thick &= [c is None or not c[0] <= d <= c[1] for c, d in zip(chosen, other.tolist())]
     for i, interval in enumerate(chosen):
         if thick[i]:
             found = side_axis.depth_at(points[i], radius[i], interval, previous)

@@ -93,12 +93,14 @@ def _walk(start, first, neighbours, keys, arrived):
     return path
 
 
-def prune_spurs(points, radius, chains, prune, min_reach=0.0):
+def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf):
     """Drop leaf chains that stick out of the disc of the node they hang on by less than ``prune`` times their own
-    width, or by less than ``min_reach``, until none does. ``chains`` are node lists; returns the surviving links.
+    width, or by less than ``min_reach``, but never by ``max_reach`` or more, until none does. ``chains`` are node
+    lists; returns the surviving links.
 
     A limb is long for its width where it leaves the base (a leg, a finger, a tail, a neck with its head) while
-    outline noise and bumps (an ear on a round head, a belly) are not, whatever their size.
+    outline noise and bumps (an ear on a round head, a belly) are not, whatever their size, up to ``max_reach``: a
+    part reaching that far needs bones of its own however wide it is (a cow's short thick neck with its head).
     """
     chains = [list(c) for c in chains]
     while True:
@@ -115,7 +117,7 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0):
                     ordered = np.array(chain if chain[0] == base else chain[::-1])
                     out = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]][:3]
                     width = 2 * float(radius[out].mean()) if len(out) else 2 * float(radius[tip])
-                    if beyond <= max(prune * width, min_reach):
+                    if beyond <= max(prune * width, min_reach) and beyond < max_reach:
                         spurs.append(i)
                     break
         if not spurs:
