@@ -314,6 +314,34 @@ def test_a_hidden_limb_near_its_bone_or_reaching_none_is_not_extended():
     np.testing.assert_allclose(heads[starts], [near[0], outside[0]])
 
 
+class EnclosesNothing:
+    """A stand-in view in which every path leaves the mesh; counts the path tests."""
+
+    cell = 0.01
+
+    def __init__(self):
+        self.tests = 0
+
+    def encloses(self, points, slack):
+        self.tests += 1
+        return np.zeros(len(points), bool)
+
+
+def test_a_hidden_limb_tries_paths_to_the_nearest_bones_only():
+    """Among many bones none reachable within the mesh (a soup of random triangles at a small bone length has a
+    thousand): paths to the ``PATH_CANDIDATES`` nearest are tried, then the limb hangs from the nearest, met nowhere
+    in particular."""
+    from rigger.methods.silhouette import PATH_CANDIDATES, _BoneBuilder
+
+    builder = _BoneBuilder(np.radians(40), 0.1, 0, None, 0.05)
+    for k in range(100):
+        bone = np.array([[k, 1.0, 0.0], [k, 2.0, 0.0]])
+        builder._add_chain(bone, bone, -1)
+    view = EnclosesNothing()
+    assert builder._attachment(np.array([50.2, 0.0, 0.0]), (view,)) == (50, None)
+    assert view.tests == PATH_CANDIDATES < 100
+
+
 def test_mirror_image_hidden_limbs_get_mirror_image_bones():
     """Two feet mirrored across x = 0, both far below the body's bone and 0.6 bone lengths apart (too far to share
     an extension), each hangs from the body (not the right foot from the left one's extension, which passes nearer

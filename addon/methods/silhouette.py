@@ -44,6 +44,7 @@ END_RESOLUTION = 1 / 3  # the end-on view (the remaining axis of larger spread: 
 # is AUTO) only looks for limbs, at this fraction of the resolution: limbs are coarse features, and its trace costs less
 MIN_VIEW_RESOLUTION = 64  # the coarsest grid any view gets
 MAX_PATH_SAMPLES = 256  # points tested along a path from a hidden limb to a bone it may hang from (one per cell)
+PATH_CANDIDATES = 32  # ... to each of the nearest bones, nearest first, at most this many (a path test is costly)
 PATH_SLACK = 0.15  # ... and that path may leave the mesh for this many bone lengths in all (grazing its surface)
 BRIDGE = 1.0  # a hidden limb starting farther than this many bone lengths from that bone is extended back to it
 AXIS_SNAP = 1e-6  # view_direction components this small beside its largest are zero
@@ -493,7 +494,8 @@ class _BoneBuilder:
         ``point`` reaches within the mesh as each of them sees it (``Silhouette.encloses``, sampled every grid cell,
         up to ``PATH_SLACK`` bone lengths outside: a path may graze the surface, but a foot beside a hanging hand
         belongs to the body, not the hand), and the point the path meets it at; the nearest bone, met nowhere (None),
-        when no path stays in."""
+        when no path to the ``PATH_CANDIDATES`` nearest stays in (a soup of triangles strewn at random has a
+        thousand bones at a small ``bone_length``, and paths through it rarely stay in)."""
         if not self.heads:
             return -1, None
         targets = nearest_on_segments(point[None], np.array(self.heads), np.array(self.tails))[0]
@@ -501,7 +503,7 @@ class _BoneBuilder:
         order = np.argsort(distance, kind="stable")
         if views:
             cell = min(view.cell for view in views)
-            for bone in order:
+            for bone in order[:PATH_CANDIDATES]:
                 count = int(np.clip(np.ceil(distance[bone] / cell), 1, MAX_PATH_SAMPLES))
                 path = point + (np.arange(1, count + 1) / (count + 1))[:, None] * (targets[bone] - point)
                 outside = np.zeros(count, bool)
