@@ -56,6 +56,8 @@ def test_mesh_drops_degenerate_faces_and_counts_them():
     (TETRA_VERTICES, [(0, 0, 1), (2, 2, 2)], "all 2 triangles are degenerate"),
     ([(1, 1, 1)] * 4, TETRA_TRIANGLES, "zero size"),
     ([(0, 0, 0), (1, 1, 1), (2, 2, 2), (3, 3, 3)], [(0, 1, 2), (1, 2, 3)], "on one line"),
+    (np.array(TETRA_VERTICES) * 1e-310, TETRA_TRIANGLES, "too small: its size 2e-310 is below float64's normal"),
+    ([(-1e308, 0, 0), (1e308, 0, 0), (0, 1e308, 0), (0, 0, 1e308)], TETRA_TRIANGLES, "too large: its extent"),
 ])
 def test_mesh_rejects_bad_input_with_a_clear_message(vertices, triangles, fragment):
     with pytest.raises(ValueError) as error:
@@ -65,8 +67,16 @@ def test_mesh_rejects_bad_input_with_a_clear_message(vertices, triangles, fragme
 
 def test_line_check_is_scale_and_position_free():
     vertices = np.array(TETRA_VERTICES, dtype=float)
-    for scale, offset in ((1e-3, 1e3), (1e3, -1e3)):
+    for scale, offset in ((1e-3, 1e3), (1e3, -1e3), (1e-300, 0.0), (1e300, -1e300)):
         Mesh(vertices * scale + offset, TETRA_TRIANGLES)
+
+
+def test_a_mesh_moves_to_unit_size_by_an_exact_power_of_two():
+    mesh = Mesh(np.array(TETRA_VERTICES, dtype=float) * 3e200, TETRA_TRIANGLES)
+    assert 0.5 <= mesh.scale * mesh.unit_factor < 1 and np.log2(mesh.unit_factor).is_integer()
+    turned = mesh.transformed(np.eye(3)[[1, 2, 0]], mesh.unit_factor)
+    np.testing.assert_array_equal(turned.vertices, mesh.vertices[:, [1, 2, 0]] * mesh.unit_factor)
+    assert turned.triangles is mesh.triangles and not turned.vertices.flags.writeable
 
 
 def test_a_flat_mesh_is_accepted():

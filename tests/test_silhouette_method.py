@@ -148,6 +148,17 @@ def test_same_skeleton_when_moved_rotated_or_scaled(default_rig, seed):
         assert chamfer_distance(back, reference.joints()) / size < 0.03
 
 
+@pytest.mark.parametrize("scale", [1e-300, 1e300])
+def test_same_skeleton_at_the_ends_of_floating_point_range(default_rig, scale):
+    """Rigged at unit size (an exact power of two away), a model 1e-300 or 1e300 big rigs as at its own size; it
+    used to come apart (squares underflow, areas overflow)."""
+    vertices, triangles, reference = default_rig("humanoid")
+    skeleton = rigger.rig_mesh(vertices * scale, triangles)
+    assert chamfer_distance(skeleton.joints() / scale, reference.joints()) / np.ptp(vertices, axis=0).max() < 0.01
+    loops = skeleton.stages["silhouette"]["loops"]
+    assert 0.5 < np.ptp(np.concatenate(loops), axis=0).max() / (scale * np.ptp(vertices, axis=0).max()) <= 1.001
+
+
 def _turned(angle, axis):
     """The rotation by ``angle`` radians about ``axis`` (Rodrigues)."""
     x, y, z = np.asarray(axis, float) / np.linalg.norm(axis)

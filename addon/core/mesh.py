@@ -32,6 +32,15 @@ class Mesh:
         self.triangles, self.degenerate_count = _validated_triangles(triangles, len(self.vertices))
         self._reject_line()
 
+    def transformed(self, rotation=None, factor=1.0):
+        """This mesh with its vertices scaled by ``factor`` and turned by the orthonormal ``rotation`` (rows: the new
+        axes), sharing its triangles: a similarity keeps a valid mesh valid, so nothing is checked again."""
+        moved = object.__new__(Mesh)
+        vertices = self.vertices * factor
+        moved.vertices = _read_only(vertices if rotation is None else vertices @ np.asarray(rotation).T)
+        moved.triangles, moved.degenerate_count = self.triangles, self.degenerate_count
+        return moved
+
     @cached_property
     def _used_points(self):
         used = np.zeros(len(self.vertices), dtype=bool)
@@ -46,18 +55,30 @@ class Mesh:
     @cached_property
     def scale(self):
         """The largest extent of the bounding box: the length that makes tolerances scale-free."""
-        return float((self.bbox[1] - self.bbox[0]).max())
+        with np.errstate(over="ignore"):
+            extent = float((self.bbox[1] - self.bbox[0]).max())
+        if not np.isfinite(extent):
+            raise ValueError(f"mesh is too large: its extent {self.bbox[0]} to {self.bbox[1]} overflows float64")
+        if 0 < extent < np.finfo(np.float64).tiny:
+            raise ValueError(f"mesh is too small: its size {extent:.3g} is below float64's normal numbers; scale it up")
+        return extent
+
+    @cached_property
+    def unit_factor(self):
+        """The power of two that scales the mesh to a size between 0.5 and 1 (1 for a point): exact in floating
+        point, so a method may work at that size, far from overflow and underflow, and scale back without error."""
+        return float(np.ldexp(1.0, -np.frexp(self.scale)[1])) if self.scale > 0 else 1.0
 
     @cached_property
     def centroid(self):
         """(3,) float64: the mean position of the used vertices."""
-        points = self._used_points
-        return _read_only(np.ones(len(points)) @ points / len(points))  # a BLAS product: faster than mean(axis=0)
+        points, factor = self._used_points, self.unit_factor  # summed at unit size: no overflow, the same bits
+        return _read_only(np.ones(len(points)) @ (points * factor) / len(points) / factor)  # BLAS: faster than mean
 
     @cached_property
     def _principal(self):
-        """Principal variances (ascending) and axes (columns) of the used vertices."""
-        centred = self._used_points - self.centroid
+        """Principal variances (ascending) and axes (columns) of the used vertices, at ``unit_factor`` size."""
+        centred = (self._used_points - self.centroid) * self.unit_factor
         return np.linalg.eigh(centred.T @ centred)
 
     @cached_property

@@ -18,7 +18,6 @@ import numpy as np
 
 from .. import cdt, silhouette
 from ..core.graphs import components
-from ..core.mesh import Mesh
 from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
@@ -111,8 +110,9 @@ class SilhouetteMethod(RigMethod):
         if view == "DIRECTION":
             frame, axis = view_frame(view_direction)
             view = AXIS_NAMES[axis]
-            if frame is not None:  # rig in the frame where the view is that axis, then map the result back
-                mesh = Mesh(mesh.vertices @ frame.T, mesh.triangles)
+        # rig at unit size (a power of two away: exact), in the frame where the view is an axis; then map back
+        factor = mesh.unit_factor
+        mesh = mesh.transformed(frame, factor)
         vertices, triangles, flat = mesh.vertices, mesh.triangles, mesh.flat_normal
         try:
             axis, (sil, tri, graph) = _primary_view(mesh, view, resolution, outline_spacing, min_hole)
@@ -171,9 +171,7 @@ class SilhouetteMethod(RigMethod):
             "frame": np.eye(3) if frame is None else frame,
             "timings": clock.laps,
         }
-        if frame is not None:
-            heads, tails = heads @ frame, tails @ frame
-            _to_world(stages, frame)
+        heads, tails = _to_world(stages, frame, factor, heads, tails)
         return Skeleton(names, heads, tails, parents, stages=stages)
 
 
@@ -197,15 +195,31 @@ def view_frame(direction):
     return (None if np.array_equal(frame, np.eye(3)) else frame), axis
 
 
-def _to_world(stages, frame):
-    """Map the 3D stage data of a rig in ``frame`` (rows: its axes in world coordinates) back to the world;
+def _to_world(stages, frame, factor, *points):
+    """Map the stage data of a rig at ``factor`` times the mesh's size, in ``frame`` (rows: its axes in world
+    coordinates; None for the world's), back to the world, and return ``points`` (arrays of 3D points) mapped so;
     ``mirror_plane`` stays in the frame, whose axis it names."""
+    rotation = np.eye(3) if frame is None else frame
+
+    def place(array):
+        return array / factor @ rotation
+
     silhouette_stage = stages["silhouette"]
-    for key in ("origin", "u", "v", "direction"):
-        silhouette_stage[key] = silhouette_stage[key] @ frame
+    silhouette_stage["origin"] = place(silhouette_stage["origin"])
+    for key in ("u", "v", "direction"):
+        silhouette_stage[key] = silhouette_stage[key] @ rotation
+    silhouette_stage["loops"] = [loop / factor for loop in silhouette_stage["loops"]]
+    silhouette_stage["depth"] /= factor
     stages["view"] = silhouette_stage["direction"]
-    stages["chains"] = [line @ frame for line in stages["chains"]]
-    stages["joints"] = np.unique(stages["joints"] @ frame, axis=0)
+    stages["cdt"]["vertices"] = stages["cdt"]["vertices"] / factor
+    stages["axis"]["points"] = stages["axis"]["points"] / factor
+    stages["axis"]["radius"] = stages["axis"]["radius"] / factor
+    stages["chains"] = [place(line) for line in stages["chains"]]
+    stages["joints"] = np.unique(place(stages["joints"]), axis=0)
+    if stages["mirror_plane"] is not None:
+        axis, offset = stages["mirror_plane"]
+        stages["mirror_plane"] = (axis, offset / factor)
+    return [place(array) for array in points]
 
 
 def _pruned_tree(graph, merge, prune, bone_length):
