@@ -58,6 +58,7 @@ def test_mesh_drops_degenerate_faces_and_counts_them():
     ([(0, 0, 0), (1, 1, 1), (2, 2, 2), (3, 3, 3)], [(0, 1, 2), (1, 2, 3)], "on one line"),
     (np.array(TETRA_VERTICES) * 1e-310, TETRA_TRIANGLES, "too small: its size 2e-310 is below float64's normal"),
     ([(-1e308, 0, 0), (1e308, 0, 0), (0, 1e308, 0), (0, 0, 1e308)], TETRA_TRIANGLES, "too large: its extent"),
+    (np.array(TETRA_VERTICES) * 2.0 ** 1022, TETRA_TRIANGLES, "reaches float64's limit (2**1023)"),
 ])
 def test_mesh_rejects_bad_input_with_a_clear_message(vertices, triangles, fragment):
     with pytest.raises(ValueError) as error:
@@ -71,12 +72,24 @@ def test_line_check_is_scale_and_position_free():
         Mesh(vertices * scale + offset, TETRA_TRIANGLES)
 
 
-def test_a_mesh_moves_to_unit_size_by_an_exact_power_of_two():
+def test_a_mesh_goes_to_unit_size_by_an_exact_power_of_two():
     mesh = Mesh(np.array(TETRA_VERTICES, dtype=float) * 3e200, TETRA_TRIANGLES)
     assert 0.5 <= mesh.scale * mesh.unit_factor < 1 and np.log2(mesh.unit_factor).is_integer()
-    turned = mesh.transformed(np.eye(3)[[1, 2, 0]], mesh.unit_factor)
+    turned = mesh.at_unit_size(np.eye(3)[[1, 2, 0]])
     np.testing.assert_array_equal(turned.vertices, mesh.vertices[:, [1, 2, 0]] * mesh.unit_factor)
     assert turned.triangles is mesh.triangles and not turned.vertices.flags.writeable
+    assert turned.scale == mesh.scale * mesh.unit_factor and turned.unit_factor == 1.0
+    np.testing.assert_array_equal(turned.centroid, mesh.centroid[[1, 2, 0]] * mesh.unit_factor)
+    scaled = mesh.at_unit_size()  # unturned: the measures carry over, as computing them again would give them
+    fresh = Mesh(mesh.vertices * mesh.unit_factor, TETRA_TRIANGLES)
+    for name in ("bbox", "scale", "centroid", "flat_normal"):
+        np.testing.assert_array_equal(getattr(scaled, name), getattr(fresh, name), err_msg=name)
+
+
+def test_a_loose_vertex_too_far_to_scale_with_its_mesh_is_refused():
+    mesh = Mesh(np.vstack([np.array(TETRA_VERTICES) * 1e-300, [(1e10, 0, 0)]]), TETRA_TRIANGLES)
+    with pytest.raises(ValueError, match="vertex 4 at .* lies too far from a mesh 2e-300 big"):
+        mesh.at_unit_size()
 
 
 def test_a_flat_mesh_is_accepted():

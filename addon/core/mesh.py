@@ -1,7 +1,7 @@
 """A triangle mesh validated once at the door, so every method can trust its arrays.
 
-Bad input (empty, NaN, wrong shapes or dtypes, out-of-range indices, all on one line) raises ``ValueError`` with a
-message that says what is wrong; faces that repeat a vertex index are dropped and counted, since exporters routinely
+Bad input (empty, NaN, wrong shapes or dtypes, out-of-range indices, all on one line, a size beyond float64's normal
+range) raises ``ValueError`` with a message that says what is wrong; faces that repeat a vertex index are dropped and counted, since exporters routinely
 emit them.
 """
 import itertools
@@ -23,8 +23,8 @@ class Mesh:
         triangles: (M, 3) int32, read-only, indexing ``vertices``; faces that repeat a vertex index are removed.
         degenerate_count: how many such faces were removed.
 
-    ``bbox``, ``scale``, ``centroid`` and ``flat_normal`` describe the vertices that triangles use, so a stray loose
-    vertex cannot distort them.
+    ``bbox``, ``scale``, ``unit_factor``, ``centroid`` and ``flat_normal`` describe the vertices that triangles use,
+    so a stray loose vertex cannot distort them.
     """
 
     def __init__(self, vertices, triangles):
@@ -32,13 +32,23 @@ class Mesh:
         self.triangles, self.degenerate_count = _validated_triangles(triangles, len(self.vertices))
         self._reject_line()
 
-    def transformed(self, rotation=None, factor=1.0):
-        """This mesh with its vertices scaled by ``factor`` and turned by the orthonormal ``rotation`` (rows: the new
-        axes), sharing its triangles: a similarity keeps a valid mesh valid, so nothing is checked again."""
+    def at_unit_size(self, rotation=None):
+        """This mesh scaled by ``unit_factor`` (a power of two: exact) and turned by the orthonormal ``rotation`` (rows:
+        the new axes), sharing its triangles. A similarity keeps a valid mesh valid, so only a loose vertex that
+        would overflow is checked for; unturned, the measures already taken carry over, scaled exactly."""
+        factor = self.unit_factor
+        with np.errstate(over="ignore"):
+            vertices = self.vertices * factor
+        if not np.isfinite(vertices).all():
+            far = int(np.flatnonzero(~np.isfinite(vertices).all(axis=1))[0])
+            raise ValueError(f"vertex {far} at {self.vertices[far]} lies too far from a mesh {self.scale:.3g} big "
+                             f"to rig it at unit size; remove that loose vertex")
         moved = object.__new__(Mesh)
-        vertices = self.vertices * factor
         moved.vertices = _read_only(vertices if rotation is None else vertices @ np.asarray(rotation).T)
         moved.triangles, moved.degenerate_count = self.triangles, self.degenerate_count
+        if rotation is None:  # cached_property values live in the instance dict
+            moved.__dict__.update(bbox=_read_only(self.bbox * factor), centroid=_read_only(self.centroid * factor),
+                                  _principal=self._principal)  # taken at unit size already
         return moved
 
     @cached_property
@@ -54,11 +64,13 @@ class Mesh:
 
     @cached_property
     def scale(self):
-        """The largest extent of the bounding box: the length that makes tolerances scale-free."""
+        """The largest extent of the bounding box: the length that makes tolerances scale-free. ValueError when
+        it is not a normal float64 number at least 2**-1022 and below 2**1023 (so that ``unit_factor`` is one)."""
         with np.errstate(over="ignore"):
             extent = float((self.bbox[1] - self.bbox[0]).max())
-        if not np.isfinite(extent):
-            raise ValueError(f"mesh is too large: its extent {self.bbox[0]} to {self.bbox[1]} overflows float64")
+        if not extent < 2.0 ** 1023:
+            raise ValueError(f"mesh is too large: its extent from {self.bbox[0]} to {self.bbox[1]} reaches float64's "
+                             f"limit (2**1023); scale it down")
         if 0 < extent < np.finfo(np.float64).tiny:
             raise ValueError(f"mesh is too small: its size {extent:.3g} is below float64's normal numbers; scale it up")
         return extent

@@ -33,7 +33,7 @@ AXES = np.eye(3)
 SPECK = 0.25  # islands whose axis is shorter than this many bone lengths get no bones of their own
 SPREAD_SAMPLES = 100_000  # triangles sampled to choose the view
 MIN_BRANCH = 0.5  # branches sticking out less than this many bone lengths are dropped, however thin
-KEEP_REACH = 2.5  # ... and those sticking out more are kept, however wide (a cow's short thick neck with its head)
+KEEP_REACH = 0.25  # branches sticking out this share of the mesh's size are kept, however wide (a cow's neck and head)
 AXIS_NAMES = ("X", "Y", "Z")
 MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
 HIDDEN_REACH = 0.6  # perpendicular-view limb tips this many bone lengths off the skeleton (seen that way) are missing
@@ -84,7 +84,8 @@ class SilhouetteMethod(RigMethod):
               description="Blob merging: nodes within this many disc radii of a branch point join it"),
         Param("prune", "float", 1.35, min=0.0, max=5.0,
               description="Branches sticking out of their base by less than this many times their width are "
-                          "dropped as bumps; lower keeps stubbier branches"),
+                          "dropped as bumps (unless they reach a quarter of the mesh's size); lower keeps stubbier "
+                          "branches"),
         Param("bone_angle", "float", 40.0, min=1.0, max=180.0,
               description="Start a new bone where a chain turns by more than this many degrees"),
         Param("bone_length", "float", 0.1, min=0.01, max=1.0,
@@ -112,7 +113,7 @@ class SilhouetteMethod(RigMethod):
             view = AXIS_NAMES[axis]
         # rig at unit size (a power of two away: exact), in the frame where the view is an axis; then map back
         factor = mesh.unit_factor
-        mesh = mesh.transformed(frame, factor)
+        mesh = mesh.at_unit_size(frame)
         vertices, triangles, flat = mesh.vertices, mesh.triangles, mesh.flat_normal
         try:
             axis, (sil, tri, graph) = _primary_view(mesh, view, resolution, outline_spacing, min_hole)
@@ -123,7 +124,8 @@ class SilhouetteMethod(RigMethod):
         clock.lap("silhouette_cdt_axis")
 
         unit = bone_length * mesh.scale  # the bone length in mesh units
-        alive, merged, kept = _pruned_tree(graph, merge, prune, unit)
+        reaches = (MIN_BRANCH * unit, KEEP_REACH * mesh.scale)  # prune_spurs' min_reach and max_reach
+        alive, merged, kept = _pruned_tree(graph, merge, prune, reaches)
         clock.lap("merge_prune")
 
         side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
@@ -147,7 +149,7 @@ class SilhouetteMethod(RigMethod):
             else:
                 builder.add_island(placed.root_point, placed.chains)
         for view_sil, view_graph in other_views:
-            limbs = _hidden_limbs(sil, view_sil, view_graph, builder.lines, merge, HIDDEN_PRUNE * prune, unit,
+            limbs = _hidden_limbs(sil, view_sil, view_graph, builder.lines, merge, HIDDEN_PRUNE * prune, reaches, unit,
                                   split_layers)
             builder.add_limbs(limbs, (sil, view_sil))
         clock.lap("depth_bones")
@@ -199,15 +201,16 @@ def _to_world(stages, frame, factor, *points):
     """Map the stage data of a rig at ``factor`` times the mesh's size, in ``frame`` (rows: its axes in world
     coordinates; None for the world's), back to the world, and return ``points`` (arrays of 3D points) mapped so;
     ``mirror_plane`` stays in the frame, whose axis it names."""
-    rotation = np.eye(3) if frame is None else frame
+    def turned(array):
+        return array if frame is None else array @ frame
 
     def place(array):
-        return array / factor @ rotation
+        return turned(array / factor)
 
     silhouette_stage = stages["silhouette"]
     silhouette_stage["origin"] = place(silhouette_stage["origin"])
     for key in ("u", "v", "direction"):
-        silhouette_stage[key] = silhouette_stage[key] @ rotation
+        silhouette_stage[key] = turned(silhouette_stage[key])
     silhouette_stage["loops"] = [loop / factor for loop in silhouette_stage["loops"]]
     silhouette_stage["depth"] /= factor
     stages["view"] = silhouette_stage["direction"]
@@ -222,13 +225,13 @@ def _to_world(stages, frame, factor, *points):
     return [place(array) for array in points]
 
 
-def _pruned_tree(graph, merge, prune, bone_length):
-    """Blob merging and spur pruning of a chordal axis: (alive nodes, merged links, kept links)."""
+def _pruned_tree(graph, merge, prune, reaches):
+    """Blob merging and spur pruning of a chordal axis, ``reaches`` being ``prune_spurs``' (min_reach, max_reach):
+    (alive nodes, merged links, kept links)."""
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
     alive = np.unique(representative)
     _, chains = chains_of(alive.tolist(), merged)
-    return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, MIN_BRANCH * bone_length,
-                                      KEEP_REACH * bone_length)
+    return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, *reaches)
 
 
 def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):
@@ -258,20 +261,19 @@ def _other_view(vertices, triangles, primary, axis, resolution, spacing, min_hol
     return view_sil, view_graph
 
 
-def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, bone_length, split_layers):
+def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, reaches, bone_length, split_layers):
     """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``);
     the view's chains are placed in depth only when a leaf tip lies off the primary skeleton."""
-    reach, min_length = HIDDEN_REACH * bone_length, MIN_BRANCH * bone_length
-    alive, _, kept = _pruned_tree(view_graph, merge, prune, bone_length)
+    alive, _, kept = _pruned_tree(view_graph, merge, prune, reaches)
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]
-    cover = Cover(lines, view_sil.direction, reach)
+    cover = Cover(lines, view_sil.direction, HIDDEN_REACH * bone_length)
     if cover.covered(view_sil.lift(tips, 0.0)).all():
         return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
     limbs = []
     for placed in _placed_islands(view_sil, view_graph, alive, kept, SPECK * bone_length, None, split_layers):
         if isinstance(placed, PlacedIsland):
-            limbs += uncovered_limbs(placed.chains, cover, sil, min_length)
+            limbs += uncovered_limbs(placed.chains, cover, sil, reaches[0])
     return limbs
 
 

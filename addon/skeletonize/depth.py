@@ -185,9 +185,9 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis, sibl
     chosen = [min(layer.tolist(), key=lambda interval: abs(0.5 * (interval[0] + interval[1]) - depth))
               if len(layer) else None for layer, depth in zip(node_layers, depths.tolist())]
     thick = np.array([c is not None and c[1] - c[0] > limit for c, limit in zip(chosen, limits)])
-    thick &= np.r_[False, thick[:-1]] | np.r_[thick[1:], False]  # a single node is a tracing slip, not a body
     for other in siblings:
         thick &= [c is None or not c[0] <= d <= c[1] for c, d in zip(chosen, other.tolist())]
+    thick &= np.r_[False, thick[:-1]] | np.r_[thick[1:], False]  # a single node is a tracing slip, not a body
     for i, interval in enumerate(chosen):
         if thick[i]:
             found = side_axis.depth_at(points[i], radius[i], interval, previous)
