@@ -10,7 +10,8 @@ import tomllib
 from Cython.Build import cythonize
 from setuptools import Extension, setup
 
-# One version for the package, the extension manifest and bl_info (tests/test_addon_zip.py checks the last two agree).
+# One version for the package, the extension manifest and bl_info (tools/build_addon.py and tests/test_addon_zip.py
+# check that the last two agree).
 MANIFEST = pathlib.Path(__file__).parent / "addon" / "blender_manifest.toml"
 VERSION = tomllib.loads(MANIFEST.read_text(encoding="utf-8"))["version"]
 

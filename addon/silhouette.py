@@ -70,8 +70,8 @@ class Silhouette:
     Attributes:
         loops: list of (K, 2) float64 arrays in the (u, v) frame, closing point not repeated. Outer boundaries run
             counter-clockwise, holes clockwise, every loop is simple and no two loops touch, so they can be passed
-            directly to ``rigger.cdt.triangulate(points, segments, mode="inside")``. Empty only when every part of
-            the projection is a speck (see the module docstring).
+            directly to ``rigger.cdt.triangulate(points, segments, mode="inside")``. Never empty: ``trace`` raises
+            ``PartsTooSmall`` when every part of the projection is a speck (see the module docstring).
         origin, u, v, direction: (3,) float64. A frame point (x, y) at depth d is the 3D point
             ``origin + x*u + y*v + d*direction``; ``direction`` is the unit view direction, depth grows away from
             the viewer, and (u, v) is what the viewer sees as (right, up).

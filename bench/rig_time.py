@@ -38,7 +38,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
 from benchkit import (REPO, RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit,  # noqa: E402
                       markdown_table, midpoint_subdivided, table_cell)
-from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
+from rigger.blender.headless import empty_scene, temporary_user_folder  # noqa: E402  (bpy-free)
 
 GENERATE_FLAG = "--generate-characters"  # child-process mode: write the characters' arrays into a directory
 GENERATION_TIMEOUT_S = 300
@@ -104,11 +104,11 @@ def generated_characters():
 def write_characters(directory):
     """Child-process side: every character at every Skin level, one .npz each."""
     temporary_user_folder()
-    import bpy
+    import bpy  # noqa: F401  (first: Blender's own modules, bmesh among them, import only once bpy is)
     from rigger import samples
     from rigger.blender.samples import character_arrays
 
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    empty_scene()
     for name in samples.CHARACTERS:
         for level in SKIN_LEVELS:
             vertices, triangles = character_arrays(name, subdivisions=level)

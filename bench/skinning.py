@@ -25,7 +25,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
 from benchkit import (RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit, format_seconds,  # noqa: E402
                       markdown_table, table_cell)
-from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
+from rigger.blender.headless import empty_scene, temporary_user_folder  # noqa: E402  (bpy-free)
 from rigger.skeletonize.polyline import segment_distances  # noqa: E402  (bpy-free)
 
 MODELS_DIR = SHARED_MODELS / "gt"
@@ -101,7 +101,7 @@ def skin_model(model, kind):
 
     record = {"model": model.name, "skeleton": kind, "vertices": len(model.vertices)}
     try:
-        bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+        empty_scene()
         mesh = bpy.data.meshes.new(model.name)
         mesh.from_pydata(model.vertices.tolist(), [], model.triangles.tolist())
         obj = bpy.data.objects.new(model.name, mesh)

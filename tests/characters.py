@@ -62,7 +62,7 @@ def _write_characters(directory):
     """Child-process side: build every character with bpy and save its arrays into ``directory``."""
     temporary_user_folder()
     import bpy  # noqa: F401  (first: Blender's own modules, bmesh among them, import only once bpy is)
-    from conftest import empty_scene
+    from rigger.blender.headless import empty_scene
     from rigger.blender.samples import character_arrays
 
     empty_scene()

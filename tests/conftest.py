@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from rigger.blender.headless import temporary_user_folder
+from rigger.blender.headless import empty_scene, temporary_user_folder
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SHARED = pathlib.Path(os.environ.get("RIGGER_SHARED", ROOT.parent / "shared"))
@@ -22,14 +22,6 @@ def shared_path(*parts):
     if not path.exists():
         pytest.skip(f"shared test data not found at {path} (clone the project beside ../shared to run this test)")
     return path
-
-
-def empty_scene():
-    """Reset Blender to its factory-default empty file and return the scene."""
-    import bpy
-
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-    return bpy.context.scene
 
 
 @pytest.fixture

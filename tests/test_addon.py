@@ -432,7 +432,7 @@ def test_the_panel_shows_method_parameters_actions_and_overlay_toggles(registere
         "rigger.rig", "rigger.skin", "rigger.rig_skin", "rigger.clear_overlays"]
 
 
-def test_the_direction_view_offers_to_look_along_the_3d_view(registered, scene):
+def test_the_direction_view_offers_to_look_along_the_3d_view(scene):
     from rigger.blender.panel import RIGGER_PT_main
     settings = scene.rigger
     settings.method = "silhouette"
@@ -443,7 +443,7 @@ def test_the_direction_view_offers_to_look_along_the_3d_view(registered, scene):
     assert bpy.ops.rigger.direction_from_view.poll() is False  # no 3D view headless
 
 
-def test_from_view_sets_the_direction_the_view_looks_along(registered, scene):
+def test_from_view_sets_the_direction_the_view_looks_along(scene):
     """The operator run as the sidebar runs it, in a 3D view turned to look along +X (view_rotation maps the
     camera's -Z there)."""
     from mathutils import Quaternion

@@ -5,11 +5,13 @@ import pytest
 from scipy.spatial import cKDTree
 
 from conftest import empty_scene
+from stages import lift
 
 bpy = pytest.importorskip("bpy")
 
 import rigger  # noqa: E402
 from rigger.blender import overlays, samples  # noqa: E402
+from rigger.blender.meshdata import mesh_vertices  # noqa: E402
 from rigger.methods._template import TemplateMethod  # noqa: E402
 from rigger.skeletonize.chordal import ISOLATED, JUNCTION, SLEEVE, TERMINAL  # noqa: E402
 from rigger.skeletonize.polyline import segment_distances  # noqa: E402
@@ -26,14 +28,6 @@ def humanoid():
     empty_scene()
     vertices, triangles = samples.character_arrays("humanoid", subdivisions=1)
     return vertices, triangles, rigger.rig_mesh(vertices, triangles).stages
-
-
-def lift(stages, points):
-    """Silhouette-plane points to 3D, as the stage interface defines it."""
-    frame = stages["silhouette"]
-    points = np.asarray(points)
-    return (frame["origin"] + frame["depth"] * frame["direction"] + points[:, :1] * frame["u"]
-            + points[:, 1:] * frame["v"])
 
 
 def stage_segments(stages, kind):
@@ -62,12 +56,10 @@ def distance_to_segments(points, starts, ends):
 def evaluated(obj):
     """Vertices (N, 3) and the material name of every face of the object's evaluated (geometry-node) mesh."""
     mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
-    vertices = np.empty(3 * len(mesh.vertices))
-    mesh.vertices.foreach_get("co", vertices)
     index = np.empty(len(mesh.polygons), dtype=np.int32)
     mesh.polygons.foreach_get("material_index", index)
     names = np.array([material.name if material else "" for material in mesh.materials] or [""])
-    return vertices.reshape(-1, 3), names[index]
+    return mesh_vertices(mesh), names[index]
 
 
 def default_radius(stages):

@@ -21,9 +21,10 @@ MIRROR_TOLERANCE = 1e-5  # metres: Blender computes in float32, so mirror images
 BUILD_IN_BLENDER = textwrap.dedent("""
     import bpy
     import pytest
+    from rigger.blender.headless import empty_scene
     from rigger.blender.samples import build_character, character_arrays
 
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    empty_scene()
     characters = bpy.data.collections.new("Characters")
     bpy.context.scene.collection.children.link(characters)
     obj = build_character("quadruped", subdivisions=1, collection=characters)

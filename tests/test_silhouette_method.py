@@ -12,6 +12,7 @@ from rigger import samples
 from rigger.skeletonize.bones import bone_names
 
 from rigdata import chamfer_distance
+from stages import lift
 
 CHARACTERS = ("humanoid", "humanoid_hips", "quadruped", "octopus", "tree", "snake")
 
@@ -156,11 +157,10 @@ def test_same_skeleton_at_the_ends_of_floating_point_range(default_rig, scale):
     skeleton = rigger.rig_mesh(vertices * scale, triangles)
     size = np.ptp(vertices, axis=0).max()
     assert chamfer_distance(skeleton.joints() / scale, reference.joints()) / size < 0.01
-    stages, plane = skeleton.stages, skeleton.stages["silhouette"]
-    for kind, points in (("loops", np.concatenate(plane["loops"])), ("cdt", stages["cdt"]["vertices"]),
+    stages = skeleton.stages
+    for kind, points in (("loops", np.concatenate(stages["silhouette"]["loops"])), ("cdt", stages["cdt"]["vertices"]),
                          ("axis", stages["axis"]["points"])):  # on the plane through the mesh, at its size
-        lifted = (plane["origin"] + plane["depth"] * plane["direction"] + points[:, :1] * plane["u"]
-                  + points[:, 1:] * plane["v"]) / scale
+        lifted = lift(stages, points) / scale
         assert (lifted >= vertices.min(axis=0) - 0.01 * size).all(), kind
         assert (lifted <= vertices.max(axis=0) + 0.01 * size).all(), kind
     np.testing.assert_allclose(stages["axis"]["radius"].max() / scale, reference.stages["axis"]["radius"].max(),

@@ -19,7 +19,7 @@ import bmesh  # noqa: E402  (Blender's own module, importable once bpy is)
 from rigger import samples  # noqa: E402
 from rigger.blender import skinning  # noqa: E402
 from rigger.blender.armature import build_armature  # noqa: E402
-from rigger.blender.meshdata import world_points  # noqa: E402
+from rigger.blender.meshdata import mesh_vertices, world_points  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
 from rigger.skeletonize.polyline import segment_distances  # noqa: E402
 
@@ -37,16 +37,6 @@ def bone_names(armature):
     return [bone.name for bone in armature.data.bones if bone.use_deform]
 
 
-def world_vertices(obj):
-    return world_points(np.array([vertex.co for vertex in obj.data.vertices]), obj.matrix_world)
-
-
-def world_bones(armature, names):
-    ends = np.array([[armature.data.bones[n].head_local, armature.data.bones[n].tail_local] for n in names])
-    ends = world_points(ends, armature.matrix_world)
-    return ends[:, 0], ends[:, 1]
-
-
 def assert_skinned(obj, armature, report, checked=slice(None), nearest_share=NEAREST_SHARE):
     """Every vertex weighted, weights normalised, one Armature modifier last, and the dominant bone of each
     ``checked`` vertex near it."""
@@ -55,10 +45,10 @@ def assert_skinned(obj, armature, report, checked=slice(None), nearest_share=NEA
     assert report.unweighted == 0
     assert (table.max(axis=1) > 0).all(), f"{(table.max(axis=1) == 0).sum()} vertices unweighted"
     np.testing.assert_allclose(table.sum(axis=1), 1.0, atol=1e-5)
-    points = world_vertices(obj)
+    points = world_points(mesh_vertices(obj.data), obj.matrix_world)
     size = np.ptp(points, axis=0).max()
     points = points[checked]
-    distances = segment_distances(points, *world_bones(armature, names))
+    distances = segment_distances(points, *skinning._world_bones(armature, names))
     dominant = table[checked].argmax(axis=1)
     gap = distances[np.arange(len(points)), dominant] - distances.min(axis=1)
     assert gap.max() <= NEAR_FRACTION * size, f"a vertex's dominant bone is {gap.max() / size:.3f} sizes too far"

@@ -14,7 +14,7 @@ import sys
 
 import numpy as np
 
-from rigger.blender.headless import temporary_user_folder
+from rigger.blender.headless import empty_scene, temporary_user_folder
 
 OUT = pathlib.Path(__file__).resolve().parents[1] / "out"
 RENDER_SIZE = (960, 1080)
@@ -31,13 +31,13 @@ def main(name="humanoid"):
     import rigger
     from rigger import samples
     from rigger.blender import overlays, skinning
-    from rigger.blender.meshdata import mesh_arrays
+    from rigger.blender.meshdata import mesh_vertices
     from rigger.blender.pipeline import rig_object
     from rigger.blender.samples import build_character
     from rigger.blender.scenefiles import rig_report, save_scene
 
     OUT.mkdir(exist_ok=True)
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    empty_scene()
     rigger.register()
     obj = build_character(name)
     result = rig_object(obj, "silhouette")
@@ -48,7 +48,7 @@ def main(name="humanoid"):
     truth = samples.ground_truth_bones(name)
     joints, true_joints = result.skeleton.joints(), truth.joints()
     gaps = np.linalg.norm(joints[:, None] - true_joints[None], axis=2)
-    size = float(np.ptp(mesh_arrays(obj.data)[0], axis=0).max())
+    size = float(np.ptp(mesh_vertices(obj.data), axis=0).max())
     report["model"] = {"name": name, "vertices": len(obj.data.vertices), "faces": len(obj.data.polygons)}
     report["joint_chamfer_to_truth"] = 0.5 * float(gaps.min(axis=1).mean() + gaps.min(axis=0).mean()) / size
     (OUT / f"{name}_report.json").write_text(json.dumps(report, indent=2))

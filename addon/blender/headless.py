@@ -1,6 +1,7 @@
 """Blender as a Python module outside Blender: bpy reads and writes a user folder (preferences, add-ons, caches) at
 import, so the demo, the tests and the benchmarks give it a temporary one and neither change nor depend on the
-user's own Blender set-up. Needs no bpy: it runs before the first ``import bpy``."""
+user's own Blender set-up, and start from one empty scene. Needs no bpy to import: it runs before the first
+``import bpy``."""
 import atexit
 import os
 import shutil
@@ -17,3 +18,12 @@ def temporary_user_folder():
         atexit.register(shutil.rmtree, folder, ignore_errors=True)
         os.environ[VARIABLE] = folder
     return os.environ[VARIABLE]
+
+
+def empty_scene():
+    """Reset Blender to its factory-default empty file (``read_factory_settings`` would unregister the add-ons)
+    and return the scene."""
+    import bpy
+
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    return bpy.context.scene

@@ -24,14 +24,19 @@ def evaluated_arrays(obj, depsgraph=None):
     return world_points(vertices, evaluated.matrix_world), triangles
 
 
+def mesh_vertices(mesh):
+    """Vertices (N, 3) float64 of mesh data ``mesh`` in its own space (no triangulation: cheap)."""
+    vertices = np.empty(len(mesh.vertices) * 3, dtype=np.float64)
+    mesh.vertices.foreach_get("co", vertices)
+    return vertices.reshape(-1, 3)
+
+
 def mesh_arrays(mesh):
     """Vertices (N, 3) float64 in the mesh's own space and triangles (M, 3) int32 of mesh data ``mesh``."""
     mesh.calc_loop_triangles()
-    vertices = np.empty(len(mesh.vertices) * 3, dtype=np.float64)
-    mesh.vertices.foreach_get("co", vertices)
     triangles = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
     mesh.loop_triangles.foreach_get("vertices", triangles)
-    return vertices.reshape(-1, 3), triangles.reshape(-1, 3)
+    return mesh_vertices(mesh), triangles.reshape(-1, 3)
 
 
 def world_points(points, matrix_world):

@@ -122,14 +122,14 @@ def _drawings(stages):
                "chains": _chains, "joints": _joints}
     drawings = {}
     for kind, _, _ in OVERLAY_KINDS:
-        stage = stages.get(STAGE_OF_KIND[kind])
+        name = STAGE_OF_KIND[kind]
+        stage = stages.get(name)
         if stage is None:
             continue
         try:
             drawing = readers[kind](stage, stages)
         except ValueError as error:
-            warnings.warn(f"Rigger overlay {kind!r} skipped: stage {STAGE_OF_KIND[kind]!r} {error}", RuntimeWarning,
-                          stacklevel=3)
+            warnings.warn(f"Rigger overlay {kind!r} skipped: stage {name!r} {error}", RuntimeWarning, stacklevel=3)
             continue
         if drawing is not None:
             drawings[kind] = drawing

@@ -8,6 +8,7 @@ import numpy as np
 from ..core.files import replaced_on_success
 from . import overlays, skinning
 from .armature import delete_armature
+from .headless import empty_scene
 from .pipeline import METHOD_PROPERTY, rig_object, skin_meshes, skin_summary
 from .properties import ARMATURE_POINTER
 
@@ -27,7 +28,7 @@ def rig_file(source, output, method, params, *, skin=True):
     renamed into place).
     """
     source, output = pathlib.Path(source), pathlib.Path(output)
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    empty_scene()
     try:
         frame = _import(source)
     except RuntimeError as error:

@@ -314,9 +314,8 @@ def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, positions, rep
     targets = np.flatnonzero(~weighted)
     heads, tails = _world_bones(armature_obj, bone_names)
     result = bone_weights(positions[targets], heads, tails, _world_normals(mesh_obj)[targets])
-    kept = result.bones >= 0
-    _write_weights(mesh_obj, bone_names, np.broadcast_to(targets[:, None], kept.shape)[kept], result.bones[kept],
-                   result.weights[kept])
+    rows, slots = np.nonzero(result.bones >= 0)
+    _write_weights(mesh_obj, bone_names, targets[rows], result.bones[rows, slots], result.weights[rows, slots])
     weighted[targets] = True
     stage.weighted = len(targets)
     _finish_stage(stage, started, report,

@@ -10,6 +10,14 @@ def numeric_array(values, name, dtype=np.float64):
         raise ValueError(f"{name} must be a numeric array: {exc}") from None
 
 
+def nonfinite_rows(array):
+    """Indices of the rows of a 2D array that hold a NaN or an infinity; the whole-array test is far faster, so rows
+    are looked at only when one is bad."""
+    if np.isfinite(array).all():
+        return np.zeros(0, np.int64)
+    return np.flatnonzero(~np.isfinite(array).all(axis=1))
+
+
 def point_array(values, columns, name):
     """``values`` as a C-contiguous (N, ``columns``) float64 array of finite numbers ((0, columns) when empty);
     ValueError naming ``name`` and the first bad row otherwise."""
@@ -18,9 +26,9 @@ def point_array(values, columns, name):
         return np.zeros((0, columns), np.float64)
     if array.ndim != 2 or array.shape[1] != columns:
         raise ValueError(f"{name} must have shape (N, {columns}), got {array.shape}")
-    if not np.isfinite(array).all():  # the whole-array test is far faster; rows only to name the bad one
-        bad = int(np.flatnonzero(~np.isfinite(array).all(axis=1))[0])
-        raise ValueError(f"{name} must be finite; row {bad} is {array[bad].tolist()}")
+    bad = nonfinite_rows(array)
+    if bad.size:
+        raise ValueError(f"{name} must be finite; row {bad[0]} is {array[bad[0]].tolist()}")
     return np.ascontiguousarray(array)
 
 

@@ -1,15 +1,15 @@
 """A triangle mesh validated once at the door, so every method can trust its arrays.
 
 Bad input (empty, NaN, wrong shapes or dtypes, out-of-range indices, all on one line, a size beyond float64's normal
-range) raises ``ValueError`` with a message that says what is wrong; faces that repeat a vertex index are dropped and counted, since exporters routinely
-emit them.
+range) raises ``ValueError`` with a message that says what is wrong; faces that repeat a vertex index are dropped
+and counted, since exporters routinely emit them.
 """
 import itertools
 from functools import cached_property
 
 import numpy as np
 
-from .arrays import column_bounds, concatenated_ranges
+from .arrays import column_bounds, concatenated_ranges, nonfinite_rows
 
 # A principal variance this small relative to the largest is none: two such make a line, one a flat mesh.
 LINE_VARIANCE_RATIO = 1e-12
@@ -39,10 +39,10 @@ class Mesh:
         factor = self.unit_factor
         with np.errstate(over="ignore"):
             vertices = self.vertices * factor
-        if not np.isfinite(vertices).all():
-            far = int(np.flatnonzero(~np.isfinite(vertices).all(axis=1))[0])
-            raise ValueError(f"vertex {far} at {self.vertices[far]} lies too far from a mesh {self.scale:.3g} big "
-                             f"to rig it at unit size; remove that loose vertex")
+        far = nonfinite_rows(vertices) if factor > 1 else ()  # scaling down cannot overflow
+        if len(far):
+            raise ValueError(f"vertex {far[0]} at {self.vertices[far[0]]} lies too far from a mesh {self.scale:.3g} "
+                             f"big to rig it at unit size; remove that loose vertex")
         moved = object.__new__(Mesh)
         moved.vertices = _read_only(vertices if rotation is None else vertices @ np.asarray(rotation).T)
         moved.triangles, moved.degenerate_count = self.triangles, self.degenerate_count
@@ -90,7 +90,8 @@ class Mesh:
     @cached_property
     def _principal(self):
         """Principal variances (ascending) and axes (columns) of the used vertices, at ``unit_factor`` size."""
-        centred = (self._used_points - self.centroid) * self.unit_factor
+        centred = self._used_points - self.centroid
+        centred *= self.unit_factor
         return np.linalg.eigh(centred.T @ centred)
 
     @cached_property
@@ -168,8 +169,8 @@ def _rows_of_three(values, what, kinds, kind_text, count_letter):
 
 def _validated_vertices(values):
     array = np.array(_rows_of_three(values, "vertices", "iuf", "real numbers", "N"), dtype=np.float64)
-    if not np.isfinite(array).all():
-        bad = np.flatnonzero(~np.isfinite(array).all(axis=1))
+    bad = nonfinite_rows(array)
+    if bad.size:
         raise ValueError(f"{bad.size} vertices have NaN or infinite coordinates (the first is vertex {bad[0]})")
     return _read_only(array)
 

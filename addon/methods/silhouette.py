@@ -168,12 +168,12 @@ class SilhouetteMethod(RigMethod):
             "merged": {"links": merged},
             "pruned": {"links": _removed(merged, kept)},
             "chains": builder.lines,
-            "joints": np.unique(np.concatenate([heads, tails]), axis=0),
             "mirror_plane": plane,
             "frame": np.eye(3) if frame is None else frame,
             "timings": clock.laps,
         }
         heads, tails = _to_world(stages, frame, factor, heads, tails)
+        stages["joints"] = np.unique(np.concatenate([heads, tails]), axis=0)
         return Skeleton(names, heads, tails, parents, stages=stages)
 
 
@@ -218,7 +218,6 @@ def _to_world(stages, frame, factor, *points):
     stages["axis"]["points"] = stages["axis"]["points"] / factor
     stages["axis"]["radius"] = stages["axis"]["radius"] / factor
     stages["chains"] = [place(line) for line in stages["chains"]]
-    stages["joints"] = np.unique(place(stages["joints"]), axis=0)
     if stages["mirror_plane"] is not None:
         axis, offset = stages["mirror_plane"]
         stages["mirror_plane"] = (axis, offset / factor)

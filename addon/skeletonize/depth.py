@@ -46,7 +46,7 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
         nodes = np.asarray(chain.nodes)
         chain_points, chain_radius = points[nodes], radius[nodes]
         node_layers = [layers[slot[n]] for n in chain.nodes]
-        copies = 1
+        copies, parts = 1, node_layers
         if split:
             parts = [_parts(layer, r) for layer, r in zip(node_layers, chain_radius)]
             copies = _layer_count(parts)
@@ -188,9 +188,10 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis, sibl
     for other in siblings:
         thick &= [c is None or not c[0] <= d <= c[1] for c, d in zip(chosen, other.tolist())]
     thick &= np.r_[False, thick[:-1]] | np.r_[thick[1:], False]  # a single node is a tracing slip, not a body
+    on_plane = sil.lift(points, 0.0) if thick.any() else None
     for i, interval in enumerate(chosen):
         if thick[i]:
-            found = side_axis.depth_at(points[i], radius[i], interval, previous)
+            found = side_axis.depth_at(on_plane[i], radius[i], interval, previous)
             if found is not None:
                 out[i] = found
         previous = out[i]
@@ -213,15 +214,13 @@ class SideAxis:
         self.depth = world @ primary_sil.direction - float(primary_sil.origin @ primary_sil.direction)
         self.radius = radius
         self.cell = side_sil.cell
-        self.primary = primary_sil
 
-    def depth_at(self, point2d, radius, interval, previous):
-        """Depth (in the primary view's frame) of the side-view part matching a primary node at ``point2d``, inside
-        ``interval``: of the side-view axis nodes at the node's height, the one nearest ``previous`` (ties to the
-        closest width); None if no side-view node fits."""
-        w0 = float(self.primary.lift(point2d, 0.0)[0] @ self.w_axis)
+    def depth_at(self, point, radius, interval, previous):
+        """Depth (in the primary view's frame) of the side-view part matching a primary node at ``point`` (3D, on
+        the primary view's plane), inside ``interval``: of the side-view axis nodes at the node's height, the one
+        nearest ``previous`` (ties to the closest width); None if no side-view node fits."""
         depth = self.depth
-        near = np.abs(self.w - w0) <= max(radius, self.cell)
+        near = np.abs(self.w - float(point @ self.w_axis)) <= max(radius, self.cell)
         near &= (depth >= interval[0]) & (depth <= interval[1])
         if not near.any():
             return None
