@@ -89,11 +89,15 @@ def _built_for(file_name):
     return f"Python {major}.{minor}" + (f" on {target}" if target else "")
 
 
+def manifest_version():
+    """The add-on's version, as its manifest gives it (the one source of the version)."""
+    return tomllib.loads((PACKAGE_DIR / MANIFEST).read_text(encoding="utf-8"))["version"]
+
+
 def _what_to_install():
     """Which zip to install instead, for this Blender's Python and this platform."""
     python = sys.version_info[:2]
-    version = tomllib.loads((PACKAGE_DIR / MANIFEST).read_text(encoding="utf-8"))["version"]
-    name = zip_name(version, blender_platform(), python)
+    name = zip_name(manifest_version(), blender_platform(), python)
     blender = BLENDER_FOR_PYTHON.get(python)
     fits = blender.label if blender else f"Python {python[0]}.{python[1]}"
     return (f"Remove this add-on and install {name} instead, the zip for {fits} on {blender_platform()} "

@@ -44,14 +44,10 @@ def build_zip(source, output_dir):
                            "--output-dir", str(output_dir)], capture_output=True, text=True, timeout=120)
 
 
-def manifest_version():
-    return tomllib.loads((ROOT / "addon" / compat.MANIFEST).read_text(encoding="utf-8"))["version"]
-
-
 # --- what the zip holds ---------------------------------------------------------------------------------------------
 
 def test_zip_is_named_for_version_platform_and_python(addon_zip):
-    assert addon_zip.name == f"rigger-{manifest_version()}-{compat.blender_platform()}-py{PYTHON[0]}{PYTHON[1]}.zip"
+    assert addon_zip.name == f"rigger-{compat.manifest_version()}-{compat.blender_platform()}-py{PYTHON[0]}{PYTHON[1]}.zip"
 
 
 def test_zip_holds_the_package_in_one_folder_with_its_compiled_modules(addon_zip):
@@ -126,7 +122,7 @@ def package_copy(tmp_path, change):
 
 
 def zip_to_install():
-    return compat.zip_name(manifest_version(), compat.blender_platform(), PYTHON)
+    return compat.zip_name(compat.manifest_version(), compat.blender_platform(), PYTHON)
 
 
 def test_problem_names_a_missing_compiled_module(tmp_path):

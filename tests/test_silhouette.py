@@ -27,7 +27,7 @@ from scipy.sparse.csgraph import connected_components
 
 from rigger import silhouette
 
-from meshes import box, combine
+from meshes import box, combine, uv_sphere
 from rigdata import load_obj
 from union_reference import exact_union, frame_points, iou, traced_region
 
@@ -62,20 +62,8 @@ def torus(major=1.0, minor=0.3, center=(0, 0, 0), n=48):
 
 def sphere(center=(0, 0, 0), radius=1.0, n=24):
     """A closed UV sphere: n - 1 rings of n vertices between two poles."""
-    rings = [[np.sin(b) * np.cos(a), np.sin(b) * np.sin(a), np.cos(b)]
-             for b in np.pi * np.arange(1, n) / n for a in 2 * np.pi * np.arange(n) / n]
-    v = np.add(center, radius * np.array([[0, 0, 1], *rings, [0, 0, -1]]))
-    south, t = len(v) - 1, []
-    for j in range(n - 1):
-        for i in range(n):
-            a, b = 1 + j * n + i, 1 + j * n + (i + 1) % n
-            if j == 0:
-                t.append([0, a, b])
-            if j == n - 2:
-                t.append([a, south, b])
-            else:
-                t += [[a, a + n, b + n], [a, b + n, b]]
-    return v, np.array(t)
+    vertices, triangles = uv_sphere(rings=n, segments=n)
+    return np.add(center, radius * vertices), triangles
 
 
 def prism(polygon, depth=0.2):

@@ -23,7 +23,7 @@ class Mesh:
         triangles: (M, 3) int32, read-only, indexing ``vertices``; faces that repeat a vertex index are removed.
         degenerate_count: how many such faces were removed.
 
-    ``bbox``, ``scale``, ``unit_factor``, ``centroid`` and ``flat_normal`` describe the vertices that triangles use,
+    ``bbox``, ``scale``, ``unit_factor``, ``centroid`` and ``flat_normal`` describe the ``used_vertices``,
     so a stray loose vertex cannot distort them.
     """
 
@@ -52,7 +52,8 @@ class Mesh:
         return moved
 
     @cached_property
-    def _used_points(self):
+    def used_vertices(self):
+        """The vertices that triangles use (all of them, unless some are loose)."""
         used = np.zeros(len(self.vertices), dtype=bool)
         used[self.triangles.ravel()] = True
         return self.vertices if used.all() else self.vertices[used]
@@ -60,7 +61,7 @@ class Mesh:
     @cached_property
     def bbox(self):
         """(2, 3) float64: the minimum and maximum corner."""
-        return _read_only(column_bounds(self._used_points))
+        return _read_only(column_bounds(self.used_vertices))
 
     @cached_property
     def scale(self):
@@ -84,13 +85,13 @@ class Mesh:
     @cached_property
     def centroid(self):
         """(3,) float64: the mean position of the used vertices."""
-        points, factor = self._used_points, self.unit_factor  # summed at unit size: no overflow, the same bits
+        points, factor = self.used_vertices, self.unit_factor  # summed at unit size: no overflow, the same bits
         return _read_only(np.ones(len(points)) @ (points * factor) / len(points) / factor)  # BLAS: faster than mean
 
     @cached_property
     def _principal(self):
         """Principal variances (ascending) and axes (columns) of the used vertices, at ``unit_factor`` size."""
-        centred = self._used_points - self.centroid
+        centred = self.used_vertices - self.centroid
         centred *= self.unit_factor
         return np.linalg.eigh(centred.T @ centred)
 

@@ -141,7 +141,7 @@ class SilhouetteMethod(RigMethod):
             other_views = [found for found in (side_of, end_on) if found is not None]
         clock.lap("other_views")
 
-        plane = mirror_plane(vertices, 0.01 * mesh.scale)
+        plane = mirror_plane(mesh.used_vertices, mesh.bbox, 0.01 * mesh.scale)
         builder = _BoneBuilder(np.radians(bone_angle), unit, max_chain_bones, plane, MIRROR_TOLERANCE * mesh.scale)
         for placed in _placed_islands(sil, graph, alive, kept, SPECK * unit, side, split_layers):
             if isinstance(placed, Blob):

@@ -1,7 +1,6 @@
 """Bones from 3D chains: where joints go along a chain, the bone hierarchy, and names with mirror suffixes."""
 import numpy as np
 
-from ..core.arrays import column_bounds
 from .polyline import arc_lengths, point_at, resampled
 
 LONGEST = 3.0  # no bone longer than this many bone lengths, whatever max_bones says (a straight leg gets a knee)
@@ -132,14 +131,14 @@ def _turns(line, tolerance):
     return turns
 
 
-def mirror_plane(vertices, tolerance, samples=600):
-    """The axis (0, 1, 2) and offset of a plane the mesh is mirror-symmetric about, or None.
+def mirror_plane(vertices, bounds, tolerance, samples=600):
+    """The axis (0, 1, 2) and offset of a plane the ``vertices`` are mirror-symmetric about, or None.
 
-    Tries the planes through the bounding-box centre perpendicular to X, Y and Z; a plane fits when at least 95% of
+    Tries the planes through the centre of ``bounds`` (their (2, 3) bounding box) perpendicular to X, Y and Z; a plane fits when at least 95% of
     (up to ``samples``) vertices have a mirror image among the vertices within ``tolerance``: vertices are hashed to
     a grid of that size and the mirrored ones looked up in the sorted hashes, with their 26 neighbour cells.
     """
-    low, high = column_bounds(vertices)
+    low, high = bounds
     origin = low - 2 * tolerance
     span = np.floor((high - low) / tolerance).astype(np.int64) + 5
     table = np.unique(_cell_keys(np.floor((vertices - origin) / tolerance).astype(np.int64), span))
