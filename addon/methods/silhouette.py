@@ -130,7 +130,7 @@ class SilhouetteMethod(RigMethod):
 
         side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
         if side_view and flat is None:  # a flat mesh has nothing to hide in depth
-            spread = _variances(vertices)
+            spread = _variances(mesh.used_vertices)
             side_axis, end_axis = sorted((a for a in range(3) if a != axis), key=lambda a: spread[a])
             side_of = _other_view(vertices, triangles, sil, side_axis, resolution, outline_spacing, min_hole)
             end_resolution = max(MIN_VIEW_RESOLUTION, round(END_RESOLUTION * resolution))
