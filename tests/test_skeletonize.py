@@ -1,10 +1,12 @@
 """The skeleton-building steps on hand-made inputs: rooting a path, counting stacked parts, joints along a chain."""
 import numpy as np
 import pytest
+from meshes import box, combine
 
+from rigger import silhouette
 from rigger.skeletonize import depth
-from rigger.skeletonize.bones import chain_joints, symmetric_joints
-from rigger.skeletonize.polyline import arc_lengths
+from rigger.skeletonize.bones import chain_joints, reflection_in_view, symmetric_joints
+from rigger.skeletonize.polyline import arc_lengths, segment_distances
 from rigger.skeletonize.tree import Chain, chains_of, prune_spurs, rooted_chains
 
 
@@ -45,6 +47,31 @@ def test_a_wide_branch_reaching_far_is_a_limb_not_a_bump():
     assert (8, 9) in kept and len(kept) == 21
     bumped = {tuple(link) for link in prune_spurs(points, radius, chains, 1.35, 0.5)}
     assert (8, 9) not in bumped and len(bumped) == 12
+
+
+def test_a_spur_whose_mirror_image_is_kept_stays():
+    """A figure's two arms off its chest, mirror images across x = 0 but for the left one reaching a little less:
+    at prune 1.35 the right arm (sticking out 1.4 times its width) is kept and the left (1.3) would go. With the
+    reflection the left one stays with its image; a bump on one side only still goes, and both arms go once
+    neither is long enough."""
+    def arm(side, ratio):  # half-width 0.5 off a chest disc of radius 1: sticks out 0.5 + reach beyond it
+        return [(side * x, 0.0, 0.5) for x in np.linspace(1.5, 0.5 + ratio, 6)]
+    legs = [[(side, -y, 0.3) for y in range(2, 8)] for side in (-0.5, 0.5)]
+    bump = [(0.0, 1.3, 0.8), (0.0, 1.6, 0.8)]  # sticks out 1.4, 1.6 wide
+    nodes = np.array([(0.0, 0.0, 1.0)] + arm(1, 1.4) + arm(-1, 1.3) + legs[0] + legs[1] + bump)
+    points, radius = nodes[:, :2], nodes[:, 2]
+    chains = [[0] + list(range(k, k + 6)) for k in (1, 7, 13, 19)] + [[0, 25, 26]]
+
+    def reflect(p):
+        return p * [-1.0, 1.0]
+
+    def tips(links):  # of the right arm, the left arm and the bump
+        return [tip in links for tip in (6, 12, 26)]
+
+    assert tips(prune_spurs(points, radius, chains, 1.35)) == [True, False, False]
+    assert tips(prune_spurs(points, radius, chains, 1.35, mirror=reflect)) == [True, True, False]
+    assert tips(prune_spurs(points, radius, chains, 1.45, mirror=reflect)) == [False, False, False]
+    assert tips(prune_spurs(points, radius, chains, 0.8, mirror=reflect)) == [True, True, True]
 
 
 def layers(*intervals):
@@ -236,3 +263,19 @@ def test_mirror_pair_chains_get_mirror_image_joints():
         assert result[k] is joints[k]
     fewer = symmetric_joints([left, right[::2]], [left, right], (0, 0.0), 0.05)  # the one with more joints decides
     np.testing.assert_allclose(fewer[1], right)
+
+
+def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_at_all():
+    """Two boxes mirrored across x = 2: seen along Y or Z every outline point reflects onto the outline; seen along
+    X, across the plane, there is no reflection in the view."""
+    vertices, triangles = combine(box((0.0, 0.0, 0.0), (1.0, 2.0, 3.0)), box((3.0, 0.0, 0.0), (4.0, 2.0, 3.0)),
+                                  box((0.5, 1.0, 0.0), (3.5, 1.5, 0.5)))
+    for view in ("Y", "-Z"):
+        sil = silhouette.trace(vertices, triangles, view)
+        outline = np.concatenate(sil.loops)
+        starts, ends = outline, np.concatenate([np.roll(loop, -1, axis=0) for loop in sil.loops])
+        image = reflection_in_view(sil, (0, 2.0))(outline)
+        assert segment_distances(image, starts, ends).min(axis=1).max() < sil.cell  # onto the outline
+        assert np.abs(image - outline).max() > 1  # and moved
+    assert reflection_in_view(silhouette.trace(vertices, triangles, "X"), (0, 2.0)) is None
+    assert reflection_in_view(silhouette.trace(vertices, triangles, "Y"), None) is None

@@ -22,7 +22,7 @@ from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
 from ..core.timing import StageClock
-from ..skeletonize.bones import bone_names, chain_joints, mirror_plane, symmetric_joints
+from ..skeletonize.bones import bone_names, chain_joints, mirror_plane, reflection_in_view, symmetric_joints
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
 from ..skeletonize.polyline import nearest_on_segments
@@ -125,7 +125,8 @@ class SilhouetteMethod(RigMethod):
 
         unit = bone_length * mesh.scale  # the bone length in mesh units
         reaches = (MIN_BRANCH * unit, KEEP_REACH * mesh.scale)  # prune_spurs' min_reach and max_reach
-        alive, merged, kept = _pruned_tree(graph, merge, prune, reaches)
+        plane = mirror_plane(mesh.used_vertices, mesh.bbox, 0.01 * mesh.scale)
+        alive, merged, kept = _pruned_tree(graph, merge, prune, reaches, reflection_in_view(sil, plane))
         clock.lap("merge_prune")
 
         side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
@@ -141,7 +142,6 @@ class SilhouetteMethod(RigMethod):
             other_views = [found for found in (side_of, end_on) if found is not None]
         clock.lap("other_views")
 
-        plane = mirror_plane(mesh.used_vertices, mesh.bbox, 0.01 * mesh.scale)
         builder = _BoneBuilder(np.radians(bone_angle), unit, max_chain_bones, plane, MIRROR_TOLERANCE * mesh.scale)
         for placed in _placed_islands(sil, graph, alive, kept, SPECK * unit, side, split_layers):
             if isinstance(placed, Blob):
@@ -224,13 +224,13 @@ def _to_world(stages, frame, factor, *points):
     return [place(array) for array in points]
 
 
-def _pruned_tree(graph, merge, prune, reaches):
-    """Blob merging and spur pruning of a chordal axis, ``reaches`` being ``prune_spurs``' (min_reach, max_reach):
-    (alive nodes, merged links, kept links)."""
+def _pruned_tree(graph, merge, prune, reaches, mirror=None):
+    """Blob merging and spur pruning of a chordal axis, ``reaches`` being ``prune_spurs``' (min_reach, max_reach)
+    and ``mirror`` its reflection: (alive nodes, merged links, kept links)."""
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
     alive = np.unique(representative)
     _, chains = chains_of(alive.tolist(), merged)
-    return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, *reaches)
+    return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, *reaches, mirror=mirror)
 
 
 def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):

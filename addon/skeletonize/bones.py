@@ -57,6 +57,22 @@ def mirrored(points, plane):
     return image
 
 
+def reflection_in_view(sil, plane, snap=1e-6):
+    """The reflection across ``plane`` = (axis, offset) of points (P, 2) in the plane of view ``sil`` (a
+    ``Silhouette``), or None when there is no plane or the view does not look along it (off by more than ``snap``):
+    seen from the side, a plane's two halves hide each other."""
+    if plane is None:
+        return None
+    axis, offset = plane
+    if abs(sil.direction[axis]) > snap:
+        return None
+    normal = np.array([sil.u[axis], sil.v[axis]])  # the plane's normal, in the view's plane
+
+    def reflect(points):
+        return points - 2 * (sil.origin[axis] + points @ normal - offset)[:, None] * normal
+    return reflect
+
+
 def _candidate_stops(line, arc, widths, bone_angle, bone_length):
     """Arc lengths where a joint belongs, most important first, and how many of them are needed: leaving the branch
     point's disc, corners by how sharply they turn and the bends a straight bone would leave the part at (its axis

@@ -93,7 +93,7 @@ def _walk(start, first, neighbours, keys, arrived):
     return path
 
 
-def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf):
+def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, mirror=None):
     """Drop leaf chains that stick out of the disc of the node they hang on by less than ``prune`` times their own
     width, or by less than ``min_reach``, but never by ``max_reach`` or more, until none does. ``chains`` are node
     lists; returns the surviving links.
@@ -101,6 +101,8 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf):
     A limb is long for its width where it leaves the base (a leg, a finger, a tail, a neck with its head) while
     outline noise and bumps (an ear on a round head, a belly) are not, whatever their size, up to ``max_reach``: a
     part reaching that far needs bones of its own however wide it is (a cow's short thick neck with its head).
+    With ``mirror``, a function reflecting (P, 2) points across the mesh's mirror plane, a spur whose mirror image
+    is kept stays too: a figure's two arms, each near the threshold, are kept or dropped together.
     """
     chains = [list(c) for c in chains]
     while True:
@@ -108,7 +110,7 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf):
         for chain in chains:
             for end in (chain[0], chain[-1]):
                 degree[end] = degree.get(end, 0) + 1
-        spurs = []
+        spurs, kept_leaves = {}, {}  # chain -> (base, tip)
         for i, chain in enumerate(chains):
             for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
                 if degree[tip] == 1 and degree[base] >= 3:
@@ -117,17 +119,30 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf):
                     ordered = np.array(chain if chain[0] == base else chain[::-1])
                     out = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]][:3]
                     width = 2 * float(radius[out].mean()) if len(out) else 2 * float(radius[tip])
-                    if beyond <= max(prune * width, min_reach) and beyond < max_reach:
-                        spurs.append(i)
+                    spur = beyond <= max(prune * width, min_reach) and beyond < max_reach
+                    (spurs if spur else kept_leaves)[i] = base, tip
                     break
+        if spurs and mirror is not None:
+            spurs = _unmirrored(spurs, kept_leaves, chains, points, radius, mirror)
         if not spurs:
             return _links_of(chains)
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
-        spurs = set(spurs)
         kept = [c for i, c in enumerate(chains) if i not in spurs]
         if not kept:
             return np.zeros((0, 2), dtype=np.int64)
         _, chains = chains_of(sorted({n for c in kept for n in c}), _links_of(kept))
+
+
+def _unmirrored(spurs, kept_leaves, chains, points, radius, mirror):
+    """The ``spurs`` (chain -> (base, tip)) whose tip's mirror image lies in no disc of a leaf branch kept off the
+    same base."""
+    left = {}
+    for i, (base, tip) in spurs.items():
+        image = mirror(points[tip][None])[0]
+        nodes = [np.array(chains[k]) for k, (other, _) in kept_leaves.items() if other == base]
+        if not any((np.linalg.norm(points[n] - image, axis=1) <= radius[n]).any() for n in nodes):
+            left[i] = base, tip
+    return left
 
 
 def _links_of(chains):
