@@ -47,7 +47,8 @@ def build_zip(source, output_dir):
 # --- what the zip holds ---------------------------------------------------------------------------------------------
 
 def test_zip_is_named_for_version_platform_and_python(addon_zip):
-    assert addon_zip.name == f"rigger-{compat.manifest_version()}-{compat.blender_platform()}-py{PYTHON[0]}{PYTHON[1]}.zip"
+    version, platform_name = compat.manifest_version(), compat.blender_platform()
+    assert addon_zip.name == f"rigger-{version}-{platform_name}-py{PYTHON[0]}{PYTHON[1]}.zip"
 
 
 def test_zip_holds_the_package_in_one_folder_with_its_compiled_modules(addon_zip):
