@@ -13,7 +13,7 @@ Example::
     sil.project(points3d)         # (points, depths) in the view's frame: the inverse of lift
     sil.encloses(points3d)        # the ray hits the mesh and the depth lies between its nearest and farthest hit
 
-How it works, and why it cannot fail: the projected triangles are snapped to an integer lattice (65536 steps per
+How it works, and why tracing cannot fail: the projected triangles are snapped to an integer lattice (65536 steps per
 grid cell) and every inside/outside decision is exact integer arithmetic under a symbolic perturbation, so no grid
 point ever sits on an edge and shared edges leave no cracks. Along each horizontal and vertical grid line the union
 of the triangles' cross-sections is computed exactly; the outline passes through those exact crossing points and is
@@ -172,13 +172,13 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
     if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)) or not 0 <= tol <= 1:
         raise ValueError(f"tolerance must be a number in [0, 1] (a fraction of a grid cell), got {tol!r}")
     handle = _rigger_silhouette.trace(verts, tris, view, int(res), float(tol))
-    origin, u, v, unit = handle.frame()
-    _, cell, _, _ = handle.grid()
     loops = handle.loops()
     if not loops:
         raise PartsTooSmall(f"no part of the mesh covers a grid cell seen along {tuple(float(c) for c in view)} "
                            f"({res} cells along the projection's longest side): its parts are too small for "
                            f"the space between them; rig them separately or raise the resolution")
+    origin, u, v, unit = handle.frame()
+    _, cell, _, _ = handle.grid()
     return Silhouette(loops, origin, u, v, unit, cell, handle)
 
 

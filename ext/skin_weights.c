@@ -35,8 +35,8 @@ const char *sw_error_message(int code)
     switch (code) {
     case SW_OK: return "ok";
     case SW_ERR_NOMEM: return "out of memory computing skin weights";
-    case SW_ERR_ARGUMENT: return "skin weights need 1 to SW_MAX_BONES bones, per_point >= 1, power > 0 and a "
-                                 "finite facing_penalty >= 0";
+    case SW_ERR_ARGUMENT: return "skin weights need 1 to INT32_MAX / 2 (1073741823) bones, per_point >= 1, "
+                                 "power > 0 and a finite facing_penalty >= 0";
     default: return "unknown skin weights error";
     }
 }

@@ -32,6 +32,8 @@ def bone_weights(const double[:, ::1] points, const double[:, ::1] normals, cons
     if heads.shape[0] == 0 or tails.shape[0] != heads.shape[0] or points.shape[1] != 3 or heads.shape[1] != 3 \
             or tails.shape[1] != 3 or (normals is not None and (normals.shape[0] != n or normals.shape[1] != 3)):
         raise ValueError("points (N, 3), normals (N, 3) or None, heads and tails (B, 3) with B >= 1 expected")
+    if heads.shape[0] > SW_MAX_BONES:  # checked before narrowing to int32, where a larger count would wrap
+        raise ValueError(f"at most {SW_MAX_BONES} bones are supported, got {heads.shape[0]}")
     cdef int32_t[:, ::1] bones_view = bones
     cdef double[:, ::1] weights_view = weights
     cdef const double *normals_data = NULL if normals is None else &normals[0, 0]

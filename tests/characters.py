@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from rigger import samples
-from rigger.blender.headless import temporary_user_folder
+from rigger.blender.headless import empty_scene, temporary_user_folder
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "bench"))
 import rigdata  # noqa: E402  (bench/ is no package)
@@ -52,7 +52,7 @@ def winding_numbers(vertices, triangles, points):
     return rigdata.winding_numbers(points, vertices, triangles)
 
 
-def inside_fraction(vertices, triangles, points):
+def strictly_inside_fraction(vertices, triangles, points):
     """Fraction of ``points`` inside the mesh (winding number > 0.5). Stricter than ``rigdata.inside_fraction``,
     which counts inward-facing parts as inside too."""
     return float((winding_numbers(vertices, triangles, points) > 0.5).mean())
@@ -62,7 +62,6 @@ def _write_characters(directory):
     """Child-process side: build every character with bpy and save its arrays into ``directory``."""
     temporary_user_folder()
     import bpy  # noqa: F401  (first: Blender's own modules, bmesh among them, import only once bpy is)
-    from rigger.blender.headless import empty_scene
     from rigger.blender.samples import character_arrays
 
     empty_scene()

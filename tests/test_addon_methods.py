@@ -10,11 +10,12 @@ import sys
 
 import pytest
 
-from conftest import ROOT, activate, empty_scene
+from conftest import ROOT, activate
 
 bpy = pytest.importorskip("bpy")
 import addon_utils  # noqa: E402  (Blender's own module, importable once bpy is)
 
+from rigger.blender.headless import empty_scene  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
 
 

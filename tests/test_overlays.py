@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from conftest import empty_scene
 from stages import lift
 
 bpy = pytest.importorskip("bpy")
 
 import rigger  # noqa: E402
 from rigger.blender import overlays, samples  # noqa: E402
+from rigger.blender.headless import empty_scene  # noqa: E402
 from rigger.blender.meshdata import mesh_vertices  # noqa: E402
 from rigger.methods._template import TemplateMethod  # noqa: E402
 from rigger.skeletonize.chordal import ISOLATED, JUNCTION, SLEEVE, TERMINAL  # noqa: E402

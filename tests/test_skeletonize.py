@@ -74,6 +74,18 @@ def test_a_spur_whose_mirror_image_is_kept_stays():
     assert tips(prune_spurs(points, radius, chains, 0.8, mirror=reflect)) == [True, True, True]
 
 
+def test_outline_noise_is_not_kept_for_lying_on_the_body_it_mirrors_onto():
+    """Two specks of outline noise mirroring each other on the edge of the chest's disc, between two legs: each
+    speck's image lies on the chest, not on a kept branch, so both go."""
+    legs = [[(side, -y, 0.3) for y in range(2, 8)] for side in (-0.5, 0.5)]
+    specks = [(0.5, 0.85, 0.01), (-0.5, 0.85, 0.01)]  # 0.99 from the chest's centre, 1.0 its radius
+    nodes = np.array([(0.0, 0.0, 1.0)] + legs[0] + legs[1] + specks)
+    points, radius = nodes[:, :2], nodes[:, 2]
+    chains = [[0] + list(range(1, 7)), [0] + list(range(7, 13)), [0, 13], [0, 14]]
+    kept = prune_spurs(points, radius, chains, 1.35, mirror=lambda p: p * [-1.0, 1.0])
+    assert 13 not in kept and 14 not in kept and 12 in kept
+
+
 def layers(*intervals):
     return np.array(intervals, dtype=float).reshape(-1, 2)
 

@@ -183,12 +183,15 @@ class RIGGER_OT_direction_from_view(bpy.types.Operator):
 
     def execute(self, context):
         settings = getattr(context.scene, SETTINGS_ATTRIBUTE)
-        props = getattr(settings.methods, settings.method, None)
-        method = method_registry().methods.get(settings.method)
-        if props is None or not any(p.name == self.param and p.type == "vector" for p in getattr(method, "params", ())):
+        try:
+            method = method_registry().lookup(settings.method)
+        except ValueError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        if not any(p.name == self.param and p.type == "vector" for p in method.params):
             self.report({'ERROR'}, f"{settings.method} has no direction parameter {self.param!r}")
             return {'CANCELLED'}
-        setattr(props, self.param, looking_along(view_of(context).view_rotation))
+        setattr(getattr(settings.methods, method.name), self.param, looking_along(view_of(context).view_rotation))
         return {'FINISHED'}
 
 

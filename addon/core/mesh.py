@@ -34,29 +34,37 @@ class Mesh:
 
     def at_unit_size(self, rotation=None):
         """This mesh scaled by ``unit_factor`` (a power of two: exact) and turned by the orthonormal ``rotation`` (rows:
-        the new axes), sharing its triangles. A similarity keeps a valid mesh valid, so only a loose vertex that
-        would overflow is checked for; unturned, the measures already taken carry over, scaled exactly."""
+        the new axes), sharing its triangles. A similarity keeps a valid mesh valid, so only a vertex that would
+        overflow (one far from the others, or a tiny mesh far from the origin) is checked for; which vertices are
+        used carries over, and unturned, the measures already taken do too, scaled exactly."""
         factor = self.unit_factor
         with np.errstate(over="ignore"):
             vertices = self.vertices * factor
         far = nonfinite_rows(vertices) if factor > 1 else ()  # scaling down cannot overflow
         if len(far):
             raise ValueError(f"vertex {far[0]} at {self.vertices[far[0]]} lies too far from a mesh {self.scale:.3g} "
-                             f"big to rig it at unit size; remove that loose vertex")
+                             f"big to rig it at unit size; move the mesh nearer the origin, or remove that vertex if "
+                             f"it is loose")
         moved = object.__new__(Mesh)
         moved.vertices = _read_only(vertices if rotation is None else vertices @ np.asarray(rotation).T)
         moved.triangles, moved.degenerate_count = self.triangles, self.degenerate_count
-        if rotation is None:  # cached_property values live in the instance dict
+        moved.__dict__["_used"] = self._used  # cached_property values live in the instance dict
+        if rotation is None:
             moved.__dict__.update(bbox=_read_only(self.bbox * factor), centroid=_read_only(self.centroid * factor),
-                                  _principal=self._principal)  # taken at unit size already
+                                  _scatter=self._scatter)  # taken at unit size already
         return moved
+
+    @cached_property
+    def _used(self):
+        """Which vertices triangles use, or None when all are."""
+        used = np.zeros(len(self.vertices), dtype=bool)
+        used[self.triangles.ravel()] = True
+        return None if used.all() else used
 
     @cached_property
     def used_vertices(self):
         """The vertices that triangles use (all of them, unless some are loose)."""
-        used = np.zeros(len(self.vertices), dtype=bool)
-        used[self.triangles.ravel()] = True
-        return self.vertices if used.all() else self.vertices[used]
+        return self.vertices if self._used is None else self.vertices[self._used]
 
     @cached_property
     def bbox(self):
@@ -66,7 +74,8 @@ class Mesh:
     @cached_property
     def scale(self):
         """The largest extent of the bounding box: the length that makes tolerances scale-free. ValueError when
-        it is not a normal float64 number at least 2**-1022 and below 2**1023 (so that ``unit_factor`` is one)."""
+        it is not a normal float64 number at least 2**-1022 and below 2**1023 (so that ``unit_factor`` is a normal
+        power of two)."""
         with np.errstate(over="ignore"):
             extent = float((self.bbox[1] - self.bbox[0]).max())
         if not extent < 2.0 ** 1023:
@@ -89,11 +98,22 @@ class Mesh:
         return _read_only(np.ones(len(points)) @ (points * factor) / len(points) / factor)  # BLAS: faster than mean
 
     @cached_property
-    def _principal(self):
-        """Principal variances (ascending) and axes (columns) of the used vertices, at ``unit_factor`` size."""
+    def _scatter(self):
+        """The (3, 3) scatter matrix of the used vertices about their centroid, at ``unit_factor`` size."""
         centred = self.used_vertices - self.centroid
         centred *= self.unit_factor
-        return np.linalg.eigh(centred.T @ centred)
+        return centred.T @ centred
+
+    @cached_property
+    def spread(self):
+        """(3,) float64: how far the used vertices spread along each axis (their summed squared offsets from the
+        centroid, at ``unit_factor`` size): proportional to the per-axis variances."""
+        return _read_only(np.diag(self._scatter).copy())
+
+    @cached_property
+    def _principal(self):
+        """Principal variances (ascending) and axes (columns) of the used vertices, at ``unit_factor`` size."""
+        return np.linalg.eigh(self._scatter)
 
     @cached_property
     def flat_normal(self):

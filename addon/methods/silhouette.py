@@ -131,8 +131,7 @@ class SilhouetteMethod(RigMethod):
 
         side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
         if side_view and flat is None:  # a flat mesh has nothing to hide in depth
-            spread = _variances(mesh.used_vertices)
-            side_axis, end_axis = sorted((a for a in range(3) if a != axis), key=lambda a: spread[a])
+            side_axis, end_axis = sorted((a for a in range(3) if a != axis), key=lambda a: mesh.spread[a])
             side_of = _other_view(vertices, triangles, sil, side_axis, resolution, outline_spacing, min_hole)
             end_resolution = max(MIN_VIEW_RESOLUTION, round(END_RESOLUTION * resolution))
             end_on = _other_view(vertices, triangles, sil, end_axis, end_resolution, outline_spacing, min_hole)
@@ -160,7 +159,6 @@ class SilhouetteMethod(RigMethod):
         clock.lap("names")
 
         stages = {
-            "view": sil.direction,
             "silhouette": {"loops": sil.loops, "origin": sil.origin, "u": sil.u, "v": sil.v,
                            "direction": sil.direction, "depth": float((mesh.centroid - sil.origin) @ sil.direction)},
             "cdt": {"vertices": tri.vertices, "triangles": tri.triangles, "classes": triangle_classes(tri)},
@@ -306,10 +304,8 @@ def axes_by_spread(vertices, triangles):
     return [int(a) for a in np.argsort([-(variances.sum() - variances[a]) for a in range(3)], kind="stable")]
 
 
-def _variances(vertices, triangles=None):
-    """Per-axis variance of the surface (area-weighted triangle centroids), or of the vertices."""
-    if triangles is None:
-        return vertices.var(axis=0)
+def _variances(vertices, triangles):
+    """Per-axis variance of the surface (area-weighted triangle centroids)."""
     triangles = triangles[::max(1, len(triangles) // SPREAD_SAMPLES)]  # a regular sample is plenty for a variance
     a, b, c = (np.take(vertices, triangles[:, k], axis=0) for k in range(3))  # take: far faster than indexing
     points = (a + b + c) / 3
@@ -419,14 +415,14 @@ class _BoneBuilder:
         pairs stay mirror pairs."""
         if not limbs:
             return
-        chains, ups, far = [], [], []  # far: (limb number, meets) of the limbs to extend
+        chains, ups, meets_of = [], [], {}  # meets_of: limb number -> where it meets its bone, for the limbs to extend
         for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
             up, meets = self._attachment(line[0], views)  # from the left one's extension, which passes nearer it)
             if meets is not None and np.linalg.norm(line[0] - meets) > BRIDGE * self.bone_length:
-                far.append((len(chains), meets))
+                meets_of[len(chains)] = meets
             chains.append((line, widths, True))
             ups.append(up)
-        ends, meets_of = {}, dict(far)  # ends: limb number -> the bridge chain it hangs from
+        ends = {}  # limb number -> the bridge chain it hangs from
         for members in self._sharing(meets_of, ups, [line[0] for line, _, _ in chains]):
             meets = np.mean([meets_of[k] for k in members], axis=0)
             shared = len(members) > 1

@@ -61,16 +61,9 @@ def reflection_in_view(sil, plane, snap=1e-6):
     """The reflection across ``plane`` = (axis, offset) of points (P, 2) in the plane of view ``sil`` (a
     ``Silhouette``), or None when there is no plane or the view does not look along it (off by more than ``snap``):
     seen from the side, a plane's two halves hide each other."""
-    if plane is None:
+    if plane is None or abs(sil.direction[plane[0]]) > snap:
         return None
-    axis, offset = plane
-    if abs(sil.direction[axis]) > snap:
-        return None
-    normal = np.array([sil.u[axis], sil.v[axis]])  # the plane's normal, in the view's plane
-
-    def reflect(points):
-        return points - 2 * (sil.origin[axis] + points @ normal - offset)[:, None] * normal
-    return reflect
+    return lambda points: sil.project(mirrored(sil.lift(points, 0.0), plane))[0]
 
 
 def _candidate_stops(line, arc, widths, bone_angle, bone_length):

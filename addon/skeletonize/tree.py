@@ -6,7 +6,8 @@ A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch p
    first, swallows the axis nodes it reaches without leaving its disc. A round head or belly thus becomes one node
    instead of a tree of spurious little branches.
 2. Spur pruning: a branch that pokes out of the disc it hangs on by less than ``prune`` times its own width is a
-   bump or outline noise, not a limb; it is removed, repeatedly, since removing one can expose another.
+   bump or outline noise, not a limb; it is removed, repeatedly, since removing one can expose another. A branch
+   reaching far enough is kept however wide, and so is one whose mirror image is kept.
 3. Rooting at the most central branch point (smallest largest distance to any end), then cutting every cycle (holes
    in the silhouette) where the two ways around it from the root meet. A path without branch points is rooted at
    its widest node, or at its thicker end when it is about equally wide throughout.
@@ -102,7 +103,8 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
     outline noise and bumps (an ear on a round head, a belly) are not, whatever their size, up to ``max_reach``: a
     part reaching that far needs bones of its own however wide it is (a cow's short thick neck with its head).
     With ``mirror``, a function reflecting (P, 2) points across the mesh's mirror plane, a spur whose mirror image
-    is kept stays too: a figure's two arms, each near the threshold, are kept or dropped together.
+    is a branch kept off the same base stays too: a figure's two arms off its chest, each near the threshold, are
+    kept or dropped together.
     """
     chains = [list(c) for c in chains]
     while True:
@@ -110,20 +112,22 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
         for chain in chains:
             for end in (chain[0], chain[-1]):
                 degree[end] = degree.get(end, 0) + 1
-        spurs, kept_leaves = {}, {}  # chain -> (base, tip)
+        spurs, kept_leaves = {}, {}  # chain -> (base, tip); chain -> (base, its nodes outside the base's disc)
         for i, chain in enumerate(chains):
             for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
                 if degree[tip] == 1 and degree[base] >= 3:
                     beyond = np.linalg.norm(points[tip] - points[base]) + radius[tip] - radius[base]
                     # width where the branch leaves the base disc: a neck, not the head it carries
                     ordered = np.array(chain if chain[0] == base else chain[::-1])
-                    out = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]][:3]
-                    width = 2 * float(radius[out].mean()) if len(out) else 2 * float(radius[tip])
-                    spur = beyond <= max(prune * width, min_reach) and beyond < max_reach
-                    (spurs if spur else kept_leaves)[i] = base, tip
+                    outside = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]]
+                    width = 2 * float(radius[outside[:3]].mean()) if len(outside) else 2 * float(radius[tip])
+                    if beyond <= max(prune * width, min_reach) and beyond < max_reach:
+                        spurs[i] = base, tip
+                    else:
+                        kept_leaves[i] = base, outside
                     break
         if spurs and mirror is not None:
-            spurs = _unmirrored(spurs, kept_leaves, chains, points, radius, mirror)
+            spurs = _unmirrored(spurs, kept_leaves.values(), points, radius, mirror)
         if not spurs:
             return _links_of(chains)
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
@@ -133,14 +137,18 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
         _, chains = chains_of(sorted({n for c in kept for n in c}), _links_of(kept))
 
 
-def _unmirrored(spurs, kept_leaves, chains, points, radius, mirror):
+def _unmirrored(spurs, kept_leaves, points, radius, mirror):
     """The ``spurs`` (chain -> (base, tip)) whose tip's mirror image lies in no disc of a leaf branch kept off the
-    same base."""
+    same base (``kept_leaves``: (base, its nodes outside the base's disc) each; the base's own disc covers the body,
+    so a bump whose image falls on it still goes)."""
+    beside = {}
+    for base, outside in kept_leaves:
+        beside.setdefault(base, []).append(outside)
+    images = mirror(points[[tip for _, tip in spurs.values()]])
     left = {}
-    for i, (base, tip) in spurs.items():
-        image = mirror(points[tip][None])[0]
-        nodes = [np.array(chains[k]) for k, (other, _) in kept_leaves.items() if other == base]
-        if not any((np.linalg.norm(points[n] - image, axis=1) <= radius[n]).any() for n in nodes):
+    for (i, (base, tip)), image in zip(spurs.items(), images):
+        nodes = np.concatenate(beside.get(base, [np.zeros(0, np.int64)]))
+        if not (np.linalg.norm(points[nodes] - image, axis=1) <= radius[nodes]).any():
             left[i] = base, tip
     return left
 
