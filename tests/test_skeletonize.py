@@ -86,6 +86,29 @@ def test_outline_noise_is_not_kept_for_lying_on_the_body_it_mirrors_onto():
     assert 13 not in kept and 14 not in kept and 12 in kept
 
 
+def test_a_round_part_without_a_neck_is_kept():
+    """A gingerbread man's head on its shoulders: the body's blob (radius 1) carries a head blob (radius 0.85)
+    centred 1.1 away, just off the body's disc, through one node as wide as the head: it sticks out 0.95, under
+    prune (1.35) times its width (1.7), so without ``blobs`` it goes as a bump. As a blob of its own it stays;
+    a smaller blob, or one centred on the body's disc, goes."""
+    legs = [[(side, -y, 0.3) for y in range(2, 8)] for side in (-0.5, 0.5)]
+
+    def head_kept(head, is_blob=True):
+        nodes = np.array([(0.0, 0.0, 1.0)] + legs[0] + legs[1] + [(0.0, 1.05, head[2]), head])
+        points, radius = nodes[:, :2], nodes[:, 2]
+        chains = [[0] + list(range(1, 7)), [0] + list(range(7, 13)), [0, 13, 14]]
+        blobs = np.zeros(len(nodes), bool)
+        blobs[[0, 14]] = True, is_blob
+        kept = prune_spurs(points, radius, chains, 1.35, blobs=blobs)
+        assert 12 in kept  # the legs are limbs whatever happens to the head
+        return 14 in kept
+
+    assert head_kept((0.0, 1.1, 0.85))
+    assert not head_kept((0.0, 1.1, 0.85), is_blob=False)
+    assert not head_kept((0.0, 1.1, 0.6))  # a bump ending in a smaller blob (an ear on a head)
+    assert not head_kept((0.0, 0.95, 0.85))  # a blob centred inside the body's disc
+
+
 def layers(*intervals):
     return np.array(intervals, dtype=float).reshape(-1, 2)
 

@@ -228,7 +228,8 @@ def _pruned_tree(graph, merge, prune, reaches, mirror=None):
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
     alive = np.unique(representative)
     _, chains = chains_of(alive.tolist(), merged)
-    return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, *reaches, mirror=mirror)
+    return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, *reaches, mirror=mirror,
+                                      blobs=graph.junction)
 
 
 def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):

@@ -7,7 +7,8 @@ A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch p
    instead of a tree of spurious little branches.
 2. Spur pruning: a branch that pokes out of the disc it hangs on by less than ``prune`` times its own width is a
    bump or outline noise, not a limb; it is removed, repeatedly, since removing one can expose another. A branch
-   reaching far enough is kept however wide, and so is one whose mirror image is kept.
+   reaching far enough is kept however wide, and so is one ending in a round part of its own (a head without a
+   neck) or one whose mirror image is kept.
 3. Rooting at the most central branch point (smallest largest distance to any end), then cutting every cycle (holes
    in the silhouette) where the two ways around it from the root meet. A path without branch points is rooted at
    its widest node, or at its thicker end when it is about equally wide throughout.
@@ -20,6 +21,7 @@ import numpy as np
 from .polyline import arc_lengths, length
 
 UNIFORM = 1.25  # a path whose widest node is at most this many times its median width is a column, not a body
+ROUND_TIP = 0.7  # a spur ending in a blob at least this share of its base's width, outside the base's disc, is a part
 
 
 @dataclass
@@ -94,7 +96,7 @@ def _walk(start, first, neighbours, keys, arrived):
     return path
 
 
-def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, mirror=None):
+def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, mirror=None, blobs=None):
     """Drop leaf chains that stick out of the disc of the node they hang on by less than ``prune`` times their own
     width, or by less than ``min_reach``, but never by ``max_reach`` or more, until none does. ``chains`` are node
     lists; returns the surviving links.
@@ -102,6 +104,10 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
     A limb is long for its width where it leaves the base (a leg, a finger, a tail, a neck with its head) while
     outline noise and bumps (an ear on a round head, a belly) are not, whatever their size, up to ``max_reach``: a
     part reaching that far needs bones of its own however wide it is (a cow's short thick neck with its head).
+    With ``blobs``, a (n,) mask of the nodes that stand for a round part (junctions, which swallow the axis within
+    their disc), a spur ending in one whose centre lies outside the base's disc and whose width is at least
+    ``ROUND_TIP`` times the base's is kept: a gingerbread man's head sits on its shoulders without a neck, and a
+    cartoon's round feet hang straight off its hips.
     With ``mirror``, a function reflecting (P, 2) points across the mesh's mirror plane, a spur whose mirror image
     is a branch kept off the same base stays too: a figure's two arms off its chest, each near the threshold, are
     kept or dropped together.
@@ -121,7 +127,8 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
                     ordered = np.array(chain if chain[0] == base else chain[::-1])
                     outside = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]]
                     width = 2 * float(radius[outside[:3]].mean()) if len(outside) else 2 * float(radius[tip])
-                    if beyond <= max(prune * width, min_reach) and beyond < max_reach:
+                    if beyond <= max(prune * width, min_reach) and beyond < max_reach and not (
+                            blobs is not None and _round_part(points, radius, blobs, base, tip)):
                         spurs[i] = base, tip
                     else:
                         kept_leaves[i] = base, outside
@@ -135,6 +142,12 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
         if not kept:
             return np.zeros((0, 2), dtype=np.int64)
         _, chains = chains_of(sorted({n for c in kept for n in c}), _links_of(kept))
+
+
+def _round_part(points, radius, blobs, base, tip):
+    """Whether leaf node ``tip`` is a blob as wide as a part of its own, lying off the disc of ``base``."""
+    return bool(blobs[tip]) and radius[tip] >= ROUND_TIP * radius[base] and (
+        np.linalg.norm(points[tip] - points[base]) > radius[base])
 
 
 def _unmirrored(spurs, kept_leaves, points, radius, mirror):
