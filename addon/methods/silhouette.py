@@ -224,9 +224,12 @@ def _to_world(stages, frame, factor, *points):
 
 def _pruned_tree(graph, merge, prune, reaches, mirror=None):
     """Blob merging and spur pruning of a chordal axis, ``reaches`` being ``prune_spurs``' (min_reach, max_reach)
-    and ``mirror`` its reflection: (alive nodes, merged links, kept links)."""
+    and ``mirror`` its reflection: (alive nodes, merged links, kept links). With ``mirror``, the blobs straddling
+    the mirror line are first centred on it (moving ``graph``'s points)."""
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
     alive = np.unique(representative)
+    if mirror is not None:
+        graph.centre_on_mirror(alive[graph.junction[alive]], mirror)
     _, chains = chains_of(alive.tolist(), merged)
     return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, *reaches, mirror=mirror,
                                       blobs=graph.junction)

@@ -35,6 +35,15 @@ class AxisGraph:
     links: np.ndarray
     island: np.ndarray
 
+    def centre_on_mirror(self, hubs, mirror):
+        """Move each of the nodes ``hubs`` whose mirror image (``mirror`` reflects (P, 2) points across the mesh's
+        mirror plane) lies within its own disc halfway to that image, onto the mirror line, in place. The
+        triangulation of a symmetric outline is not symmetric: a body's centre left off the line would hang a
+        figure's left and right limbs from it at different angles."""
+        image = mirror(self.points[hubs])
+        near = np.linalg.norm(image - self.points[hubs], axis=1) <= self.radius[hubs]
+        self.points[hubs[near]] = 0.5 * (self.points[hubs[near]] + image[near])
+
 
 def triangle_classes(tri):
     """Class of every triangle of a ``rigger.cdt`` triangulation (TERMINAL, SLEEVE, JUNCTION or ISOLATED)."""
