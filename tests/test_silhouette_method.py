@@ -141,16 +141,17 @@ def test_a_symmetric_character_gets_a_symmetric_rig(default_rig):
 
 
 def test_a_figure_whose_triangulation_is_lopsided_gets_a_symmetric_rig():
-    """A gingerbread man (flattish ellipsoids: a body, a head on it without a neck, two legs) seen from the front:
-    the triangulation of its symmetric outline is not symmetric, and the centre of the body's blob lies off the
-    mirror plane unless put back on it, so the legs hanging from it would get different bones."""
+    """A gingerbread man (flattish ellipsoids: a body, a head, two legs) seen from the front: the triangulation
+    of its symmetric outline is not symmetric, and the centre of the body's blob lies off the mirror plane unless
+    put back on it, so the legs hanging from it would get different bones."""
     legs = [((x, 0.0, -0.9), (0.15, 0.12, 0.45)) for x in (-0.25, 0.25)]
     vertices, triangles = ellipsoids([((0.0, 0.0, 0.0), (0.5, 0.15, 0.6)), ((0.0, 0.0, 0.95), (0.42, 0.14, 0.42))]
                                      + legs)
     skeleton = rigger.rig_mesh(vertices, triangles)
     index = {name: i for i, name in enumerate(skeleton.names)}
-    pairs = [(i, index[name[:-2] + ".R"]) for i, name in enumerate(skeleton.names) if name.endswith(".L")]
+    pairs = [(i, index.get(name[:-2] + ".R")) for i, name in enumerate(skeleton.names) if name.endswith(".L")]
     assert len(pairs) >= 2 and 2 * len(pairs) == sum(name.endswith((".L", ".R")) for name in skeleton.names)
+    assert None not in {right for _, right in pairs}
     mirror = np.array([-1.0, 1.0, 1.0])
     for left, right in pairs:
         np.testing.assert_allclose(skeleton.heads[left] * mirror, skeleton.heads[right], atol=1e-6)

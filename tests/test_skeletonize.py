@@ -5,6 +5,7 @@ from meshes import box, combine
 
 from rigger import silhouette
 from rigger.skeletonize import depth
+from rigger.skeletonize.chordal import AxisGraph
 from rigger.skeletonize.bones import chain_joints, reflection_in_view, symmetric_joints
 from rigger.skeletonize.polyline import arc_lengths, segment_distances
 from rigger.skeletonize.tree import Chain, chains_of, prune_spurs, rooted_chains
@@ -90,16 +91,16 @@ def test_a_round_part_without_a_neck_is_kept():
     """A gingerbread man's head on its shoulders: the body's blob (radius 1) carries a head blob (radius 0.85)
     centred 1.1 away, just off the body's disc, through one node as wide as the head: it sticks out 0.95, under
     prune (1.35) times its width (1.7), so without ``blobs`` it goes as a bump. As a blob of its own it stays;
-    a smaller blob, or one centred on the body's disc, goes."""
+    a smaller blob, one centred on the body's disc, or one sticking out less than ``min_reach`` goes."""
     legs = [[(side, -y, 0.3) for y in range(2, 8)] for side in (-0.5, 0.5)]
 
-    def head_kept(head, is_blob=True):
+    def head_kept(head, is_blob=True, min_reach=0.0):
         nodes = np.array([(0.0, 0.0, 1.0)] + legs[0] + legs[1] + [(0.0, 1.05, head[2]), head])
         points, radius = nodes[:, :2], nodes[:, 2]
         chains = [[0] + list(range(1, 7)), [0] + list(range(7, 13)), [0, 13, 14]]
         blobs = np.zeros(len(nodes), bool)
         blobs[[0, 14]] = True, is_blob
-        kept = prune_spurs(points, radius, chains, 1.35, blobs=blobs)
+        kept = prune_spurs(points, radius, chains, 1.35, min_reach, blobs=blobs)
         assert 12 in kept  # the legs are limbs whatever happens to the head
         return 14 in kept
 
@@ -107,6 +108,19 @@ def test_a_round_part_without_a_neck_is_kept():
     assert not head_kept((0.0, 1.1, 0.85), is_blob=False)
     assert not head_kept((0.0, 1.1, 0.6))  # a bump ending in a smaller blob (an ear on a head)
     assert not head_kept((0.0, 0.95, 0.85))  # a blob centred inside the body's disc
+    assert not head_kept((0.0, 1.1, 0.85), min_reach=1.0)
+
+
+def test_blobs_near_the_mirror_line_are_centred_on_it():
+    """Hubs within half their radius of the line x = 0 move onto it (halfway to their image); one farther off,
+    and every other node, stay; the graph itself is left as it was."""
+    points = np.array([(0.2, 0.0), (0.6, 1.0), (0.3, 2.0), (-0.05, 3.0)])
+    radius = np.array([0.5, 1.0, 0.5, 0.1])
+    graph = AxisGraph(points, radius, np.ones(4, bool), np.array([(0, 1), (1, 2), (2, 3)]), np.zeros(4, int))
+    centred = graph.centred_on_mirror(np.array([0, 1, 2]), lambda p: p * [-1.0, 1.0])
+    np.testing.assert_array_equal(centred.points, [(0.0, 0.0), (0.6, 1.0), (0.3, 2.0), (-0.05, 3.0)])
+    assert graph.points[0, 0] == 0.2
+    assert graph.centred_on_mirror(np.zeros(0, int), lambda p: -p).points.tolist() == points.tolist()
 
 
 def layers(*intervals):

@@ -126,7 +126,7 @@ class SilhouetteMethod(RigMethod):
         unit = bone_length * mesh.scale  # the bone length in mesh units
         reaches = (MIN_BRANCH * unit, KEEP_REACH * mesh.scale)  # prune_spurs' min_reach and max_reach
         plane = mirror_plane(mesh.used_vertices, mesh.bbox, 0.01 * mesh.scale)
-        alive, merged, kept = _pruned_tree(graph, merge, prune, reaches, reflection_in_view(sil, plane))
+        graph, alive, merged, kept = _pruned_tree(graph, merge, prune, reaches, reflection_in_view(sil, plane))
         clock.lap("merge_prune")
 
         side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
@@ -224,15 +224,16 @@ def _to_world(stages, frame, factor, *points):
 
 def _pruned_tree(graph, merge, prune, reaches, mirror=None):
     """Blob merging and spur pruning of a chordal axis, ``reaches`` being ``prune_spurs``' (min_reach, max_reach)
-    and ``mirror`` its reflection: (alive nodes, merged links, kept links). With ``mirror``, the blobs straddling
-    the mirror line are first centred on it (moving ``graph``'s points)."""
+    and ``mirror`` its reflection; its junctions are the blobs that keep a spur ending in one. Returns (graph, alive
+    nodes, merged links, kept links): with ``mirror``, the graph whose blobs near the mirror line are centred on it
+    (``AxisGraph.centred_on_mirror``), the stages show and the bones follow."""
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
     alive = np.unique(representative)
     if mirror is not None:
-        graph.centre_on_mirror(alive[graph.junction[alive]], mirror)
+        graph = graph.centred_on_mirror(alive[graph.junction[alive]], mirror)
     _, chains = chains_of(alive.tolist(), merged)
-    return alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, *reaches, mirror=mirror,
-                                      blobs=graph.junction)
+    return graph, alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, *reaches, mirror=mirror,
+                                             blobs=graph.junction)
 
 
 def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):
@@ -265,7 +266,7 @@ def _other_view(vertices, triangles, primary, axis, resolution, spacing, min_hol
 def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, reaches, bone_length, split_layers):
     """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``);
     the view's chains are placed in depth only when a leaf tip lies off the primary skeleton."""
-    alive, _, kept = _pruned_tree(view_graph, merge, prune, reaches)
+    _, alive, _, kept = _pruned_tree(view_graph, merge, prune, reaches)
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]
     cover = Cover(lines, view_sil.direction, HIDDEN_REACH * bone_length)

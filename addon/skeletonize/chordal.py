@@ -8,7 +8,7 @@ links its two, a junction links its three to its centre, a terminal links its on
 The result is a :class:`AxisGraph`: points in the silhouette plane with the radius of the part there (half the
 chord, or the junction's circumradius) and undirected links.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -35,14 +35,16 @@ class AxisGraph:
     links: np.ndarray
     island: np.ndarray
 
-    def centre_on_mirror(self, hubs, mirror):
-        """Move each of the nodes ``hubs`` whose mirror image (``mirror`` reflects (P, 2) points across the mesh's
-        mirror plane) lies within its own disc halfway to that image, onto the mirror line, in place. The
-        triangulation of a symmetric outline is not symmetric: a body's centre left off the line would hang a
-        figure's left and right limbs from it at different angles."""
+    def centred_on_mirror(self, hubs, mirror):
+        """A copy with each of the nodes ``hubs`` (int array) whose mirror image lies within its disc (``mirror``
+        reflects (P, 2) points across the mesh's mirror plane) moved to the midpoint of it and its image, onto the
+        mirror line. The triangulation of a symmetric outline is not symmetric: a body's centre left off the line
+        would hang a figure's left and right limbs from it at different angles."""
         image = mirror(self.points[hubs])
         near = np.linalg.norm(image - self.points[hubs], axis=1) <= self.radius[hubs]
-        self.points[hubs[near]] = 0.5 * (self.points[hubs[near]] + image[near])
+        points = self.points.copy()
+        points[hubs[near]] = 0.5 * (points[hubs[near]] + image[near])
+        return replace(self, points=points)
 
 
 def triangle_classes(tri):

@@ -105,9 +105,9 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
     outline noise and bumps (an ear on a round head, a belly) are not, whatever their size, up to ``max_reach``: a
     part reaching that far needs bones of its own however wide it is (a cow's short thick neck with its head).
     With ``blobs``, a (n,) mask of the nodes that stand for a round part (junctions, which swallow the axis within
-    their disc), a spur ending in one whose centre lies outside the base's disc and whose width is at least
-    ``ROUND_TIP`` times the base's is kept: a gingerbread man's head sits on its shoulders without a neck, and a
-    cartoon's round feet hang straight off its hips.
+    their disc), a spur reaching ``min_reach`` and ending in one whose centre lies outside the base's disc and
+    whose width is at least ``ROUND_TIP`` times the base's is kept: a gingerbread man's head sits on its shoulders
+    without a neck, and a cartoon's round feet hang straight off its hips.
     With ``mirror``, a function reflecting (P, 2) points across the mesh's mirror plane, a spur whose mirror image
     is a branch kept off the same base stays too: a figure's two arms off its chest, each near the threshold, are
     kept or dropped together.
@@ -127,8 +127,8 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
                     ordered = np.array(chain if chain[0] == base else chain[::-1])
                     outside = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]]
                     width = 2 * float(radius[outside[:3]].mean()) if len(outside) else 2 * float(radius[tip])
-                    if beyond <= max(prune * width, min_reach) and beyond < max_reach and not (
-                            blobs is not None and _round_part(points, radius, blobs, base, tip)):
+                    round_part = blobs is not None and _round_part(points, radius, blobs, base, tip)
+                    if beyond < max_reach and (beyond <= min_reach or (beyond <= prune * width and not round_part)):
                         spurs[i] = base, tip
                     else:
                         kept_leaves[i] = base, outside
