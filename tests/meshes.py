@@ -1,4 +1,5 @@
-"""Small generated meshes the tests share: boxes, UV spheres and ellipsoids, and soups of several meshes."""
+"""Small generated meshes the tests share: boxes, UV spheres and ellipsoids, parametric surfaces, and soups of several
+meshes."""
 import numpy as np
 
 
@@ -45,3 +46,17 @@ def ellipsoids(parts):
     """One closed UV-sphere mesh per (centre, semi-axes) part, all in one vertex and triangle array."""
     sphere, sphere_triangles = uv_sphere()
     return combine(*((sphere * size + centre, sphere_triangles) for centre, size in parts))
+
+
+def grid_surface(point, nu, nv, closed_v=True):
+    """Triangles of a (nu x nv) parametric surface ``point(s, t)``, wrapping in u always and in v when closed_v."""
+    us, vs = np.arange(nu), np.arange(nv)
+    vertices = np.array([point(i / nu, j / (nv if closed_v else nv - 1)) for i in us for j in vs])
+    rows = nv if closed_v else nv - 1
+    tris = []
+    for i in us:
+        for j in range(rows):
+            a, b = i * nv + j, ((i + 1) % nu) * nv + j
+            c, d = ((i + 1) % nu) * nv + (j + 1) % nv, i * nv + (j + 1) % nv
+            tris += [[a, b, c], [a, c, d]]
+    return vertices, np.array(tris)

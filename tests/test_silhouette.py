@@ -27,7 +27,7 @@ from scipy.sparse.csgraph import connected_components
 
 from rigger import silhouette
 
-from meshes import box, combine, uv_sphere
+from meshes import box, combine, grid_surface, uv_sphere
 from rigdata import load_obj
 from union_reference import exact_union, frame_points, iou, traced_region
 
@@ -36,20 +36,6 @@ BIG_FEATURE = 8  # islands and holes above this many square cells must match
 TOUCH = 0.01  # cells: parts meeting closer than this may merge or split
 
 # ------------------------------------------------------------------------------------------------ meshes
-
-
-def grid_surface(point, nu, nv, closed_v=True):
-    """Triangles of a (nu x nv) parametric surface, wrapping in u always and in v when closed_v."""
-    us, vs = np.arange(nu), np.arange(nv)
-    vertices = np.array([point(i / nu, j / (nv if closed_v else nv - 1)) for i in us for j in vs])
-    rows = nv if closed_v else nv - 1
-    tris = []
-    for i in us:
-        for j in range(rows):
-            a, b = i * nv + j, ((i + 1) % nu) * nv + j
-            c, d = ((i + 1) % nu) * nv + (j + 1) % nv, i * nv + (j + 1) % nv
-            tris += [[a, b, c], [a, c, d]]
-    return vertices, np.array(tris)
 
 
 def torus(major=1.0, minor=0.3, center=(0, 0, 0), n=48):

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 import rigger
 from cdt_checks import polygon_area
 from characters import strictly_inside_fraction, load_character
-from meshes import box, combine, ellipsoids, uv_sphere
+from meshes import box, combine, ellipsoids, grid_surface, uv_sphere
 from rigger import samples
 from rigger.skeletonize.bones import bone_names
 
@@ -128,11 +128,16 @@ def test_every_bone_off_the_mirror_plane_is_named_for_its_side(default_rig, name
     assert sorted(stem for stem in stems if stems.count(stem) == 1) == []  # every side bone has its twin
 
 
+def mirror_pairs(skeleton):
+    """(left bone, its right twin or None) for every ``.L`` bone."""
+    index = {name: i for i, name in enumerate(skeleton.names)}
+    return [(i, index.get(name[:-2] + ".R")) for i, name in enumerate(skeleton.names) if name.endswith(".L")]
+
+
 def test_a_symmetric_character_gets_a_symmetric_rig(default_rig):
     _, _, skeleton = default_rig("humanoid")
-    index = {name: i for i, name in enumerate(skeleton.names)}
-    pairs = [(i, index[name[:-2] + ".R"]) for i, name in enumerate(skeleton.names) if name.endswith(".L")]
-    assert len(pairs) >= 8
+    pairs = mirror_pairs(skeleton)
+    assert len(pairs) >= 8 and None not in {right for _, right in pairs}
     mirror = np.array([-1.0, 1.0, 1.0])
     for left, right in pairs:
         np.testing.assert_allclose(skeleton.tails[left] * mirror, skeleton.tails[right], atol=1e-3)
@@ -148,8 +153,7 @@ def test_a_figure_whose_triangulation_is_lopsided_gets_a_symmetric_rig():
     vertices, triangles = ellipsoids([((0.0, 0.0, 0.0), (0.5, 0.15, 0.6)), ((0.0, 0.0, 0.95), (0.42, 0.14, 0.42))]
                                      + legs)
     skeleton = rigger.rig_mesh(vertices, triangles)
-    index = {name: i for i, name in enumerate(skeleton.names)}
-    pairs = [(i, index.get(name[:-2] + ".R")) for i, name in enumerate(skeleton.names) if name.endswith(".L")]
+    pairs = mirror_pairs(skeleton)
     assert len(pairs) >= 2 and 2 * len(pairs) == sum(name.endswith((".L", ".R")) for name in skeleton.names)
     assert None not in {right for _, right in pairs}
     mirror = np.array([-1.0, 1.0, 1.0])
@@ -441,12 +445,8 @@ def test_hidden_limbs_starting_together_share_their_extension():
 
 def test_an_open_tube_rigs_though_it_shows_nothing_end_on():
     """Every face runs along the tube, so the end-on view has no area: that view finds no limbs, the rig goes on."""
-    angle = np.linspace(0, 2 * np.pi, 16, endpoint=False)
-    rings = [np.c_[0.1 * np.cos(angle), 0.1 * np.sin(angle), np.full(16, z)] for z in np.linspace(-1, 1, 11)]
-    vertices = np.vstack(rings)
-    triangles = [(r * 16 + k, r * 16 + (k + 1) % 16, (r + 1) * 16 + k) for r in range(10) for k in range(16)]
-    triangles += [(r * 16 + (k + 1) % 16, (r + 1) * 16 + (k + 1) % 16, (r + 1) * 16 + k)
-                  for r in range(10) for k in range(16)]
+    vertices, triangles = grid_surface(
+        lambda s, t: [0.1 * np.cos(2 * np.pi * s), 0.1 * np.sin(2 * np.pi * s), 2 * t - 1], 16, 11, closed_v=False)
     skeleton = rigger.rig_mesh(vertices, triangles)
     joints = skeleton.joints()
     assert np.ptp(joints[:, 2]) > 1.5 and np.abs(joints[:, :2]).max() < 0.1  # along the tube, inside it

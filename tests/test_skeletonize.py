@@ -50,24 +50,32 @@ def test_a_wide_branch_reaching_far_is_a_limb_not_a_bump():
     assert (8, 9) not in bumped and len(bumped) == 12
 
 
+def chest_with_legs(*branches):
+    """(points, radius, chains) of an axis: a chest (node 0, radius 1) with two thin legs (nodes 1-12) and the
+    ``branches`` ((x, y, radius) node lists) off it, numbered on from 13."""
+    nodes, chains = [(0.0, 0.0, 1.0)], []
+    for part in [[(side, -y, 0.3) for y in range(2, 8)] for side in (-0.5, 0.5)] + list(branches):
+        chains.append([0] + list(range(len(nodes), len(nodes) + len(part))))
+        nodes += part
+    nodes = np.array(nodes)
+    return nodes[:, :2], nodes[:, 2], chains
+
+
 def test_a_spur_whose_mirror_image_is_kept_stays():
     """A figure's two arms off its chest, mirror images across x = 0 but for the left one reaching a little less:
     at prune 1.35 the right arm (sticking out 1.4 times its width) is kept and the left (1.3) would go. With the
-    reflection the left one stays with its image; a bump on one side only still goes, and both arms go once
-    neither is long enough."""
+    reflection the left one stays with its image; a bump on the mirror line (its own image) still goes, and both
+    arms go once neither is long enough."""
     def arm(side, ratio):  # half-width 0.5 off a chest disc of radius 1: sticks out 0.5 + reach beyond it
         return [(side * x, 0.0, 0.5) for x in np.linspace(1.5, 0.5 + ratio, 6)]
-    legs = [[(side, -y, 0.3) for y in range(2, 8)] for side in (-0.5, 0.5)]
     bump = [(0.0, 1.3, 0.8), (0.0, 1.6, 0.8)]  # sticks out 1.4, 1.6 wide
-    nodes = np.array([(0.0, 0.0, 1.0)] + arm(1, 1.4) + arm(-1, 1.3) + legs[0] + legs[1] + bump)
-    points, radius = nodes[:, :2], nodes[:, 2]
-    chains = [[0] + list(range(k, k + 6)) for k in (1, 7, 13, 19)] + [[0, 25, 26]]
+    points, radius, chains = chest_with_legs(arm(1, 1.4), arm(-1, 1.3), bump)
 
     def reflect(p):
         return p * [-1.0, 1.0]
 
     def tips(links):  # of the right arm, the left arm and the bump
-        return [tip in links for tip in (6, 12, 26)]
+        return [tip in links for tip in (18, 24, 26)]
 
     assert tips(prune_spurs(points, radius, chains, 1.35)) == [True, False, False]
     assert tips(prune_spurs(points, radius, chains, 1.35, mirror=reflect)) == [True, True, False]
@@ -78,11 +86,8 @@ def test_a_spur_whose_mirror_image_is_kept_stays():
 def test_outline_noise_is_not_kept_for_lying_on_the_body_it_mirrors_onto():
     """Two specks of outline noise mirroring each other on the edge of the chest's disc, between two legs: each
     speck's image lies on the chest, not on a kept branch, so both go."""
-    legs = [[(side, -y, 0.3) for y in range(2, 8)] for side in (-0.5, 0.5)]
-    specks = [(0.5, 0.85, 0.01), (-0.5, 0.85, 0.01)]  # 0.99 from the chest's centre, 1.0 its radius
-    nodes = np.array([(0.0, 0.0, 1.0)] + legs[0] + legs[1] + specks)
-    points, radius = nodes[:, :2], nodes[:, 2]
-    chains = [[0] + list(range(1, 7)), [0] + list(range(7, 13)), [0, 13], [0, 14]]
+    specks = [(0.5, 0.85, 0.01)], [(-0.5, 0.85, 0.01)]  # 0.99 from the chest's centre, 1.0 its radius
+    points, radius, chains = chest_with_legs(*specks)
     kept = prune_spurs(points, radius, chains, 1.35, mirror=lambda p: p * [-1.0, 1.0])
     assert 13 not in kept and 14 not in kept and 12 in kept
 
@@ -92,13 +97,9 @@ def test_a_round_part_without_a_neck_is_kept():
     centred 1.1 away, just off the body's disc, through one node as wide as the head: it sticks out 0.95, under
     prune (1.35) times its width (1.7), so without ``blobs`` it goes as a bump. As a blob of its own it stays;
     a smaller blob, one centred on the body's disc, or one sticking out less than ``min_reach`` goes."""
-    legs = [[(side, -y, 0.3) for y in range(2, 8)] for side in (-0.5, 0.5)]
-
     def head_kept(head, is_blob=True, min_reach=0.0):
-        nodes = np.array([(0.0, 0.0, 1.0)] + legs[0] + legs[1] + [(0.0, 1.05, head[2]), head])
-        points, radius = nodes[:, :2], nodes[:, 2]
-        chains = [[0] + list(range(1, 7)), [0] + list(range(7, 13)), [0, 13, 14]]
-        blobs = np.zeros(len(nodes), bool)
+        points, radius, chains = chest_with_legs([(0.0, 1.05, head[2]), head])
+        blobs = np.zeros(len(points), bool)
         blobs[[0, 14]] = True, is_blob
         kept = prune_spurs(points, radius, chains, 1.35, min_reach, blobs=blobs)
         assert 12 in kept  # the legs are limbs whatever happens to the head
@@ -175,6 +176,8 @@ def test_fingers_fork_off_their_arm_but_legs_split_from_the_body():
 
 class FlatSilhouette:
     """A stand-in for ``Silhouette``: fixed depth intervals per axis node, depth along z."""
+
+    cell = 0.01
 
     def __init__(self, node_layers):
         self.node_layers = node_layers
@@ -267,7 +270,6 @@ def test_one_node_seeing_two_legs_as_one_part_is_a_slip_not_an_occlusion():
     """A leg at depth 3: one node's ray pairs its hits across both legs (one thick interval); the leg stays put.
     Several such nodes in a row are an occlusion (an arm in front of the body): the side view decides there."""
     sil = FlatSilhouette(None)
-    sil.cell = 0.01
     leg, merged = layers((2.5, 3.5)), layers((-3.5, 3.5))
     points, radius = np.zeros((9, 2)), np.full(9, 0.5)
     slip = [leg] * 4 + [merged] + [leg] * 4
@@ -285,7 +287,6 @@ def test_split_legs_keep_their_sides_where_they_merge_into_the_hips():
     count = 20
     node_layers = [layers((-3.5, 3.5))] * 5 + [layers((-3.5, -2.5), (2.5, 3.5))] * 15
     sil = FlatSilhouette(node_layers)
-    sil.cell = 0.01
     points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
     _, placed = depth.place_chains(sil, points, np.full(count, 0.5), 0, [Chain(list(range(count)), -1)],
                                    FixedSide())

@@ -89,7 +89,7 @@ class Mesh:
     def unit_factor(self):
         """The power of two that scales the mesh to a size between 0.5 and 1 (1 for a point): exact in floating
         point, so a method may work at that size, far from overflow and underflow, and scale back without error."""
-        return float(np.ldexp(1.0, -np.frexp(self.scale)[1])) if self.scale > 0 else 1.0
+        return float(np.ldexp(1.0, -np.frexp(self.scale)[1]))  # frexp(0) has exponent 0: a point keeps its size
 
     @cached_property
     def centroid(self):

@@ -17,6 +17,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import cdt, silhouette
+from ..core.arrays import concatenated_ranges
 from ..core.graphs import components
 from ..core.params import Param
 from ..core.registry import RigMethod
@@ -132,9 +133,9 @@ class SilhouetteMethod(RigMethod):
         side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
         if side_view and flat is None:  # a flat mesh has nothing to hide in depth
             side_axis, end_axis = sorted((a for a in range(3) if a != axis), key=lambda a: mesh.spread[a])
-            side_of = _other_view(vertices, triangles, sil, side_axis, resolution, outline_spacing, min_hole)
+            side_of = _other_view(vertices, triangles, side_axis, resolution, outline_spacing, min_hole)
             end_resolution = max(MIN_VIEW_RESOLUTION, round(END_RESOLUTION * resolution))
-            end_on = _other_view(vertices, triangles, sil, end_axis, end_resolution, outline_spacing, min_hole)
+            end_on = _other_view(vertices, triangles, end_axis, end_resolution, outline_spacing, min_hole)
             if side_of is not None:
                 side_sil, side_graph = side_of
                 side = SideAxis(side_sil, side_graph.points, side_graph.radius, sil)
@@ -252,14 +253,13 @@ def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):
         yield PlacedIsland(*place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers))
 
 
-def _other_view(vertices, triangles, primary, axis, resolution, spacing, min_hole):
-    """(silhouette, chordal axis) along another axis, sharing the primary view's welded parts; None where the mesh
-    shows nothing that way (an open tube seen end-on)."""
+def _other_view(vertices, triangles, axis, resolution, spacing, min_hole):
+    """(silhouette, chordal axis) along another axis; None where the mesh shows nothing that way (an open tube
+    seen end-on)."""
     try:
         view_sil, _, view_graph = planar_axis(vertices, triangles, AXES[axis], resolution, spacing, min_hole)
     except silhouette.NoSilhouette:
         return None
-    view_sil.share_parts(primary)
     return view_sil, view_graph
 
 
@@ -272,6 +272,7 @@ def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, reaches, bone_
     cover = Cover(lines, view_sil.direction, HIDDEN_REACH * bone_length)
     if cover.covered(view_sil.lift(tips, 0.0)).all():
         return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
+    view_sil.share_parts(sil)  # the mesh's welded parts, found once for the primary view, give the view's layers
     limbs = []
     for placed in _placed_islands(view_sil, view_graph, alive, kept, SPECK * bone_length, None, split_layers):
         if isinstance(placed, PlacedIsland):
@@ -285,16 +286,18 @@ def _primary_view(mesh, view, resolution, spacing, min_hole):
     it); a flat mesh tilted off the axis planes is seen straight on, not edge-on."""
     if view != "AUTO":
         axis = AXIS_NAMES.index(view)
-        return axis, planar_axis(mesh.vertices, mesh.triangles, AXES[axis], resolution, spacing, min_hole)
-    order = axes_by_spread(mesh.vertices, mesh.triangles)
-    flat = mesh.flat_normal
-    if flat is not None:
-        direction = flat if abs(flat @ AXES[order[0]]) < 1 - 1e-9 else AXES[order[0]]
-        return order[0], planar_axis(mesh.vertices, mesh.triangles, direction, resolution, spacing, min_hole)
+        candidates = [(axis, AXES[axis])]  # (axis, view direction), the first that shows the mesh wins
+    else:
+        order = axes_by_spread(mesh.vertices, mesh.triangles)
+        flat = mesh.flat_normal
+        if flat is not None:
+            candidates = [(order[0], flat if abs(flat @ AXES[order[0]]) < 1 - 1e-9 else AXES[order[0]])]
+        else:
+            candidates = [(axis, AXES[axis]) for axis in order]
     first_error = None
-    for axis in order:
+    for axis, direction in candidates:
         try:
-            return axis, planar_axis(mesh.vertices, mesh.triangles, AXES[axis], resolution, spacing, min_hole)
+            return axis, planar_axis(mesh.vertices, mesh.triangles, direction, resolution, spacing, min_hole)
         except silhouette.PartsTooSmall:
             raise  # along every axis alike
         except silhouette.NoSilhouette as error:
@@ -346,7 +349,7 @@ def _outline(loops, spacing):
     for loop in loops:
         nxt = np.roll(loop, -1, axis=0)
         pieces = np.maximum(1, np.ceil(np.linalg.norm(nxt - loop, axis=1) / step).astype(int))
-        t = np.concatenate([np.arange(p) / p for p in pieces])
+        t = concatenated_ranges(np.zeros_like(pieces), pieces) / np.repeat(pieces, pieces)
         start = np.repeat(np.arange(len(loop)), pieces)
         dense = loop[start] + t[:, None] * (nxt[start] - loop[start])
         count = len(dense)

@@ -6,6 +6,7 @@ from .polyline import arc_lengths, point_at, resampled
 LONGEST = 3.0  # no bone longer than this many bone lengths, whatever max_bones says (a straight leg gets a knee)
 SAME_SHAPE = 0.6  # mirror-pair chains get mirror-image joints when their shapes agree this closely (in tolerances)
 SHAPE_SAMPLES = 9  # points along each chain compared for that
+ALONG_PLANE = 1e-6  # a view whose direction has no larger component along a mirror plane's axis looks along it
 
 
 def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=False):
@@ -57,11 +58,11 @@ def mirrored(points, plane):
     return image
 
 
-def reflection_in_view(sil, plane, snap=1e-6):
+def reflection_in_view(sil, plane):
     """The reflection across ``plane`` = (axis, offset) of points (P, 2) in the plane of view ``sil`` (a
-    ``Silhouette``), or None when there is no plane or the view does not look along it (off by more than ``snap``):
-    seen from the side, a plane's two halves hide each other."""
-    if plane is None or abs(sil.direction[plane[0]]) > snap:
+    ``Silhouette``), or None when there is no plane or the view does not look along it (``ALONG_PLANE``): seen
+    from the side, a plane's two halves hide each other."""
+    if plane is None or abs(sil.direction[plane[0]]) > ALONG_PLANE:
         return None
     return lambda points: sil.project(mirrored(sil.lift(points, 0.0), plane))[0]
 

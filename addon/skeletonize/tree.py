@@ -157,10 +157,11 @@ def _unmirrored(spurs, kept_leaves, points, radius, mirror):
     beside = {}
     for base, outside in kept_leaves:
         beside.setdefault(base, []).append(outside)
+    beside = {base: np.concatenate(parts) for base, parts in beside.items()}
     images = mirror(points[[tip for _, tip in spurs.values()]])
     left = {}
     for (i, (base, tip)), image in zip(spurs.items(), images):
-        nodes = np.concatenate(beside.get(base, [np.zeros(0, np.int64)]))
+        nodes = beside.get(base, np.zeros(0, np.int64))
         if not (np.linalg.norm(points[nodes] - image, axis=1) <= radius[nodes]).any():
             left[i] = base, tip
     return left
