@@ -11,7 +11,8 @@ from meshes import box, combine, ellipsoids, grid_surface, uv_sphere
 from rigger import samples
 from rigger.skeletonize.bones import bone_names
 
-from rigdata import chamfer_distance
+from conftest import shared_path
+from rigdata import chamfer_distance, load_obj
 from stages import lift
 
 CHARACTERS = ("humanoid", "humanoid_hips", "quadruped", "octopus", "tree", "snake")
@@ -331,6 +332,23 @@ def test_ears_hidden_in_the_primary_view_come_from_the_end_on_view():
     without = rigger.rig_mesh(vertices, triangles, side_view=False)
     assert np.linalg.norm(without.joints() - (0.06, 0.32, 0.5), axis=1).min() > 0.1  # the primary view alone: no ears
     assert strictly_inside_fraction(vertices, triangles, bone_samples(skeleton)) >= 0.9
+
+
+def test_ears_from_a_lopsided_end_on_view_are_a_mirror_pair():
+    """Quaternius' wolf, seen from the side: its ears come from the end-on view, whose triangulation is lopsided
+    (one ear's branch is shorter); that view prunes its spurs knowing the mirror too, so both ears are kept, as a
+    left/right pair."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_Wolf", "Quaternius_Wolf.obj"))[:2]
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    size = np.ptp(vertices, axis=0).max()
+    pairs = mirror_pairs(skeleton)
+    assert len(pairs) >= 9 and 2 * len(pairs) == sum(name.endswith((".L", ".R")) for name in skeleton.names)
+    assert None not in {right for _, right in pairs}
+    ears = [left for left, _ in pairs if skeleton.tails[left, 1] > vertices[:, 1].max() - 0.1 * size]
+    assert ears, "no bone reaches up to the ears"
+    mirror = np.array([-1.0, 1.0, 1.0])
+    for left, right in pairs:
+        np.testing.assert_allclose(skeleton.tails[left] * mirror, skeleton.tails[right], atol=0.01 * size)
 
 
 def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):

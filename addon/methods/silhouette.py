@@ -150,7 +150,7 @@ class SilhouetteMethod(RigMethod):
                 builder.add_island(placed.root_point, placed.chains)
         for view_sil, view_graph in other_views:
             limbs = _hidden_limbs(sil, view_sil, view_graph, builder.lines, merge, HIDDEN_PRUNE * prune, reaches, unit,
-                                  split_layers)
+                                  split_layers, reflection_in_view(view_sil, plane))
             builder.add_limbs(limbs, (sil, view_sil))
         clock.lap("depth_bones")
 
@@ -263,10 +263,11 @@ def _other_view(vertices, triangles, axis, resolution, spacing, min_hole):
     return view_sil, view_graph
 
 
-def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, reaches, bone_length, split_layers):
-    """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``);
-    the view's chains are placed in depth only when a leaf tip lies off the primary skeleton."""
-    _, alive, _, kept = _pruned_tree(view_graph, merge, prune, reaches)
+def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, reaches, bone_length, split_layers, mirror=None):
+    """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``;
+    ``mirror`` is the view's ``reflection_in_view``, so it keeps a spur whose mirror image it keeps, as the primary
+    view does); the view's chains are placed in depth only when a leaf tip lies off the primary skeleton."""
+    view_graph, alive, _, kept = _pruned_tree(view_graph, merge, prune, reaches, mirror)
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]
     cover = Cover(lines, view_sil.direction, HIDDEN_REACH * bone_length)
