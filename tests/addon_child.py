@@ -99,7 +99,8 @@ def is_enabled(module):
 
 def operators_registered():
     return sorted(name for name in ("RIGGER_OT_rig", "RIGGER_OT_skin", "RIGGER_OT_rig_skin",
-                                    "RIGGER_OT_clear_overlays") if hasattr(bpy.types, name))
+                                    "RIGGER_OT_clear_overlays", "RIGGER_OT_direction_from_view")
+                  if hasattr(bpy.types, name))
 
 
 def rig_and_skin(module):

@@ -27,7 +27,8 @@ CHILD = pathlib.Path(__file__).with_name("addon_child.py")
 BLENDER_VENVS = {"5.0": ROOT / ".venv", "4.2": ROOT / ".venv" / "bpy42"}
 PYTHON = sys.version_info[:2]
 SUFFIX = importlib.machinery.EXTENSION_SUFFIXES[0]  # this interpreter's compiled-module file ending
-ALL_OPERATORS = ["RIGGER_OT_clear_overlays", "RIGGER_OT_rig", "RIGGER_OT_rig_skin", "RIGGER_OT_skin"]
+ALL_OPERATORS = ["RIGGER_OT_clear_overlays", "RIGGER_OT_direction_from_view", "RIGGER_OT_rig", "RIGGER_OT_rig_skin",
+                 "RIGGER_OT_skin"]
 CHILD_SECONDS = 300
 
 
