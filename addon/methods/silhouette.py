@@ -115,7 +115,7 @@ class SilhouetteMethod(RigMethod):
         # rig at unit size (a power of two away: exact), in the frame where the view is an axis; then map back
         factor = mesh.unit_factor
         mesh = mesh.at_unit_size(frame)
-        vertices, triangles, flat = mesh.vertices, mesh.triangles, mesh.flat_normal
+        vertices, triangles, flat = mesh.vertices, mesh.wide_triangles, mesh.flat_normal
         try:
             axis, (sil, tri, graph) = _primary_view(mesh, view, resolution, outline_spacing, min_hole)
         except silhouette.NoSilhouette as error:
@@ -298,7 +298,7 @@ def _primary_view(mesh, view, resolution, spacing, min_hole):
     first_error = None
     for axis, direction in candidates:
         try:
-            return axis, planar_axis(mesh.vertices, mesh.triangles, direction, resolution, spacing, min_hole)
+            return axis, planar_axis(mesh.vertices, mesh.wide_triangles, direction, resolution, spacing, min_hole)
         except silhouette.PartsTooSmall:
             raise  # along every axis alike
         except silhouette.NoSilhouette as error:
