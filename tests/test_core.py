@@ -84,6 +84,8 @@ def test_a_mesh_goes_to_unit_size_by_an_exact_power_of_two():
     fresh = Mesh(mesh.vertices * mesh.unit_factor, TETRA_TRIANGLES)
     for name in ("bbox", "scale", "centroid", "flat_normal"):
         np.testing.assert_array_equal(getattr(scaled, name), getattr(fresh, name), err_msg=name)
+    assert scaled.at_unit_size() is scaled  # at unit size already: nothing to copy
+    assert scaled.at_unit_size(np.eye(3)[[1, 2, 0]]) is not scaled
 
 
 def test_a_loose_vertex_too_far_to_scale_with_its_mesh_is_refused():

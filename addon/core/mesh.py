@@ -36,8 +36,11 @@ class Mesh:
         """This mesh scaled by ``unit_factor`` (a power of two: exact) and turned by the orthonormal ``rotation`` (rows:
         the new axes), sharing its triangles. A similarity keeps a valid mesh valid, so only a vertex that would
         overflow (one far from the others, or a tiny mesh far from the origin) is checked for; which vertices are
-        used carries over, and unturned, the measures already taken do too, scaled exactly."""
+        used carries over, and unturned, the measures already taken do too, scaled exactly. A mesh already at unit
+        size and not turned is itself (it is read-only)."""
         factor = self.unit_factor
+        if factor == 1 and rotation is None:
+            return self
         with np.errstate(over="ignore"):
             vertices = self.vertices * factor
         far = nonfinite_rows(vertices) if factor > 1 else ()  # scaling down cannot overflow
