@@ -77,8 +77,7 @@ class _RiggerOperator:
         return {'CANCELLED'}
 
     def rig(self, context, progress):
-        settings = getattr(context.scene, SETTINGS_ATTRIBUTE)
-        method = method_registry().lookup(settings.method)
+        settings, method = chosen_method(context)
         params = param_values(method, getattr(settings.methods, method.name))
         meshes, _ = rig_targets(context)
         result = rig_object(meshes[0], method.name, params, parts=meshes[1:],
@@ -182,9 +181,8 @@ class RIGGER_OT_direction_from_view(bpy.types.Operator):
         return True
 
     def execute(self, context):
-        settings = getattr(context.scene, SETTINGS_ATTRIBUTE)
         try:
-            method = method_registry().lookup(settings.method)
+            settings, method = chosen_method(context)
         except ValueError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
@@ -193,6 +191,12 @@ class RIGGER_OT_direction_from_view(bpy.types.Operator):
             return {'CANCELLED'}
         setattr(getattr(settings.methods, method.name), self.param, looking_along(view_of(context).view_rotation))
         return {'FINISHED'}
+
+
+def chosen_method(context):
+    """(the scene's Rigger settings, the method class they choose); a ValueError when no such method is loaded."""
+    settings = getattr(context.scene, SETTINGS_ATTRIBUTE)
+    return settings, method_registry().lookup(settings.method)
 
 
 def view_of(context):
