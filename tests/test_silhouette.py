@@ -482,20 +482,22 @@ def test_layers_merge_nested_and_intersecting_parts():
     assert np.allclose(sil.layers([x, y])[0], [[front, back]])
 
 
+def unwelded(vertices, triangles):
+    """The same triangles, each with vertices of its own (as glTF seams leave a mesh)."""
+    corners = vertices[triangles].reshape(-1, 3)
+    return corners, np.arange(len(corners)).reshape(-1, 3)
+
+
 def test_layers_weld_split_vertices():
     """A closed box whose faces do not share vertices (as glTF seams leave it) still pairs front with back."""
-    v, t = box((0, 0, 0), (1, 1, 1))
-    split = v[t].reshape(-1, 3)
-    sil = silhouette.trace(split, np.arange(len(split)).reshape(-1, 3), "Y")
+    sil = silhouette.trace(*unwelded(*box((0, 0, 0), (1, 1, 1))), "Y")
     assert np.allclose(sil.layers([[0.1, 0.2]])[0], [[-0.5, 0.5]])
 
 
 def test_layers_with_parts_shared_from_another_view_match_their_own():
     """The welded parts are the mesh's, not the view's: a view that takes them from another gives the same layers."""
     v, t = box((0, 0, 0), (1, 1, 1))
-    split = v[t].reshape(-1, 3)
-    mesh = combine((split, np.arange(len(split)).reshape(-1, 3)), box((0, 3, 0), (1, 4, 1)),
-                   box((0.2, 0.2, 0.2), (0.6, 0.6, 0.6)))
+    mesh = combine(unwelded(v, t), box((0, 3, 0), (1, 4, 1)), box((0.2, 0.2, 0.2), (0.6, 0.6, 0.6)))
     points = np.random.default_rng(3).uniform(-1, 1.5, (200, 2))
     for direction in ("X", "Z", (1, 2, 3)):
         own = silhouette.trace(*mesh, direction)
