@@ -338,7 +338,7 @@ def test_ears_from_a_lopsided_end_on_view_are_a_mirror_pair():
     """Quaternius' wolf, seen from the side: its ears come from the end-on view, whose triangulation is lopsided
     (one ear's branch is shorter); that view prunes its spurs knowing the mirror too, so both ears are kept, as a
     left/right pair."""
-    vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_Wolf", "Quaternius_Wolf.obj"))[:2]
+    vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_Wolf", "Quaternius_Wolf.obj"))
     skeleton = rigger.rig_mesh(vertices, triangles)
     size = np.ptp(vertices, axis=0).max()
     pairs = mirror_pairs(skeleton)

@@ -37,7 +37,7 @@ class Mesh:
         the new axes), sharing its triangles. A similarity keeps a valid mesh valid, so only a vertex that would
         overflow (one far from the others, or a tiny mesh far from the origin) is checked for; which vertices are
         used carries over, and unturned, the measures already taken do too, scaled exactly. A mesh already at unit
-        size and not turned is itself (it is read-only)."""
+        size and not turned is itself (its arrays are read-only, so sharing it is safe)."""
         factor = self.unit_factor
         if factor == 1 and rotation is None:
             return self

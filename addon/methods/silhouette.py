@@ -263,10 +263,11 @@ def _other_view(vertices, triangles, axis, resolution, spacing, min_hole):
     return view_sil, view_graph
 
 
-def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, reaches, bone_length, split_layers, mirror=None):
-    """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``;
-    ``mirror`` is the view's ``reflection_in_view``, so it keeps a spur whose mirror image it keeps, as the primary
-    view does); the view's chains are placed in depth only when a leaf tip lies off the primary skeleton."""
+def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, reaches, bone_length, split_layers, mirror):
+    """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``);
+    the view's chains are placed in depth only when a leaf tip lies off the primary skeleton. With ``mirror`` (the
+    view's ``reflection_in_view``, None when it does not look across the mirror plane) the tree is pruned as the
+    primary view's is: blobs near the mirror line are centred on it, and a spur whose mirror image is kept stays."""
     view_graph, alive, _, kept = _pruned_tree(view_graph, merge, prune, reaches, mirror)
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]
