@@ -145,9 +145,9 @@ def _check_destinations(source, output, report):
         if path is None:
             continue
         if role != "the input":
+            _check_folder(path.parent, role)  # first: it may be searched then (is_dir raises where it may not)
             if path.is_dir():
                 raise CliError(f"{path}: is a folder; {role} needs a file name")
-            _check_folder(path.parent, role)
         key = os.path.normcase(path.resolve())
         if key in seen:
             raise CliError(f"{path}: {role} would overwrite {seen[key]}; choose another file name")
@@ -179,6 +179,7 @@ def _run_batch(args):
     sources = sorted(path for path in args.folder.iterdir() if path.suffix.lower() in INPUTS and path.is_file())
     if not sources:
         raise CliError(f"{args.folder}: no model files ({', '.join(INPUTS)})")
+    _check_folder(args.output, "the results")
     args.output.mkdir(parents=True, exist_ok=True)
     extra = [f"--method={args.method}", *(f"--set={pair}" for pair in args.settings)]
     extra += ["--no-skin"] if args.no_skin else []

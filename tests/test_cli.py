@@ -245,3 +245,10 @@ def test_batch_on_a_missing_folder_is_an_error(tmp_path):
     result = run("batch", tmp_path / "nope", "-o", tmp_path / "out")
     assert result.returncode == 1 and "no such folder" in result.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_batch_results_under_a_file_are_an_error(humanoid_obj, tmp_path):
+    (tmp_path / "a_file").write_text("")
+    result = run("batch", humanoid_obj[0].parent, "-o", tmp_path / "a_file" / "out")
+    assert result.returncode == 1 and "a_file: is not a folder, so the results cannot go in" in result.stderr
+    assert "Traceback" not in result.stderr
