@@ -2015,13 +2015,13 @@ static int build_components(SilTrace *t)
 
 int sil_share_components(SilTrace *t, SilTrace *source)
 {
+    if (t == source) return build_components(t); /* its own parts: found once, kept */
     if (t->n_vertices != source->n_vertices || t->n_all != source->n_all ||
         memcmp(t->all_tris, source->all_tris, (size_t)(3 * t->n_all) * sizeof(int32_t)) != 0)
         return SIL_ERR_MISMATCH;
     if (t->vertex_comp) return SIL_OK;
     int rc = build_components(source);
     if (rc != SIL_OK) return rc;
-    if (t->vertex_comp) return SIL_OK; /* t is source: just built */
     t->vertex_comp = alloc_array(t->n_vertices, sizeof(int32_t));
     if (!t->vertex_comp) return SIL_ERR_NOMEM;
     memcpy(t->vertex_comp, source->vertex_comp, (size_t)t->n_vertices * sizeof(int32_t));

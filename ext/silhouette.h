@@ -66,8 +66,9 @@ int sil_depth(SilTrace *trace, const double *points, int64_t n, double *front, d
 int sil_layers(SilTrace *trace, const double *points, int64_t n, int64_t **offsets, double **intervals);
 void sil_release(void *memory);
 
-/* Give `trace` the welded connected components `source` has found (finding them now if it has not): they depend on
- * the mesh, not on the view, so the views of one mesh find them once. Both must trace the same vertices and
+/* Give `trace` the welded connected components `source` has found (finding them now if it has not): they belong to
+ * the mesh, not the view (welded as `source` sees its vertices, exactly equal there), so the views of one mesh find
+ * them once. Both must trace the same vertices and
  * triangles (SIL_ERR_MISMATCH when the vertex counts or the triangles differ). A trace that has its components
  * keeps them. */
 int sil_share_components(SilTrace *trace, SilTrace *source);

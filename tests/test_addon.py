@@ -398,11 +398,12 @@ def test_operators_are_undoable_and_scriptable_by_name(registered):
 class RecordingLayout:
     """Stands in for bpy.types.UILayout (which only exists while Blender draws a region): records what is drawn."""
 
-    def __init__(self, log=None):
+    def __init__(self, log=None, buttons=None):
         self.log = [] if log is None else log
+        self.buttons = {} if buttons is None else buttons  # operator id -> the properties its button was given
 
     def _nested(self, *args, **kwargs):
-        return RecordingLayout(self.log)
+        return RecordingLayout(self.log, self.buttons)
 
     box = column = row = grid_flow = _nested
 
@@ -411,10 +412,18 @@ class RecordingLayout:
 
     def operator(self, idname, **kwargs):
         self.log.append(("operator", idname))
-        return types.SimpleNamespace()  # the button's operator properties, which the caller may set
+        return self.buttons.setdefault(idname, types.SimpleNamespace())  # its operator properties, for the caller
 
     def label(self, text="", **kwargs):
         self.log.append(("label", text))
+
+
+def drawn_panel():
+    """The Rigger panel drawn into a ``RecordingLayout``, which it returns."""
+    from rigger.blender.panel import RIGGER_PT_main
+    panel = types.SimpleNamespace(layout=RecordingLayout())
+    RIGGER_PT_main.draw(panel, bpy.context)
+    return panel.layout
 
 
 def test_the_panel_shows_method_parameters_actions_and_overlay_toggles(registered, scene):
@@ -422,9 +431,7 @@ def test_the_panel_shows_method_parameters_actions_and_overlay_toggles(registere
     from rigger.blender.panel import RIGGER_PT_main
     assert (RIGGER_PT_main.bl_space_type, RIGGER_PT_main.bl_region_type) == ('VIEW_3D', 'UI')
     assert RIGGER_PT_main.bl_category == "Rigger"
-    panel = type("Drawn", (), {"layout": RecordingLayout()})()
-    RIGGER_PT_main.draw(panel, bpy.context)
-    log = panel.layout.log
+    log = drawn_panel().log
     props = [name for kind, name in log if kind == "prop"]
     assert props[0] == "method"
     assert {"resolution", "bone_length", "view"} <= set(props)
@@ -434,13 +441,12 @@ def test_the_panel_shows_method_parameters_actions_and_overlay_toggles(registere
 
 
 def test_the_direction_view_offers_to_look_along_the_3d_view(scene):
-    from rigger.blender.panel import RIGGER_PT_main
     settings = scene.rigger
     settings.method = "silhouette"
     settings.methods.silhouette.view = "DIRECTION"
-    panel = type("Drawn", (), {"layout": RecordingLayout()})()
-    RIGGER_PT_main.draw(panel, bpy.context)
-    assert ("operator", "rigger.direction_from_view") in panel.layout.log
+    layout = drawn_panel()
+    assert ("operator", "rigger.direction_from_view") in layout.log
+    assert layout.buttons["rigger.direction_from_view"].param == "view_direction"
     assert bpy.ops.rigger.direction_from_view.poll() is False  # no 3D view headless
 
 

@@ -135,15 +135,26 @@ def mirror_pairs(skeleton):
     return [(i, index.get(name[:-2] + ".R")) for i, name in enumerate(skeleton.names) if name.endswith(".L")]
 
 
-def test_a_symmetric_character_gets_a_symmetric_rig(default_rig):
-    _, _, skeleton = default_rig("humanoid")
+def assert_mirror_image_pairs(skeleton, min_pairs, atol, heads, complete=True):
+    """At least ``min_pairs`` ``.L`` bones, each with its ``.R`` twin (and with ``complete``, no ``.R`` bone without
+    one), whose tails mirror each other across x = 0 within ``atol``, and their heads too: all (``heads="all"``), or
+    those of twins that do not hang from one bone (``"off_trunk"``), or none. Returns the pairs."""
     pairs = mirror_pairs(skeleton)
-    assert len(pairs) >= 8 and None not in {right for _, right in pairs}
+    assert len(pairs) >= min_pairs
+    if complete:
+        assert 2 * len(pairs) == sum(name.endswith((".L", ".R")) for name in skeleton.names)
+    assert None not in {right for _, right in pairs}
     mirror = np.array([-1.0, 1.0, 1.0])
     for left, right in pairs:
-        np.testing.assert_allclose(skeleton.tails[left] * mirror, skeleton.tails[right], atol=1e-3)
-        if skeleton.parents[left] != skeleton.parents[right]:  # not both on the trunk: heads mirror too
-            np.testing.assert_allclose(skeleton.heads[left] * mirror, skeleton.heads[right], atol=1e-3)
+        np.testing.assert_allclose(skeleton.tails[left] * mirror, skeleton.tails[right], atol=atol)
+        if heads == "all" or (heads == "off_trunk" and skeleton.parents[left] != skeleton.parents[right]):
+            np.testing.assert_allclose(skeleton.heads[left] * mirror, skeleton.heads[right], atol=atol)
+    return pairs
+
+
+def test_a_symmetric_character_gets_a_symmetric_rig(default_rig):
+    _, _, skeleton = default_rig("humanoid")
+    assert_mirror_image_pairs(skeleton, 8, 1e-3, heads="off_trunk", complete=False)
 
 
 def test_a_figure_whose_triangulation_is_lopsided_gets_a_symmetric_rig():
@@ -153,14 +164,7 @@ def test_a_figure_whose_triangulation_is_lopsided_gets_a_symmetric_rig():
     legs = [((x, 0.0, -0.9), (0.15, 0.12, 0.45)) for x in (-0.25, 0.25)]
     vertices, triangles = ellipsoids([((0.0, 0.0, 0.0), (0.5, 0.15, 0.6)), ((0.0, 0.0, 0.95), (0.42, 0.14, 0.42))]
                                      + legs)
-    skeleton = rigger.rig_mesh(vertices, triangles)
-    pairs = mirror_pairs(skeleton)
-    assert len(pairs) >= 2 and 2 * len(pairs) == sum(name.endswith((".L", ".R")) for name in skeleton.names)
-    assert None not in {right for _, right in pairs}
-    mirror = np.array([-1.0, 1.0, 1.0])
-    for left, right in pairs:
-        np.testing.assert_allclose(skeleton.heads[left] * mirror, skeleton.heads[right], atol=1e-6)
-        np.testing.assert_allclose(skeleton.tails[left] * mirror, skeleton.tails[right], atol=1e-6)
+    assert_mirror_image_pairs(rigger.rig_mesh(vertices, triangles), 2, 1e-6, heads="all")
 
 
 def test_no_bone_is_longer_than_three_bone_lengths():
@@ -341,14 +345,9 @@ def test_ears_from_a_lopsided_end_on_view_are_a_mirror_pair():
     vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_Wolf", "Quaternius_Wolf.obj"))
     skeleton = rigger.rig_mesh(vertices, triangles)
     size = np.ptp(vertices, axis=0).max()
-    pairs = mirror_pairs(skeleton)
-    assert len(pairs) >= 9 and 2 * len(pairs) == sum(name.endswith((".L", ".R")) for name in skeleton.names)
-    assert None not in {right for _, right in pairs}
+    pairs = assert_mirror_image_pairs(skeleton, 9, 0.01 * size, heads="none")
     ears = [left for left, _ in pairs if skeleton.tails[left, 1] > vertices[:, 1].max() - 0.1 * size]
     assert ears, "no bone reaches up to the ears"
-    mirror = np.array([-1.0, 1.0, 1.0])
-    for left, right in pairs:
-        np.testing.assert_allclose(skeleton.tails[left] * mirror, skeleton.tails[right], atol=0.01 * size)
 
 
 def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):

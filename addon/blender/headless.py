@@ -1,7 +1,7 @@
 """Blender as a Python module outside Blender: bpy reads and writes a user folder (preferences, add-ons, caches) at
 import, so the demo, the tests and the benchmarks give it a temporary one (unless ``BLENDER_USER_RESOURCES`` is
-set already) and neither change nor depend on the user's own Blender set-up, and start from one empty
-scene. Needs no bpy to import: it runs before the first ``import bpy``."""
+set already) and neither change nor depend on the user's own Blender set-up. They, and the command line's
+scene files, start from one empty scene. Needs no bpy to import: it runs before the first ``import bpy``."""
 import atexit
 import os
 import shutil

@@ -23,7 +23,7 @@ class Mesh:
         triangles: (M, 3) int32, read-only, indexing ``vertices``; faces that repeat a vertex index are removed.
         degenerate_count: how many such faces were removed.
 
-    ``bbox``, ``scale``, ``unit_factor``, ``centroid`` and ``flat_normal`` describe the ``used_vertices``,
+    ``bbox``, ``scale``, ``unit_factor``, ``centroid``, ``spread`` and ``flat_normal`` describe the ``used_vertices``,
     so a stray loose vertex cannot distort them.
     """
 
@@ -103,7 +103,8 @@ class Mesh:
     def centroid(self):
         """(3,) float64: the mean position of the used vertices."""
         points, factor = self.used_vertices, self.unit_factor  # summed at unit size: no overflow, the same bits
-        return _read_only(np.ones(len(points)) @ (points * factor) / len(points) / factor)  # BLAS: faster than mean
+        scaled = points if factor == 1 else points * factor  # no copy of a mesh at unit size already
+        return _read_only(np.ones(len(points)) @ scaled / len(points) / factor)  # BLAS: faster than mean
 
     @cached_property
     def _scatter(self):

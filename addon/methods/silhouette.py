@@ -198,8 +198,8 @@ def view_frame(direction):
 
 def _to_world(stages, frame, factor, *points):
     """Map the stage data of a rig at ``factor`` times the mesh's size, in ``frame`` (rows: its axes in world
-    coordinates; None for the world's), back to the world, and return ``points`` (arrays of 3D points) mapped so;
-    ``mirror_plane`` stays in the frame, whose axis it names."""
+    coordinates; None for the world's), back to the world (adding ``view``, the world view direction), and return
+    ``points`` (arrays of 3D points) mapped so; ``mirror_plane`` stays in the frame, whose axis it names."""
     def turned(array):
         return array if frame is None else array @ frame
 

@@ -1,4 +1,5 @@
-"""Bones from 3D chains: where joints go along a chain, the bone hierarchy, and names with mirror suffixes."""
+"""Bones from 3D chains: where joints go along a chain, the mesh's mirror plane (and its reflection in a view), mirror
+pairs of chains with mirror-image joints, and names with mirror suffixes."""
 import numpy as np
 
 from .polyline import arc_lengths, point_at, resampled

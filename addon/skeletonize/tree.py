@@ -127,8 +127,9 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
                     ordered = np.array(chain if chain[0] == base else chain[::-1])
                     outside = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]]
                     width = 2 * float(radius[outside[:3]].mean()) if len(outside) else 2 * float(radius[tip])
-                    round_part = blobs is not None and _round_part(points, radius, blobs, base, tip)
-                    if beyond < max_reach and (beyond <= min_reach or (beyond <= prune * width and not round_part)):
+                    bump = beyond <= prune * width and not (  # the round-part test only where it can matter
+                        blobs is not None and _round_part(points, radius, blobs, base, tip))
+                    if beyond < max_reach and (beyond <= min_reach or bump):
                         spurs[i] = base, tip
                     else:
                         kept_leaves[i] = base, outside
