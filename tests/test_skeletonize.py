@@ -6,7 +6,7 @@ from meshes import box, combine
 from rigger import silhouette
 from rigger.skeletonize import depth
 from rigger.skeletonize.chordal import AxisGraph
-from rigger.skeletonize.bones import chain_joints, reflection_in_view, symmetric_joints
+from rigger.skeletonize.bones import bone_names, chain_joints, reflection_in_view, symmetric_joints
 from rigger.skeletonize.polyline import arc_lengths, segment_distances
 from rigger.skeletonize.tree import Chain, chains_of, prune_spurs, rooted_chains
 
@@ -313,6 +313,15 @@ def test_mirror_pair_chains_get_mirror_image_joints():
         assert result[k] is joints[k]
     fewer = symmetric_joints([left, right[::2]], [left, right], (0, 0.0), 0.05)  # the one with more joints decides
     np.testing.assert_allclose(fewer[1], right)
+
+
+def test_legs_from_the_middle_of_the_hips_are_named_for_the_side_their_feet_are_on():
+    """Legs hanging from the middle of the hips lie mostly near the mirror plane but are still a left and a right
+    leg; a trunk that leans off the plane at its tip, with no twin, stays unsided."""
+    spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.08, 2.0, 0.0]])  # leaning: its tip is off the plane
+    leg = np.array([[0.0, 0.0, 0.0], [0.02, -0.5, 0.0], [0.12, -1.0, 0.0]])  # on the plane on average, tip off it
+    names = bone_names([0, 0, 1, 1, 2, 2], [0, 1, 0, 1, 0, 1], [spine, leg, leg * [-1, 1, 1]], (0, 0.0), 0.05)
+    assert names == ["trunk.00", "trunk.01", "limb01.00.L", "limb01.01.L", "limb01.00.R", "limb01.01.R"]
 
 
 def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_at_all():

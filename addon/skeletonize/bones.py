@@ -176,10 +176,12 @@ def _cell_keys(cells, span):
 
 def mirror_chain_pairs(lines, plane, tolerance):
     """Pairs (i, j) of chains (3D polylines) that are mirror images of each other across ``plane`` = (axis, offset):
-    their ends match the mirrored ends within ``tolerance``. Chains on the plane are never paired."""
+    their ends match the mirrored ends within ``tolerance``. Chains on the plane are never paired; a chain that
+    starts on it and leaves it (legs from the middle of the hips, antennae from the middle of the head) is on the
+    side its tip is."""
     ends = np.array([[line[0], line[-1]] for line in lines])  # (C, 2, 3)
     images = mirrored(ends, plane)
-    side = np.array([_side(line, plane, tolerance) for line in lines])
+    side = np.array([_side(line, plane, tolerance, by_tip=True) for line in lines])
     pairs, taken = [], np.zeros(len(lines), bool)
     for i in range(len(lines)):
         if taken[i] or side[i] == 0:
@@ -214,10 +216,13 @@ def symmetric_joints(joints, lines, plane, tolerance):
     return joints
 
 
-def _side(line, plane, tolerance):
-    """+1 on the plane's positive side, -1 on its negative side, 0 for a chain on the plane."""
+def _side(line, plane, tolerance, by_tip=False):
+    """+1 on the plane's positive side, -1 on its negative side, 0 for a chain on the plane (on average), or with
+    ``by_tip`` for one whose tip is on it too."""
     axis, offset = plane
     distance = float(np.mean(line[:, axis])) - offset
+    if by_tip and abs(distance) <= tolerance:
+        distance = float(line[-1, axis]) - offset
     return 0 if abs(distance) <= tolerance else int(np.sign(distance))
 
 
@@ -231,10 +236,12 @@ def bone_names(chain_of_bone, index_in_chain, lines, plane, tolerance):
     label = list(range(len(lines)))
     suffix = [""] * len(lines)
     if plane is not None:
+        paired = set()
         for i, j in mirror_chain_pairs(lines, plane, tolerance):
             label[j] = label[i] = min(i, j)
+            paired |= {i, j}
         for c, line in enumerate(lines):
-            suffix[c] = {1: ".L", -1: ".R", 0: ""}[_side(line, plane, tolerance)]
+            suffix[c] = {1: ".L", -1: ".R", 0: ""}[_side(line, plane, tolerance, by_tip=c in paired)]
     number = {value: k for k, value in enumerate(sorted(set(label)))}  # the trunk (chain 0) keeps 0
     base = ["trunk" if number[label[c]] == 0 else f"limb{number[label[c]]:02d}" for c in range(len(lines))]
     names = [f"{base[c]}.{k:02d}{suffix[c]}" for c, k in zip(chain_of_bone, index_in_chain)]
