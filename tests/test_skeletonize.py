@@ -204,6 +204,24 @@ def test_a_forked_chain_is_one_stem_then_a_chain_per_part():
     np.testing.assert_allclose(tips, [0.4, 1.4, 2.4, 3.4])  # one per finger, centred in it
 
 
+def test_a_head_seen_across_the_mirror_plane_does_not_run_into_one_ear():
+    """A head (one part on the mirror plane z = 0, half-width 0.5) with thin ears on each side seen from the side:
+    where the rays pass only beside the plane (a gap in the head's outline, and the ears' tips) the chain neither
+    steps into one ear nor ends in one; the perpendicular views find the ears. Without the plane it follows one ear
+    to its tip, as it must for a single part off to one side."""
+    count = 12
+    ears = layers((-0.8, -0.7), (0.7, 0.8))
+    node_layers = [layers((-0.5, 0.5))] * 5 + [ears] + [layers((-0.5, 0.5))] * 3 + [ears] * 3
+    points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
+    chains = [Chain(list(range(count)), -1)]
+    sil = FlatSilhouette(node_layers)
+    (_, [(line, _, _)]) = depth.place_chains(sil, points, np.full(count, 0.5), 0, chains, mirror=(0.0, 0.05))
+    assert len(line) == 9  # the ears' tips cut
+    np.testing.assert_array_equal(line[:, 2], 0.0)  # on the plane throughout
+    (_, [(line, _, _)]) = depth.place_chains(sil, points, np.full(count, 0.5), 0, chains)
+    assert len(line) == count and line[-1, 2] == -0.75
+
+
 def straight(length, points=101):
     return np.stack([np.linspace(0.0, length, points), np.zeros(points), np.zeros(points)], axis=1)
 

@@ -23,7 +23,8 @@ from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
 from ..core.timing import StageClock
-from ..skeletonize.bones import bone_names, chain_joints, mirror_plane, reflection_in_view, symmetric_joints
+from ..skeletonize.bones import (bone_names, chain_joints, mirror_plane, plane_depth, reflection_in_view,
+                                symmetric_joints)
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
 from ..skeletonize.polyline import nearest_on_segments
@@ -143,7 +144,8 @@ class SilhouetteMethod(RigMethod):
         clock.lap("other_views")
 
         builder = _BoneBuilder(np.radians(bone_angle), unit, max_chain_bones, plane, MIRROR_TOLERANCE * mesh.scale)
-        for placed in _placed_islands(sil, graph, alive, kept, SPECK * unit, side, split_layers):
+        for placed in _placed_islands(sil, graph, alive, kept, SPECK * unit, side, split_layers,
+                                      _mirror_in_depth(sil, plane, MIRROR_TOLERANCE * mesh.scale)):
             if isinstance(placed, Blob):
                 builder.add_blob(sil, placed.point, placed.radius)
             else:
@@ -237,10 +239,10 @@ def _pruned_tree(graph, merge, prune, reaches, mirror=None):
                                              blobs=graph.junction)
 
 
-def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):
+def _placed_islands(sil, graph, alive, kept, speck, side, split_layers, mirror):
     """Per island of the pruned axis, largest first: a ``PlacedIsland`` (its chains in 3D), or a ``Blob`` for an
     island that is a single node; islands other than the largest and smaller than ``speck`` are skipped (skinning
-    gives them to the nearest bone)."""
+    gives them to the nearest bone). ``mirror``: see ``place_chains``."""
     for number, (nodes, links, size) in enumerate(_islands(graph, alive, kept)):
         if number and size < speck:
             continue
@@ -250,7 +252,13 @@ def _placed_islands(sil, graph, alive, kept, speck, side, split_layers):
             yield Blob(graph.points[widest], graph.radius[widest])
             continue
         root, rooted = rooted_chains(graph.points, keys, island_chains, graph.radius)
-        yield PlacedIsland(*place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers))
+        yield PlacedIsland(*place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers, mirror))
+
+
+def _mirror_in_depth(sil, plane, tolerance):
+    """(depth, tolerance) of the mirror ``plane`` along view ``sil`` when the view looks across it, else None."""
+    depth = plane_depth(sil, plane)
+    return None if depth is None else (depth, tolerance)
 
 
 def _other_view(vertices, triangles, axis, resolution, spacing, min_hole):
@@ -276,7 +284,7 @@ def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, reaches, bone_
         return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
     view_sil.share_parts(sil)  # the mesh's welded parts, found once for the primary view, give the view's layers
     limbs = []
-    for placed in _placed_islands(view_sil, view_graph, alive, kept, SPECK * bone_length, None, split_layers):
+    for placed in _placed_islands(view_sil, view_graph, alive, kept, SPECK * bone_length, None, split_layers, None):
         if isinstance(placed, PlacedIsland):
             limbs += uncovered_limbs(placed.chains, cover, sil, reaches[0])
     return limbs

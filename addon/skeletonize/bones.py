@@ -68,6 +68,15 @@ def reflection_in_view(sil, plane):
     return lambda points: sil.project(mirrored(sil.lift(points, 0.0), plane))[0]
 
 
+def plane_depth(sil, plane):
+    """The depth along view ``sil`` of ``plane`` = (axis, offset) when the view looks straight across it (along its
+    axis, as ``ALONG_PLANE`` allows), else None."""
+    if plane is None or abs(abs(sil.direction[plane[0]]) - 1) > ALONG_PLANE:
+        return None
+    axis, offset = plane
+    return float((offset - sil.origin[axis]) * sil.direction[axis])
+
+
 def _candidate_stops(line, arc, widths, bone_angle, bone_length):
     """Arc lengths where a joint belongs, most important first, and how many of them are needed: leaving the branch
     point's disc, corners by how sharply they turn and the bends a straight bone would leave the part at (its axis

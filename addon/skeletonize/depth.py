@@ -20,7 +20,7 @@ PART = 0.8  # a separate part (a leg behind a leg) is at least this many of its 
 ALIKE = 0.45  # ... and at least this share of the thickest part's thickness (not a nose or a brim beside a head)
 
 
-def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
+def place_chains(sil, points, radius, root, chains, side_axis=None, split=True, mirror=None):
     """3D polylines for the rooted ``chains`` (see ``tree.rooted_chains``).
 
     Args:
@@ -29,6 +29,9 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
         root: the root node; chains: ``tree.Chain`` list, parents first.
         side_axis: optional ``SideAxis`` of the perpendicular view, used where the primary view is occluded.
         split: split chains that run through several separate parts along the view (else follow one).
+        mirror: (depth, tolerance) of a mirror plane the view looks across, or None: a leaf chain on the plane
+            ends where its rays pass only beside the plane, through parts mirroring each other (a head's ears seen
+            from the side), rather than follow one of them off the plane; the perpendicular views find them.
 
     Returns (root_point, placed) with ``placed`` a list of (polyline (k, 3), parent_index, half-widths (k,)) —
     parents first; a split chain yields several entries with the same parent.
@@ -41,15 +44,19 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
     end_depth = {-1: root_depth}
     ends_of = {-1: []}  # chain -> the placed entries its child chains hang from (its outer copies)
     root_is_end = sum(chain.parent < 0 for chain in chains) == 1
+    inner = {chain.parent for chain in chains}
     placed = []
     for ci, chain in enumerate(chains):
         nodes = np.asarray(chain.nodes)
-        chain_points, chain_radius = points[nodes], radius[nodes]
-        node_layers = [layers[slot[n]] for n in chain.nodes]
+        node_layers = [layers[slot[n]] for n in nodes]
         copies, parts = 1, node_layers
         if split:
-            parts = [_parts(layer, r) for layer, r in zip(node_layers, chain_radius)]
+            parts = [_parts(layer, r) for layer, r in zip(node_layers, radius[nodes])]
             copies = _layer_count(parts)
+            if copies == 1 and mirror is not None and ci not in inner:
+                end = _on_plane(node_layers, *mirror)
+                nodes, node_layers, parts = nodes[:end], node_layers[:end], parts[:end]
+        chain_points, chain_radius = points[nodes], radius[nodes]
         widths = chain_radius
         if chain.parent < 0 and root_is_end:
             widths = np.r_[0.0, widths[1:]]  # no branch point here: no disc for the chain to leave (chain_joints)
@@ -58,8 +65,8 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True):
         parents = ends_of[chain.parent]
         for part, count in pieces:
             first = len(placed)
-            followed = [_follow((parts if count > 1 else node_layers)[part], copy, count, end_depth[chain.parent])
-                        for copy in range(count)]
+            followed = [_follow((parts if count > 1 else node_layers)[part], copy, count, end_depth[chain.parent],
+                                mirror) for copy in range(count)]
             for copy in range(count):
                 depths = _resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
                                             followed[copy], side_axis, followed[:copy] + followed[copy + 1:])
@@ -122,6 +129,28 @@ def _fork(parts, radius, copies):
     return start - 1 if own else 0
 
 
+def _on_plane(node_layers, depth, tolerance):
+    """How many nodes of a leaf chain to keep: all but the tip stretch whose rays pass only beside a mirror plane at
+    ``depth``, through intervals mirroring each other across it within ``tolerance``, when the chain reaches that
+    stretch on the plane; all of them otherwise."""
+    end = len(node_layers)
+    while end > 0 and _beside(node_layers[end - 1], depth, tolerance):
+        end -= 1
+    return end if 2 <= end < len(node_layers) and _holds(node_layers[end - 1], depth) else len(node_layers)
+
+
+def _beside(layer, depth, tolerance):
+    """Whether one node's depth ``layer`` flanks the plane at ``depth``: two or more intervals, none holding it,
+    mirroring each other across it."""
+    if len(layer) < 2 or _holds(layer, depth):
+        return False
+    return float(np.abs(2 * depth - layer[::-1, ::-1] - layer).max()) <= tolerance
+
+
+def _holds(layer, depth):
+    return bool(((layer[:, 0] <= depth) & (depth <= layer[:, 1])).any())
+
+
 def _layer_count(node_layers):
     """How many separate parts a chain runs through, judged over its outer two thirds (the part near its parent
     often runs into the body): the fewest parts (more than one) that 30% of those nodes cross, else the most
@@ -137,14 +166,15 @@ def _layer_count(node_layers):
     return int(several[0]) if len(several) else int(np.argmax(frequency))
 
 
-def _follow(node_layers, copy, copies, start):
+def _follow(node_layers, copy, copies, start, mirror=None):
     """Depth along a chain, always the middle of an interval. A single chain follows, from its start, the interval
-    nearest the previous depth. Copy ``copy`` of a split chain is anchored at interval ``copy`` (front to back) of
+    nearest the previous depth; on a ``mirror`` plane ((depth, tolerance) or None) it stays there across nodes whose
+    rays pass only beside it (ears on each side of a head), not stepping to the one side or the other. Copy ``copy`` of a split chain is anchored at interval ``copy`` (front to back) of
     the outermost node crossing exactly ``copies`` intervals, and followed from there both ways by nearest depth,
     so it never jumps to the other part where some node sees the parts merged or an extra part."""
     depths = np.full(len(node_layers), np.nan)
     if copies == 1:
-        _track(node_layers, range(len(node_layers)), start, depths)
+        _track(node_layers, range(len(node_layers)), start, depths, mirror=mirror)
     else:
         anchor = max(i for i, layer in enumerate(node_layers) if len(layer) == copies)
         depths[anchor] = _middle(node_layers[anchor][copy])
@@ -154,13 +184,16 @@ def _follow(node_layers, copy, copies, start):
     return depths
 
 
-def _track(node_layers, order, previous, depths, stay=False):
+def _track(node_layers, order, previous, depths, stay=False, mirror=None):
     """Follow a part along its chain: at each node take the interval the previous depth lies in, else the one
     nearest to it (distance to the interval, not to its middle, so a thick neighbour does not steal the track),
-    and centre in it — or, with ``stay``, keep the previous depth while an interval still contains it."""
+    and centre in it — or, with ``stay``, keep the previous depth while an interval still contains it; on the
+    ``mirror`` plane, keep it where the intervals flank the plane (``_beside``)."""
     for i in order:  # plain floats: the intervals are few, and numpy's per-call cost would dominate
         layer = node_layers[i]
-        if len(layer):
+        if mirror is not None and abs(previous - mirror[0]) <= mirror[1] and _beside(layer, *mirror):
+            pass
+        elif len(layer):
             gap, low, high = min((max(low - previous, 0.0) + max(previous - high, 0.0), low, high)
                                  for low, high in layer.tolist())
             if not (stay and gap == 0.0):
