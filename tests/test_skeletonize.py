@@ -6,7 +6,8 @@ from meshes import box, combine
 from rigger import silhouette
 from rigger.skeletonize import depth
 from rigger.skeletonize.chordal import AxisGraph
-from rigger.skeletonize.bones import bone_names, chain_joints, reflection_in_view, symmetric_joints
+from rigger.skeletonize.bones import (bone_names, chain_joints, mirror_completed, reflection_in_view,
+                                     symmetric_joints)
 from rigger.skeletonize.polyline import arc_lengths, segment_distances
 from rigger.skeletonize.tree import Chain, chains_of, prune_spurs, rooted_chains
 
@@ -340,6 +341,23 @@ def test_legs_from_the_middle_of_the_hips_are_named_for_the_side_their_feet_are_
     leg = np.array([[0.0, 0.0, 0.0], [0.02, -0.5, 0.0], [0.12, -1.0, 0.0]])  # on the plane on average, tip off it
     names = bone_names([0, 0, 1, 1, 2, 2], [0, 1, 0, 1, 0, 1], [spine, leg, leg * [-1, 1, 1]], (0, 0.0), 0.05)
     assert names == ["trunk.00", "trunk.01", "limb01.00.L", "limb01.01.L", "limb01.00.R", "limb01.01.R"]
+
+
+def test_a_limb_whose_twin_is_a_stub_of_its_image_gives_the_twin_its_image():
+    """Ears seen end-on: the right one's tip was pruned, leaving a stub along the left one's mirror image (its start
+    placed a little apart in depth), so the right ear becomes that image. A limb reaching as far as the image (a
+    mirror pair) and one going elsewhere are left alone."""
+    ear = np.array([[0.1, 1.0, 0.0], [0.3, 1.1, 0.0], [0.5, 1.3, 0.0]])
+    stub = np.array([[-0.1, 1.0, 0.08], [-0.28, 1.09, 0.0]])
+    widths = np.array([0.1, 0.05, 0.01])
+    limbs = mirror_completed([(ear, widths), (stub, np.array([0.1, 0.05]))], (0, 0.0), 0.05)
+    assert limbs[0][0] is ear
+    np.testing.assert_array_equal(limbs[1][0], ear * [-1, 1, 1])
+    np.testing.assert_array_equal(limbs[1][1], widths)
+    twin = ear * [-1, 1, 1] + [0, 0, 0.02]
+    elsewhere = np.array([[-0.1, 1.0, 0.0], [-0.3, 0.7, 0.0]])
+    for other in (twin, elsewhere):
+        assert mirror_completed([(ear, widths), (other, widths)], (0, 0.0), 0.05)[1][0] is other
 
 
 def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_at_all():

@@ -23,8 +23,8 @@ from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
 from ..core.timing import StageClock
-from ..skeletonize.bones import (bone_names, chain_joints, mirror_plane, plane_depth, reflection_in_view,
-                                symmetric_joints)
+from ..skeletonize.bones import (bone_names, chain_joints, mirror_completed, mirror_plane, plane_depth,
+                                reflection_in_view, symmetric_joints)
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
 from ..skeletonize.polyline import nearest_on_segments
@@ -433,6 +433,8 @@ class _BoneBuilder:
         pairs stay mirror pairs."""
         if not limbs:
             return
+        if self.plane is not None:
+            limbs = mirror_completed(limbs, self.plane, self.tolerance)
         chains, ups, meets_of = [], [], {}  # meets_of: limb number -> where it meets its bone, for the limbs to extend
         for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
             up, meets = self._attachment(line[0], views)  # from the left one's extension, which passes nearer it)
