@@ -104,7 +104,6 @@ def generated_characters():
 def write_characters(directory):
     """Child-process side: every character at every Skin level, one .npz each."""
     temporary_user_folder()
-    import bpy  # noqa: F401  (first: Blender's own modules, bmesh among them, import only once bpy is)
     from rigger import samples
     from rigger.blender.samples import character_arrays
 

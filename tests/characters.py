@@ -61,7 +61,6 @@ def strictly_inside_fraction(vertices, triangles, points):
 def _write_characters(directory):
     """Child-process side: build every character with bpy and save its arrays into ``directory``."""
     temporary_user_folder()
-    import bpy  # noqa: F401  (first: Blender's own modules, bmesh among them, import only once bpy is)
     from rigger.blender.samples import character_arrays
 
     empty_scene()

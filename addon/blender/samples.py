@@ -9,8 +9,8 @@ sit close together along a thick trunk. The characters' data avoids both (tests/
 closed). Before subdivision, the zero-length edges it leaves at some branch points are collapsed, and the faces it
 sometimes winds inwards (at a root with a single child) are turned outwards.
 """
+import bpy  # before bmesh: Blender's own modules import only once bpy has
 import bmesh
-import bpy
 import numpy as np
 
 from .. import samples
