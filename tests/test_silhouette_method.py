@@ -338,11 +338,15 @@ def test_ears_hidden_in_the_primary_view_come_from_the_end_on_view():
     assert strictly_inside_fraction(vertices, triangles, bone_samples(skeleton)) >= 0.9
 
 
-def test_ears_from_a_lopsided_end_on_view_are_a_mirror_pair():
-    """Quaternius' wolf, seen from the side: its ears come from the end-on view, whose triangulation is lopsided
-    (one ear's branch is shorter); that view prunes its spurs knowing the mirror too, so both ears are kept, as a
-    left/right pair."""
-    vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_Wolf", "Quaternius_Wolf.obj"))
+@pytest.mark.parametrize("model", ["Quaternius_Wolf", "Quaternius_Fox", "Quaternius_Husky", "Quaternius_Deer",
+                                   "rignet_2982"])
+def test_ears_of_a_symmetric_quadruped_seen_from_the_side_are_a_mirror_pair(model):
+    """Quadrupeds seen from the side, their ears (or antlers) one behind the other: the primary view's head chain
+    stays on the mirror plane rather than following one ear (Husky, 2982's antlers), and the ears come from the
+    end-on view, whose triangulation is lopsided (one ear's branch is shorter): that view prunes its spurs knowing
+    the mirror (Wolf), and an ear that the other's mirror image covers becomes that image (Deer's stub, Fox's and
+    Husky's bent ears). Every side bone has its twin, mirroring it, and some reach up to the ears."""
+    vertices, triangles = load_obj(shared_path("models", "gt", model, f"{model}.obj"))
     skeleton = rigger.rig_mesh(vertices, triangles)
     size = np.ptp(vertices, axis=0).max()
     pairs = assert_mirror_image_pairs(skeleton, 9, 0.01 * size, heads="none")

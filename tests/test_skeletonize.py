@@ -343,17 +343,20 @@ def test_legs_from_the_middle_of_the_hips_are_named_for_the_side_their_feet_are_
     assert names == ["trunk.00", "trunk.01", "limb01.00.L", "limb01.01.L", "limb01.00.R", "limb01.01.R"]
 
 
-def test_a_limb_whose_twin_is_a_stub_of_its_image_gives_the_twin_its_image():
-    """Ears seen end-on: the right one's tip was pruned, leaving a stub along the left one's mirror image (its start
-    placed a little apart in depth), so the right ear becomes that image. A limb reaching as far as the image (a
-    mirror pair) and one going elsewhere are left alone."""
+def test_a_limb_that_its_longer_twins_image_covers_becomes_that_image():
+    """Ears seen end-on, in a triangulation that is not symmetric: the right one's tip was pruned, leaving a stub
+    along the left one's mirror image (its start placed a little apart in depth), or its branch bent, ending near
+    the image's tip; either way the right ear becomes that image. A twin as long as the image (a mirror pair
+    already) and a limb going elsewhere are left alone."""
     ear = np.array([[0.1, 1.0, 0.0], [0.3, 1.1, 0.0], [0.5, 1.3, 0.0]])
-    stub = np.array([[-0.1, 1.0, 0.08], [-0.28, 1.09, 0.0]])
     widths = np.array([0.1, 0.05, 0.01])
-    limbs = mirror_completed([(ear, widths), (stub, np.array([0.1, 0.05]))], (0, 0.0), 0.05)
-    assert limbs[0][0] is ear
-    np.testing.assert_array_equal(limbs[1][0], ear * [-1, 1, 1])
-    np.testing.assert_array_equal(limbs[1][1], widths)
+    stub = np.array([[-0.1, 1.0, 0.08], [-0.28, 1.09, 0.0]])
+    bent = np.array([[-0.1, 1.0, 0.0], [-0.25, 1.16, 0.0], [-0.48, 1.28, 0.0]])
+    for short in (stub, bent):
+        limbs = mirror_completed([(ear, widths), (short, widths[:len(short)])], (0, 0.0), 0.05)
+        assert limbs[0][0] is ear
+        np.testing.assert_array_equal(limbs[1][0], ear * [-1, 1, 1])
+        np.testing.assert_array_equal(limbs[1][1], widths)
     twin = ear * [-1, 1, 1] + [0, 0, 0.02]
     elsewhere = np.array([[-0.1, 1.0, 0.0], [-0.3, 0.7, 0.0]])
     for other in (twin, elsewhere):

@@ -2,7 +2,7 @@
 pairs of chains with mirror-image joints, and names with mirror suffixes."""
 import numpy as np
 
-from .polyline import arc_lengths, point_at, resampled, segment_distances
+from .polyline import arc_lengths, length, point_at, resampled, segment_distances
 
 LONGEST = 3.0  # no bone longer than this many bone lengths, whatever max_bones says (a straight leg gets a knee)
 SAME_SHAPE = 0.6  # mirror-pair chains get mirror-image joints when their shapes agree this closely (in tolerances)
@@ -205,19 +205,19 @@ def mirror_chain_pairs(lines, plane, tolerance):
 
 
 def mirror_completed(limbs, plane, tolerance):
-    """The (polyline, half-widths) ``limbs`` with each stub of a mirror twin replaced by the twin's mirror image: a
-    limb on one side of ``plane`` whose start lies within two ``tolerance``s of the image of the start of a limb on
-    the other side, and whose tip lies within one of that image, short of its tip (a view's triangulation is not
-    symmetric, and may prune one ear's tip but not the other's)."""
+    """The (polyline, half-widths) ``limbs`` with each one that a longer mirror twin covers replaced by the twin's
+    mirror image: a limb on one side of ``plane`` whose start lies within two ``tolerance``s of the image of the
+    twin's start, and whose tip lies within one of the twin's image (a view's triangulation is not symmetric: it
+    may prune one ear's tip but not the other's, or bend one ear's branch more)."""
     lines = [line for line, _ in limbs]
     side = [_side(line, plane, tolerance, by_tip=True) for line in lines]
     result = list(limbs)
     for i, (line, widths) in enumerate(limbs):
         image = mirrored(line, plane)
-        for j, stub in enumerate(lines):
-            if (side[i] == 0 or side[j] != -side[i] or np.linalg.norm(stub[0] - image[0]) > 2 * tolerance
-                    or np.linalg.norm(stub[-1] - image[-1]) <= tolerance
-                    or segment_distances(stub[-1:], image[:-1], image[1:]).min() > tolerance):
+        for j, other in enumerate(lines):
+            if (side[i] == 0 or side[j] != -side[i] or length(other) >= length(line)
+                    or np.linalg.norm(other[0] - image[0]) > 2 * tolerance
+                    or segment_distances(other[-1:], image[:-1], image[1:]).min() > tolerance):
                 continue
             result[j] = (image, widths)
     return result
