@@ -361,6 +361,10 @@ def test_a_limb_that_its_longer_twins_image_covers_becomes_that_image():
     elsewhere = np.array([[-0.1, 1.0, 0.0], [-0.3, 0.7, 0.0]])
     for other in (twin, elsewhere):
         assert mirror_completed([(ear, widths), (other, widths)], (0, 0.0), 0.05)[1][0] is other
+    leg = np.array([[0.12, 0.95, 0.0], [0.2, 1.03, 0.0]])  # short, beside the ear: its own twin fits it better
+    pair = [(leg, widths[:2]), (leg * [-1, 1, 1], widths[:2])]
+    limbs = mirror_completed([(ear, widths), (twin, widths)] + pair, (0, 0.0), 0.05)
+    assert all(got is kept for (got, _), (kept, _) in zip(limbs[2:], pair))
 
 
 def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_at_all():

@@ -208,18 +208,22 @@ def mirror_completed(limbs, plane, tolerance):
     """The (polyline, half-widths) ``limbs`` with each one that a longer mirror twin covers replaced by the twin's
     mirror image: a limb on one side of ``plane`` whose start lies within two ``tolerance``s of the image of the
     twin's start, and whose tip lies within one of the twin's image (a view's triangulation is not symmetric: it
-    may prune one ear's tip but not the other's, or bend one ear's branch more)."""
+    may prune one ear's tip but not the other's, or bend one ear's branch more). The twin is the limb whose image
+    fits best (start and tip nearest), so a short limb beside a long one (a leg below an antenna) keeps its own."""
     lines = [line for line, _ in limbs]
     side = [_side(line, plane, tolerance, by_tip=True) for line in lines]
+    images = [mirrored(line, plane) for line in lines]
     result = list(limbs)
-    for i, (line, widths) in enumerate(limbs):
-        image = mirrored(line, plane)
-        for j, other in enumerate(lines):
-            if (side[i] == 0 or side[j] != -side[i] or length(other) >= length(line)
-                    or np.linalg.norm(other[0] - image[0]) > 2 * tolerance
-                    or segment_distances(other[-1:], image[:-1], image[1:]).min() > tolerance):
-                continue
-            result[j] = (image, widths)
+    for j, line in enumerate(lines):
+        twins = [i for i in range(len(lines)) if side[i] != 0 and side[i] == -side[j]]
+        if not twins:
+            continue
+        starts = np.array([np.linalg.norm(line[0] - images[i][0]) for i in twins])
+        tips = np.array([segment_distances(line[-1:], images[i][:-1], images[i][1:]).min() for i in twins])
+        best = int(np.argmin(starts + tips))
+        i = twins[best]
+        if starts[best] <= 2 * tolerance and tips[best] <= tolerance and length(line) < length(lines[i]):
+            result[j] = (images[i], limbs[i][1])
     return result
 
 
