@@ -219,8 +219,27 @@ def test_a_head_seen_across_the_mirror_plane_does_not_run_into_one_ear():
     (_, [(line, _, _)]) = depth.place_chains(sil, points, np.full(count, 0.5), 0, chains, mirror=(0.0, 0.05))
     assert len(line) == 9  # the ears' tips cut
     np.testing.assert_array_equal(line[:, 2], 0.0)  # on the plane throughout
-    (_, [(line, _, _)]) = depth.place_chains(sil, points, np.full(count, 0.5), 0, chains)
-    assert len(line) == count and line[-1, 2] == -0.75
+    for plane in (None, (0.0, 0.05)):
+        (_, [(line, _, _)]) = depth.place_chains(sil, points, np.full(count, 0.5), 0, chains, split=False,
+                                                 mirror=plane)
+        assert len(line) == count and line[-1, 2] == -0.75
+
+
+def test_a_chain_that_cannot_end_before_its_tip_between_the_ears_follows_one_ear():
+    """A chain running between two ears from its start, or one that another chain hangs from, cannot end on the
+    plane before its tip stretch: it follows one ear as it would without a plane, rather than run through the
+    gap between the ears."""
+    ears = layers((-0.8, -0.7), (0.7, 0.8))
+    beside = [layers((-0.5, 0.5))] + [ears] * 5
+    on_then_beside = [layers((-0.5, 0.5))] * 4 + [ears] * 2 + [layers((-0.8, -0.7))] * 2
+    for node_layers, chains in ((beside, [Chain(list(range(6)), -1)]),
+                                (on_then_beside, [Chain(list(range(6)), -1), Chain([5, 6, 7], 0)])):
+        count = len(node_layers)
+        points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
+        _, placed = depth.place_chains(FlatSilhouette(node_layers), points, np.full(count, 0.5), 0, chains,
+                                       mirror=(0.0, 0.05))
+        line = placed[0][0]
+        assert len(line) == 6 and line[-1, 2] == -0.75
 
 
 def straight(length, points=101):
@@ -361,6 +380,8 @@ def test_a_limb_that_its_longer_twins_image_covers_becomes_that_image():
     elsewhere = np.array([[-0.1, 1.0, 0.0], [-0.3, 0.7, 0.0]])
     for other in (twin, elsewhere):
         assert mirror_completed([(ear, widths), (other, widths)], (0, 0.0), 0.05)[1][0] is other
+    one_twin = mirror_completed([(ear, widths), (stub, widths[:2]), (bent, widths)], (0, 0.0), 0.05)
+    assert one_twin[1][0] is stub and one_twin[2][0] is not bent  # the ear's image replaces the limb it fits best
     leg = np.array([[0.12, 0.95, 0.0], [0.2, 1.03, 0.0]])  # short, beside the ear: its own twin fits it better
     pair = [(leg, widths[:2]), (leg * [-1, 1, 1], widths[:2])]
     limbs = mirror_completed([(ear, widths), (twin, widths)] + pair, (0, 0.0), 0.05)

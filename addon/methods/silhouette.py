@@ -23,7 +23,7 @@ from ..core.params import Param
 from ..core.registry import RigMethod
 from ..core.skeleton import Skeleton
 from ..core.timing import StageClock
-from ..skeletonize.bones import (bone_names, chain_joints, mirror_completed, mirror_plane, plane_depth,
+from ..skeletonize.bones import (bone_names, chain_joints, mirror_completed, mirror_in_depth, mirror_plane,
                                 reflection_in_view, symmetric_joints)
 from ..skeletonize.chordal import chordal_axis, triangle_classes
 from ..skeletonize.depth import SideAxis, place_chains
@@ -145,7 +145,7 @@ class SilhouetteMethod(RigMethod):
 
         builder = _BoneBuilder(np.radians(bone_angle), unit, max_chain_bones, plane, MIRROR_TOLERANCE * mesh.scale)
         for placed in _placed_islands(sil, graph, alive, kept, SPECK * unit, side, split_layers,
-                                      _mirror_in_depth(sil, plane, MIRROR_TOLERANCE * mesh.scale)):
+                                      mirror_in_depth(sil, plane, MIRROR_TOLERANCE * mesh.scale)):
             if isinstance(placed, Blob):
                 builder.add_blob(sil, placed.point, placed.radius)
             else:
@@ -253,12 +253,6 @@ def _placed_islands(sil, graph, alive, kept, speck, side, split_layers, mirror):
             continue
         root, rooted = rooted_chains(graph.points, keys, island_chains, graph.radius)
         yield PlacedIsland(*place_chains(sil, graph.points, graph.radius, root, rooted, side, split_layers, mirror))
-
-
-def _mirror_in_depth(sil, plane, tolerance):
-    """(depth, tolerance) of the mirror ``plane`` along view ``sil`` when the view looks across it, else None."""
-    depth = plane_depth(sil, plane)
-    return None if depth is None else (depth, tolerance)
 
 
 def _other_view(vertices, triangles, axis, resolution, spacing, min_hole):

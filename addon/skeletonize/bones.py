@@ -68,13 +68,13 @@ def reflection_in_view(sil, plane):
     return lambda points: sil.project(mirrored(sil.lift(points, 0.0), plane))[0]
 
 
-def plane_depth(sil, plane):
-    """The depth along view ``sil`` of ``plane`` = (axis, offset) when the view looks straight across it (along its
-    axis, as ``ALONG_PLANE`` allows), else None."""
+def mirror_in_depth(sil, plane, tolerance):
+    """(depth, ``tolerance``) of ``plane`` = (axis, offset) along view ``sil`` when the view looks straight across
+    it (along its axis, as ``ALONG_PLANE`` allows), else None: ``depth.place_chains``' ``mirror``."""
     if plane is None or abs(abs(sil.direction[plane[0]]) - 1) > ALONG_PLANE:
         return None
     axis, offset = plane
-    return float((offset - sil.origin[axis]) * sil.direction[axis])
+    return float((offset - sil.origin[axis]) * sil.direction[axis]), tolerance
 
 
 def _candidate_stops(line, arc, widths, bone_angle, bone_length):
@@ -185,9 +185,9 @@ def _cell_keys(cells, span):
 
 def mirror_chain_pairs(lines, plane, tolerance):
     """Pairs (i, j) of chains (3D polylines) that are mirror images of each other across ``plane`` = (axis, offset):
-    their ends match the mirrored ends within ``tolerance``. Chains on the plane are never paired; a chain that
-    starts on it and leaves it (legs from the middle of the hips, antennae from the middle of the head) is on the
-    side its tip is."""
+    their ends match the mirrored ends within ``tolerance``. Chains on the plane are never paired; one that lies on
+    it on average but whose tip is off it (legs from the middle of the hips, antennae from the middle of the head)
+    is on its tip's side."""
     ends = np.array([[line[0], line[-1]] for line in lines])  # (C, 2, 3)
     images = mirrored(ends, plane)
     side = np.array([_side(line, plane, tolerance, by_tip=True) for line in lines])
@@ -207,23 +207,29 @@ def mirror_chain_pairs(lines, plane, tolerance):
 def mirror_completed(limbs, plane, tolerance):
     """The (polyline, half-widths) ``limbs`` with each one that a longer mirror twin covers replaced by the twin's
     mirror image: a limb on one side of ``plane`` whose start lies within two ``tolerance``s of the image of the
-    twin's start, and whose tip lies within one of the twin's image (a view's triangulation is not symmetric: it
-    may prune one ear's tip but not the other's, or bend one ear's branch more). The twin is the limb whose image
-    fits best (start and tip nearest), so a short limb beside a long one (a leg below an antenna) keeps its own."""
+    twin's start, and whose tip lies within one ``tolerance`` of that image (anywhere along it): a view's
+    triangulation is not symmetric, and may prune one ear's tip but not the other's, or bend one ear's branch more.
+    A limb's twin is the one whose image fits it best (start and tip nearest), so a short limb beside a long one
+    (a leg below an antenna) keeps its own; each twin replaces one limb, the one it fits best."""
     lines = [line for line, _ in limbs]
     side = [_side(line, plane, tolerance, by_tip=True) for line in lines]
     images = [mirrored(line, plane) for line in lines]
-    result = list(limbs)
+    fits = {}  # twin -> (misfit, limb it replaces)
     for j, line in enumerate(lines):
         twins = [i for i in range(len(lines)) if side[i] != 0 and side[i] == -side[j]]
         if not twins:
             continue
-        starts = np.array([np.linalg.norm(line[0] - images[i][0]) for i in twins])
-        tips = np.array([segment_distances(line[-1:], images[i][:-1], images[i][1:]).min() for i in twins])
-        best = int(np.argmin(starts + tips))
+        start_gaps = np.array([np.linalg.norm(line[0] - images[i][0]) for i in twins])
+        tip_gaps = np.array([segment_distances(line[-1:], images[i][:-1], images[i][1:]).min() for i in twins])
+        misfits = start_gaps + tip_gaps
+        best = int(np.argmin(misfits))
         i = twins[best]
-        if starts[best] <= 2 * tolerance and tips[best] <= tolerance and length(line) < length(lines[i]):
-            result[j] = (images[i], limbs[i][1])
+        covered = start_gaps[best] <= 2 * tolerance and tip_gaps[best] <= tolerance and length(line) < length(lines[i])
+        if covered and misfits[best] < fits.get(i, (np.inf,))[0]:
+            fits[i] = (misfits[best], j)
+    result = list(limbs)
+    for i, (_, j) in fits.items():
+        result[j] = (images[i], limbs[i][1])
     return result
 
 
@@ -261,9 +267,10 @@ def _side(line, plane, tolerance, by_tip=False):
 def bone_names(chain_of_bone, index_in_chain, lines, plane, tolerance):
     """Names by chain and place in it: ``trunk.00``, ``limb03.01`` …, chains numbered in order from 1.
 
-    With a mirror ``plane``, every bone of a chain off the plane gets ``.L`` on the side of the plane's positive axis
-    (Blender's convention for a character's left) or ``.R``, and mirror-image chains share their number, so
-    ``limb02.01.L`` and ``limb02.01.R`` are a left and a right bone in the same place.
+    With a mirror ``plane``, every bone of a chain off the plane (on average; for a chain with a mirror twin, at its
+    tip) gets ``.L`` on the side of the plane's positive axis (Blender's convention for a character's left) or
+    ``.R``, and mirror-image chains share their number, so ``limb02.01.L`` and ``limb02.01.R`` are a left and a
+    right bone in the same place.
     """
     label = list(range(len(lines)))
     suffix = [""] * len(lines)

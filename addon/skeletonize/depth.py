@@ -29,9 +29,10 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True, 
         root: the root node; chains: ``tree.Chain`` list, parents first.
         side_axis: optional ``SideAxis`` of the perpendicular view, used where the primary view is occluded.
         split: split chains that run through several separate parts along the view (else follow one).
-        mirror: (depth, tolerance) of a mirror plane the view looks across, or None: a leaf chain on the plane
-            ends where its rays pass only beside the plane, through parts mirroring each other (a head's ears seen
-            from the side), rather than follow one of them off the plane; the perpendicular views find them.
+        mirror: (depth, tolerance) of a mirror plane the view looks across, or None: with ``split``, a chain on
+            the plane stays on it where its rays pass only beside it, through parts mirroring each other (the gap
+            between a head's ears seen from the side), and a leaf chain ends before a tip that does, rather than
+            follow one ear off the plane; the perpendicular views find the ears (see ``_plane_course``).
 
     Returns (root_point, placed) with ``placed`` a list of (polyline (k, 3), parent_index, half-widths (k,)) —
     parents first; a split chain yields several entries with the same parent.
@@ -44,18 +45,19 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True, 
     end_depth = {-1: root_depth}
     ends_of = {-1: []}  # chain -> the placed entries its child chains hang from (its outer copies)
     root_is_end = sum(chain.parent < 0 for chain in chains) == 1
-    inner = {chain.parent for chain in chains}
+    has_children = {chain.parent for chain in chains}
     placed = []
     for ci, chain in enumerate(chains):
         nodes = np.asarray(chain.nodes)
         node_layers = [layers[slot[n]] for n in nodes]
-        copies, parts = 1, node_layers
+        copies, parts, plane = 1, node_layers, None  # plane: the mirror this chain keeps to, if any
         if split:
             parts = [_parts(layer, r) for layer, r in zip(node_layers, radius[nodes])]
             copies = _layer_count(parts)
-            if copies == 1 and mirror is not None and ci not in inner:
-                end = _on_plane(node_layers, *mirror)
+            if copies == 1 and mirror is not None:
+                end, stays = _plane_course(node_layers, *mirror, leaf=ci not in has_children)
                 nodes, node_layers, parts = nodes[:end], node_layers[:end], parts[:end]
+                plane = mirror if stays else None
         chain_points, chain_radius = points[nodes], radius[nodes]
         widths = chain_radius
         if chain.parent < 0 and root_is_end:
@@ -66,7 +68,7 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True, 
         for part, count in pieces:
             first = len(placed)
             followed = [_follow((parts if count > 1 else node_layers)[part], copy, count, end_depth[chain.parent],
-                                mirror) for copy in range(count)]
+                                plane) for copy in range(count)]
             for copy in range(count):
                 depths = _resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
                                             followed[copy], side_axis, followed[:copy] + followed[copy + 1:])
@@ -129,14 +131,20 @@ def _fork(parts, radius, copies):
     return start - 1 if own else 0
 
 
-def _on_plane(node_layers, depth, tolerance):
-    """How many nodes of a leaf chain to keep: all but the tip stretch whose rays pass only beside a mirror plane at
-    ``depth``, through intervals mirroring each other across it within ``tolerance``, when the chain reaches that
-    stretch on the plane; all of them otherwise."""
-    end = len(node_layers)
-    while end > 0 and _beside(node_layers[end - 1], depth, tolerance):
-        end -= 1
-    return end if 2 <= end < len(node_layers) and _holds(node_layers[end - 1], depth) else len(node_layers)
+def _plane_course(node_layers, depth, tolerance, leaf):
+    """(how many nodes to keep, whether to keep to the plane) for a single chain seen across a mirror plane at
+    ``depth``: where no tip stretch of its nodes passes only beside the plane (``_beside``), all of them, keeping
+    to the plane across gaps; for a ``leaf`` whose tip stretch does, after a node whose rays cross the plane inside
+    the mesh, the nodes before that stretch, keeping to the plane; else all of them, following one part as without
+    a plane (a chain wholly beside the plane, or one that others hang from, would otherwise run through the air)."""
+    start = len(node_layers)
+    while start > 0 and _beside(node_layers[start - 1], depth, tolerance):
+        start -= 1
+    if start == len(node_layers):
+        return start, True
+    if leaf and start >= 2 and _holds(node_layers[start - 1], depth):
+        return start, True
+    return len(node_layers), False
 
 
 def _beside(layer, depth, tolerance):
@@ -148,6 +156,7 @@ def _beside(layer, depth, tolerance):
 
 
 def _holds(layer, depth):
+    """Whether one of a node's depth intervals contains ``depth``."""
     return bool(((layer[:, 0] <= depth) & (depth <= layer[:, 1])).any())
 
 
@@ -168,10 +177,11 @@ def _layer_count(node_layers):
 
 def _follow(node_layers, copy, copies, start, mirror=None):
     """Depth along a chain, always the middle of an interval. A single chain follows, from its start, the interval
-    nearest the previous depth; on a ``mirror`` plane ((depth, tolerance) or None) it stays there across nodes whose
-    rays pass only beside it (ears on each side of a head), not stepping to the one side or the other. Copy ``copy`` of a split chain is anchored at interval ``copy`` (front to back) of
-    the outermost node crossing exactly ``copies`` intervals, and followed from there both ways by nearest depth,
-    so it never jumps to the other part where some node sees the parts merged or an extra part."""
+    nearest the previous depth; on a ``mirror`` plane ((depth, tolerance) or None) it stays there across nodes
+    whose rays pass only beside it (ears on each side of a head), not stepping to the one side or the other. Copy
+    ``copy`` of a split chain is anchored at interval ``copy`` (front to back) of the outermost node crossing exactly
+    ``copies`` intervals, and followed from there both ways by nearest depth, so it never jumps to the other part
+    where some node sees the parts merged or an extra part."""
     depths = np.full(len(node_layers), np.nan)
     if copies == 1:
         _track(node_layers, range(len(node_layers)), start, depths, mirror=mirror)
