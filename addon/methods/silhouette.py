@@ -278,6 +278,7 @@ def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, reaches, bone_
         return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
     view_sil.share_parts(sil)  # the mesh's welded parts, found once for the primary view, give the view's layers
     limbs = []
+    # placed without the plane: only the limbs off the skeleton are kept, and add_limbs completes their mirror pairs
     for placed in _placed_islands(view_sil, view_graph, alive, kept, SPECK * bone_length, None, split_layers, None):
         if isinstance(placed, PlacedIsland):
             limbs += uncovered_limbs(placed.chains, cover, sil, reaches[0])
