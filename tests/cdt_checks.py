@@ -238,10 +238,10 @@ def check_boundary_constrained(tri):
 
 
 def _direction_key(a, b):
-    """A function ordering points along the line a -> b (exact for points on it)."""
-    axis = 0 if abs(b[0] - a[0]) >= abs(b[1] - a[1]) else 1
-    sign = 1.0 if b[axis] > a[axis] else -1.0
-    return lambda p: sign * p[axis]
+    """A function ordering points along the line a -> b: their projection onto it, so that a vertex snapped onto the
+    segment beside an endpoint (sharing its coordinate along either axis) still comes before that endpoint."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return lambda p: (p[0] - a[0]) * dx + (p[1] - a[1]) * dy
 
 
 def _near_line(p, a, b):
