@@ -62,6 +62,7 @@ class PartsTooSmall(NoSilhouette):
 
 DEFAULT_RESOLUTION = 1024
 DEFAULT_TOLERANCE = 0.05
+INT32_MAX = 2**31 - 1  # the tracer indexes vertices with int32
 AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 
 
@@ -161,8 +162,10 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
             parts far apart).
     """
     verts = point_array(vertices, 3, "vertices")
+    if len(verts) > INT32_MAX:
+        raise ValueError(f"the mesh has {len(verts)} vertices; the tracer indexes at most {INT32_MAX}")
     tris = index_array(triangles, 3, len(verts), name="triangles", item="triangle", target=("vertex", "vertices"),
-                       dtype=np.int64)
+                       dtype=np.int32)
     if len(verts) == 0 or len(tris) == 0:
         raise ValueError(f"the mesh is empty ({len(verts)} vertices, {len(tris)} triangles)")
     view = _as_direction(direction)

@@ -1836,7 +1836,7 @@ static int trace_outline(SilTrace *t, double tolerance)
     return SIL_OK;
 }
 
-int sil_trace(const double *vertices, int64_t n_vertices, const int64_t *triangles, int64_t n_triangles,
+int sil_trace(const double *vertices, int64_t n_vertices, const int32_t *triangles, int64_t n_triangles,
               const double direction[3], int32_t resolution, double tolerance, SilTrace **out)
 {
     *out = NULL;
@@ -1855,7 +1855,7 @@ int sil_trace(const double *vertices, int64_t n_vertices, const int64_t *triangl
         if (!t->all_tris) rc = SIL_ERR_NOMEM;
         for (int64_t i = 0; rc == SIL_OK && i < 3 * n_triangles; i++) {
             if (triangles[i] < 0 || triangles[i] >= n_vertices) rc = SIL_ERR_INDEX;
-            else t->all_tris[i] = (int32_t)triangles[i];
+            else t->all_tris[i] = triangles[i];
         }
     }
     if (rc == SIL_OK) rc = snap(t, resolution);

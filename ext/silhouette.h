@@ -43,7 +43,7 @@ const char *sil_error_message(int code);
 /* Trace the silhouette of `n_triangles` triangles (vertex index triples) over `n_vertices` xyz vertices seen along
  * `direction`. `resolution`: grid cells along the longest projected side. `tolerance`: how far, in cells (0..1),
  * simplification may move the outline. On success *out owns everything; free it with sil_free. */
-int sil_trace(const double *vertices, int64_t n_vertices, const int64_t *triangles, int64_t n_triangles,
+int sil_trace(const double *vertices, int64_t n_vertices, const int32_t *triangles, int64_t n_triangles,
               const double direction[3], int32_t resolution, double tolerance, SilTrace **out);
 void sil_free(SilTrace *trace);
 

@@ -19,7 +19,7 @@ cdef extern from "silhouette.h":
     int SIL_MIN_RESOLUTION
     int SIL_MAX_RESOLUTION
     const char *sil_error_message(int code)
-    int sil_trace(const double *vertices, int64_t n_vertices, const int64_t *triangles, int64_t n_triangles,
+    int sil_trace(const double *vertices, int64_t n_vertices, const int32_t *triangles, int64_t n_triangles,
                   const double *direction, int32_t resolution, double tolerance, SilTrace **out) nogil
     void sil_free(SilTrace *trace)
     void sil_frame(const SilTrace *trace, double *origin, double *u, double *v, double *direction)
@@ -117,7 +117,7 @@ cdef class Trace:
             sil_release(intervals)
 
 
-def trace(const double[:, ::1] vertices, const int64_t[:, ::1] triangles, const double[::1] direction, int resolution,
+def trace(const double[:, ::1] vertices, const int32_t[:, ::1] triangles, const double[::1] direction, int resolution,
           double tolerance):
     """Trace the silhouette; see ``rigger.silhouette.trace`` for the contract. Arrays must be non-empty."""
     if vertices.shape[0] == 0 or triangles.shape[0] == 0:

@@ -286,10 +286,10 @@ int sw_bone_weights(const double *points, int64_t n_points, const double *normal
         tree_free(&tree);
         return SW_ERR_NOMEM;
     }
+    if (!(facing_penalty > 0.0)) normals = NULL; /* no penalty: no normal to read */
     for (int64_t p = 0; p < n_points; p++) {
         double unit[3];
-        const double *normal = normals && facing_penalty > 0.0 ? normals + 3 * p : NULL; /* no penalty: no normal */
-        const double *unit_normal = unit_or_null(normal, unit);
+        const double *unit_normal = unit_or_null(normals ? normals + 3 * p : NULL, unit);
         nearest_bones(&tree, heads, tails, points + 3 * p, unit_normal, facing_penalty, best, capacity, stack);
         point_weights(best, capacity, used, per_point, power, bones_out + p * per_point, weights_out + p * per_point);
     }

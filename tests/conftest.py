@@ -6,6 +6,7 @@ import pathlib
 import sys
 
 import pytest
+from hypothesis import settings
 
 from rigger.blender.headless import empty_scene, temporary_user_folder
 
@@ -14,6 +15,11 @@ SHARED = pathlib.Path(os.environ.get("RIGGER_SHARED", ROOT.parent / "shared"))
 sys.path.insert(0, str(ROOT / "bench"))  # bench/ is not a package; tests use its scorers and readers (rigdata, ...)
 
 temporary_user_folder()  # before any test imports bpy; the Blender child processes share the folder
+
+# Property tests are derandomised and keep no saved-example database, so a run's verdict does not depend on the run
+# (a failure found once is pinned as an example of its own); no deadline, the compiled code's first call is slow.
+settings.register_profile("rigger", deadline=None, derandomize=True, database=None)
+settings.load_profile("rigger")
 
 
 def shared_path(*parts):

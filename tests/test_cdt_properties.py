@@ -20,11 +20,8 @@ from rigger.cdt import triangulate
 
 
 def budget(examples):
-    """Hypothesis settings with a bounded example count (the whole file stays well under a minute), derandomised and
-    without a saved-example database, so a run's verdict does not depend on the run: a failure found once is pinned
-    below as an example of its own."""
-    return settings(max_examples=examples, deadline=None, suppress_health_check=[HealthCheck.too_slow],
-                    derandomize=True, database=None)
+    """Hypothesis settings with a bounded example count (the whole file stays well under a minute)."""
+    return settings(max_examples=examples, suppress_health_check=[HealthCheck.too_slow])
 
 
 GRID = st.integers(-4, 4)

@@ -319,7 +319,7 @@ def test_every_kind_of_soup():
 coordinates = st.one_of(st.integers(-3, 3).map(float), st.floats(-1, 1, allow_nan=False, width=32))
 
 
-@settings(max_examples=120, deadline=None, derandomize=True, database=None)
+@settings(max_examples=120)
 @given(st.lists(st.tuples(coordinates, coordinates, coordinates), min_size=3, max_size=30),
        st.sampled_from(["X", "Y", "Z", (0.3, 0.5, 0.8)]), st.sampled_from([16, 33, 256]))
 def test_random_soups(points, direction, resolution):

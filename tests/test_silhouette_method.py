@@ -526,8 +526,7 @@ def test_unknown_parameter_is_rejected():
         rigger.rig_mesh(vertices, triangles, bone_lenght=0.2)
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow],
-          derandomize=True, database=None)
+@settings(max_examples=40, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 2**32 - 1), count=st.integers(1, 60), flat=st.booleans())
 def test_any_triangle_soup_gives_a_valid_tree_or_a_clear_error(seed, count, flat):
     """Random soups (overlapping, intersecting, flat or not): a rooted tree of bones, or a ValueError."""

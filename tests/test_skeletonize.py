@@ -208,8 +208,8 @@ def test_a_forked_chain_is_one_stem_then_a_chain_per_part():
 def test_a_head_seen_across_the_mirror_plane_does_not_run_into_one_ear():
     """A head (one part on the mirror plane z = 0, half-width 0.5) with thin ears on each side seen from the side:
     where the rays pass only beside the plane (a gap in the head's outline, and the ears' tips) the chain neither
-    steps into one ear nor ends in one; the perpendicular views find the ears. Without the plane it follows one ear
-    to its tip, as it must for a single part off to one side."""
+    steps into one ear nor ends in one. Without the plane, or without splitting, it follows one ear to its tip, as
+    it must for a single part off to one side."""
     count = 12
     ears = layers((-0.8, -0.7), (0.7, 0.8))
     node_layers = [layers((-0.5, 0.5))] * 5 + [ears] + [layers((-0.5, 0.5))] * 3 + [ears] * 3
@@ -389,8 +389,8 @@ def test_a_limb_that_its_longer_twins_image_covers_becomes_that_image():
 
 
 def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_at_all():
-    """Two boxes mirrored across x = 2: seen along Y or Z every outline point reflects onto the outline; seen along
-    X, across the plane, there is no reflection in the view."""
+    """Two boxes mirrored across x = 2, joined by a bar: seen along Y or -Z every outline point reflects onto the
+    outline; seen along X, across the plane, there is no reflection in the view."""
     vertices, triangles = combine(box((0.0, 0.0, 0.0), (1.0, 2.0, 3.0)), box((3.0, 0.0, 0.0), (4.0, 2.0, 3.0)),
                                   box((0.5, 1.0, 0.0), (3.5, 1.5, 0.5)))
     for view in ("Y", "-Z"):

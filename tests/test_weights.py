@@ -70,7 +70,7 @@ def test_power_and_penalty_follow_the_rule(power, penalty):
 finite = st.floats(-10, 10, allow_nan=False, width=64)
 
 
-@settings(max_examples=150, deadline=None, derandomize=True, database=None)
+@settings(max_examples=150)
 @given(points=arrays(np.float64, st.tuples(st.integers(0, 12), st.just(3)), elements=finite),
        heads=arrays(np.float64, (6, 3), elements=finite), tails=arrays(np.float64, (6, 3), elements=finite),
        count=st.integers(1, 8))

@@ -58,11 +58,6 @@ class Mesh:
         return moved
 
     @cached_property
-    def wide_triangles(self):
-        """``triangles`` as int64, the index type the silhouette tracer takes: converted once, not once per view."""
-        return _read_only(self.triangles.astype(np.int64))
-
-    @cached_property
     def _used(self):
         """Which vertices triangles use, or None when all are."""
         used = np.zeros(len(self.vertices), dtype=bool)

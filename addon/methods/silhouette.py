@@ -116,7 +116,7 @@ class SilhouetteMethod(RigMethod):
         # rig at unit size (a power of two away: exact), in the frame where the view is an axis; then map back
         factor = mesh.unit_factor
         mesh = mesh.at_unit_size(frame)
-        vertices, triangles, flat = mesh.vertices, mesh.wide_triangles, mesh.flat_normal
+        vertices, triangles, flat = mesh.vertices, mesh.triangles, mesh.flat_normal
         try:
             axis, (sil, tri, graph) = _primary_view(mesh, view, resolution, outline_spacing, min_hole)
         except silhouette.NoSilhouette as error:
@@ -128,6 +128,7 @@ class SilhouetteMethod(RigMethod):
         unit = bone_length * mesh.scale  # the bone length in mesh units
         reaches = (MIN_BRANCH * unit, KEEP_REACH * mesh.scale)  # prune_spurs' min_reach and max_reach
         plane = mirror_plane(mesh.used_vertices, mesh.bbox, 0.01 * mesh.scale)
+        tolerance = MIRROR_TOLERANCE * mesh.scale  # chains whose ends mirror this close are a pair
         graph, alive, merged, kept = _pruned_tree(graph, merge, prune, reaches, reflection_in_view(sil, plane))
         clock.lap("merge_prune")
 
@@ -143,9 +144,9 @@ class SilhouetteMethod(RigMethod):
             other_views = [found for found in (side_of, end_on) if found is not None]
         clock.lap("other_views")
 
-        builder = _BoneBuilder(np.radians(bone_angle), unit, max_chain_bones, plane, MIRROR_TOLERANCE * mesh.scale)
+        builder = _BoneBuilder(np.radians(bone_angle), unit, max_chain_bones, plane, tolerance)
         for placed in _placed_islands(sil, graph, alive, kept, SPECK * unit, side, split_layers,
-                                      mirror_in_depth(sil, plane, MIRROR_TOLERANCE * mesh.scale)):
+                                      mirror_in_depth(sil, plane, tolerance)):
             if isinstance(placed, Blob):
                 builder.add_blob(sil, placed.point, placed.radius)
             else:
@@ -157,8 +158,7 @@ class SilhouetteMethod(RigMethod):
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()
-        names = bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, plane,
-                           MIRROR_TOLERANCE * mesh.scale)
+        names = bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, plane, tolerance)
         clock.lap("names")
 
         stages = {
@@ -302,7 +302,7 @@ def _primary_view(mesh, view, resolution, spacing, min_hole):
     first_error = None
     for axis, direction in candidates:
         try:
-            return axis, planar_axis(mesh.vertices, mesh.wide_triangles, direction, resolution, spacing, min_hole)
+            return axis, planar_axis(mesh.vertices, mesh.triangles, direction, resolution, spacing, min_hole)
         except silhouette.PartsTooSmall:
             raise  # along every axis alike
         except silhouette.NoSilhouette as error:

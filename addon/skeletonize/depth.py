@@ -149,15 +149,16 @@ def _plane_course(node_layers, depth, tolerance, leaf):
 
 def _beside(layer, depth, tolerance):
     """Whether one node's depth ``layer`` flanks the plane at ``depth``: two or more intervals, none holding it,
-    mirroring each other across it."""
+    mirroring each other across it (plain floats, as in ``_track``, which asks this of every node)."""
     if len(layer) < 2 or _holds(layer, depth):
         return False
-    return float(np.abs(2 * depth - layer[::-1, ::-1] - layer).max()) <= tolerance
+    intervals = layer.tolist()  # the k-th interval's low end mirrors the k-th from the back's high end
+    return max(abs(2 * depth - low - high) for (low, _), (_, high) in zip(intervals, reversed(intervals))) <= tolerance
 
 
 def _holds(layer, depth):
     """Whether one of a node's depth intervals contains ``depth``."""
-    return bool(((layer[:, 0] <= depth) & (depth <= layer[:, 1])).any())
+    return any(low <= depth <= high for low, high in layer.tolist())
 
 
 def _layer_count(node_layers):
@@ -201,9 +202,8 @@ def _track(node_layers, order, previous, depths, stay=False, mirror=None):
     ``mirror`` plane, keep it where the intervals flank the plane (``_beside``)."""
     for i in order:  # plain floats: the intervals are few, and numpy's per-call cost would dominate
         layer = node_layers[i]
-        if mirror is not None and abs(previous - mirror[0]) <= mirror[1] and _beside(layer, *mirror):
-            pass
-        elif len(layer):
+        on_plane = mirror is not None and abs(previous - mirror[0]) <= mirror[1]
+        if len(layer) and not (on_plane and _beside(layer, *mirror)):
             gap, low, high = min((max(low - previous, 0.0) + max(previous - high, 0.0), low, high)
                                  for low, high in layer.tolist())
             if not (stay and gap == 0.0):
