@@ -760,20 +760,23 @@ cdef int release(Mesh *m, Buffer *dirty, int p, int q) noexcept nogil:
     return buf_push2(dirty, p, q) or restore_delaunay(m, dirty)
 
 
-cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a, int b, int count) noexcept nogil:
-    """Make a-b an edge (or queue its pieces when a vertex lies on it or a constraint crosses it)."""
+cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, Buffer *bypassed, int a, int b,
+                        int count) noexcept nogil:
+    """Make a-b an edge (or queue its pieces when a vertex lies on it or a constraint crosses it).
+
+    An existing edge a-b that the segment is routed around (through a sliver apex) goes to ``bypassed``: it may have
+    been Delaunay only behind a constraint since split, so it is flipped once every segment is in."""
     cdef int h, start, p, q, o, r, s, head, u, v, x, y, k
     cdef long long guard
     h = find_edge(m, a, b)
     if h >= 0:
         # a sliver apex within SNAP of the edge (beside a Steiner vertex) lies on the segment: route through it
         r = m.V[prv(h)]
-        if r != GHOST and on_segment(m, a, b, r):
-            return split_at(w, a, r, b, count)
-        r = m.V[prv(m.N[h])]
-        if r != GHOST and on_segment(m, a, b, r):
-            return split_at(w, a, r, b, count)
-        return mark(m, h, count)
+        if r == GHOST or not on_segment(m, a, b, r):
+            r = m.V[prv(m.N[h])]
+            if r == GHOST or not on_segment(m, a, b, r):
+                return mark(m, h, count)
+        return buf_push2(bypassed, a, b) or split_at(w, a, r, b, count)
     # the triangle around a that the segment leaves through
     h = m.VT[a]
     start = h
@@ -861,12 +864,12 @@ cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, int a,
 
 cdef int insert_constraints(Mesh *m, const int *segs, int nseg, const int *vmap) noexcept nogil:
     cdef Work w
-    cdef Buffer crossed, fresh
+    cdef Buffer crossed, fresh, bypassed
     cdef int i, a, b, count, err = 0
     w.data = NULL
     w.n = w.cap = 0
-    crossed.data = fresh.data = NULL
-    crossed.n = crossed.cap = fresh.n = fresh.cap = 0
+    crossed.data = fresh.data = bypassed.data = NULL
+    crossed.n = crossed.cap = fresh.n = fresh.cap = bypassed.n = bypassed.cap = 0
     for i in range(nseg - 1, -1, -1):
         err = work_push(&w, vmap[segs[2 * i]], vmap[segs[2 * i + 1]], 1)
         if err:
@@ -880,10 +883,13 @@ cdef int insert_constraints(Mesh *m, const int *segs, int nseg, const int *vmap)
         b = w.data[w.n + 1]
         count = w.data[w.n + 2]
         if a != b and count > 0:
-            err = insert_segment(m, &w, &crossed, &fresh, a, b, count)
+            err = insert_segment(m, &w, &crossed, &fresh, &bypassed, a, b, count)
+    if err == 0:
+        err = restore_delaunay(m, &bypassed)
     free(w.data)
     free(crossed.data)
     free(fresh.data)
+    free(bypassed.data)
     return err
 
 

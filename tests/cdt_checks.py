@@ -8,6 +8,7 @@ compared with a small tolerance.
 import bisect
 import math
 from collections import Counter
+from fractions import Fraction
 
 import numpy as np
 
@@ -239,9 +240,11 @@ def check_boundary_constrained(tri):
 
 def _direction_key(a, b):
     """A function ordering points along the line a -> b: their projection onto it, so that a vertex snapped onto the
-    segment beside an endpoint (sharing its coordinate along either axis) still comes before that endpoint."""
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    return lambda p: (p[0] - a[0]) * dx + (p[1] - a[1]) * dy
+    segment beside an endpoint (sharing its coordinate along either axis) still comes before that endpoint. Exact
+    rationals: in floats that projection can round to the endpoint's own."""
+    ax, ay = Fraction(a[0]), Fraction(a[1])
+    dx, dy = Fraction(b[0]) - ax, Fraction(b[1]) - ay
+    return lambda p: (Fraction(p[0]) - ax) * dx + (Fraction(p[1]) - ay) * dy
 
 
 def _near_line(p, a, b):

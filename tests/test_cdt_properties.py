@@ -135,10 +135,10 @@ def test_a_segment_routed_through_a_vertex_an_ulp_from_its_end_is_a_chain_along_
     check_both_modes(points, np.array([[0, 1]]))
 
 
-@pytest.mark.xfail(strict=True, reason="known CDT bug: after a crossing's segment is routed through a vertex an ulp "
-                   "from its end, the edge from that end to the crossing is not flipped (not Delaunay)")
 def test_a_crossing_next_to_a_vertex_an_ulp_from_a_segments_end_stays_delaunay():
-    """Found by Hypothesis: vertex 7 lies an ulp from vertex 2, the end of segment 0-2, which crosses 1-6."""
+    """Found by Hypothesis: vertex 7 lies an ulp from vertex 2, the end of segment 0-2, which crosses 1-6 at Steiner
+    vertex 8. The piece 8-2 is routed through 7, so edge 8-2, until then behind the constraint 0-2, must be flipped.
+    The chain 0-8-7-2 also tests the checker: 7's projection onto 0-2 rounds to 2's in floats."""
     points = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, -4.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, -1.0],
                        [2.0, -3.9999999999999996]])
     check_both_modes(points, np.array([[0, 2], [1, 6]]))
