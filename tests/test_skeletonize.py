@@ -84,6 +84,31 @@ def test_a_spur_whose_mirror_image_is_kept_stays():
     assert tips(prune_spurs(points, radius, chains, 0.8, mirror=reflect)) == [True, True, True]
 
 
+def test_a_mirror_pair_of_stubby_branches_stays_where_a_lone_one_goes():
+    """Two ears off a head (a chest disc of radius 1), each sticking out 0.9 times its width: under prune (1.35),
+    over pair_prune (0.74). With the reflection the pair stays; a lone ear, a pair under pair_prune, or either rule
+    missing, and they go."""
+    def ear(side, ratio, y=0.0):  # radius 0.3 off the chest's disc: sticks out ratio times its width 0.6
+        return [(side * x, y, 0.3) for x in np.linspace(1.02, 0.7 + 0.6 * ratio, 5)]
+
+    def reflect(p):
+        return p * [-1.0, 1.0]
+
+    def kept(right, left, **rules):  # whether each ear's tip (the last node of its part) stays
+        points, radius, chains = chest_with_legs(right, left)
+        links = prune_spurs(points, radius, chains, 1.35, **rules)
+        return [tip in links for tip in (17, 22)]
+
+    pair = {"mirror": reflect, "pair_prune": 0.74}
+    assert kept(ear(1, 0.9), ear(-1, 0.9), **pair) == [True, True]
+    assert kept(ear(1, 0.9), ear(-1, 0.9), mirror=reflect) == [False, False]
+    assert kept(ear(1, 0.9), ear(-1, 0.9), pair_prune=0.74) == [False, False]
+    assert kept(ear(1, 0.9), ear(-1, 0.9, y=0.8), **pair) == [False, False]  # not each other's image
+    assert kept(ear(1, 0.9), ear(-1, 0.6), **pair) == [False, False]
+    assert kept(ear(1, 0.7), ear(-1, 0.7), **pair) == [False, False]
+
+
+
 def test_outline_noise_is_not_kept_for_lying_on_the_body_it_mirrors_onto():
     """Two specks of outline noise mirroring each other on the edge of the chest's disc, between two legs: each
     speck's image lies on the chest, not on a kept branch, so both go."""

@@ -39,6 +39,7 @@ KEEP_REACH = 0.25  # branches sticking out this share of the mesh's size are kep
 AXIS_NAMES = ("X", "Y", "Z")
 MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
 HIDDEN_REACH = 0.6  # perpendicular-view limb tips this many bone lengths off the skeleton (seen that way) are missing
+PAIRED_PRUNE = 0.55  # mirror twins sticking out at least this fraction of ``prune`` times their width are limbs
 HIDDEN_PRUNE = 2 / 3  # the perpendicular views prune at this fraction of ``prune``: a limb they add must also be off
 # the primary skeleton and hidden in the primary view, so they can trust stubbier branches (a fox's ears)
 END_RESOLUTION = 1 / 3  # the end-on view (the remaining axis of larger spread: along the longest extent when the view
@@ -129,7 +130,8 @@ class SilhouetteMethod(RigMethod):
         reaches = (MIN_BRANCH * unit, KEEP_REACH * mesh.scale)  # prune_spurs' min_reach and max_reach
         plane = mirror_plane(mesh.used_vertices, mesh.bbox, 0.01 * mesh.scale)
         tolerance = MIRROR_TOLERANCE * mesh.scale  # chains whose ends mirror this close are a pair
-        graph, alive, merged, kept = _pruned_tree(graph, merge, prune, reaches, reflection_in_view(sil, plane))
+        graph, alive, merged, kept = _pruned_tree(graph, merge, (prune, PAIRED_PRUNE * prune), reaches,
+                                                  reflection_in_view(sil, plane))
         clock.lap("merge_prune")
 
         side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
@@ -152,8 +154,9 @@ class SilhouetteMethod(RigMethod):
             else:
                 builder.add_island(placed.root_point, placed.chains)
         for view_sil, view_graph in other_views:
-            limbs = _hidden_limbs(sil, view_sil, view_graph, builder.lines, merge, HIDDEN_PRUNE * prune, reaches, unit,
-                                  split_layers, reflection_in_view(view_sil, plane))
+            limbs = _hidden_limbs(sil, view_sil, view_graph, builder.lines, merge,
+                                  (HIDDEN_PRUNE * prune, PAIRED_PRUNE * prune), reaches, unit, split_layers,
+                                  reflection_in_view(view_sil, plane))
             builder.add_limbs(limbs, (sil, view_sil))
         clock.lap("depth_bones")
 
@@ -225,9 +228,9 @@ def _to_world(stages, frame, factor, *points):
     return [place(array) for array in points]
 
 
-def _pruned_tree(graph, merge, prune, reaches, mirror=None):
-    """Blob merging and spur pruning of a chordal axis, ``reaches`` being ``prune_spurs``' (min_reach, max_reach)
-    and ``mirror`` its reflection; its junctions are the blobs that keep a spur ending in one. Returns (graph, alive
+def _pruned_tree(graph, merge, prunes, reaches, mirror=None):
+    """Blob merging and spur pruning of a chordal axis, ``prunes`` and ``reaches`` being ``prune_spurs``' (prune,
+    pair_prune) and (min_reach, max_reach), ``mirror`` its reflection; its junctions are the blobs that keep a spur ending in one. Returns (graph, alive
     nodes, merged links, kept links): with ``mirror``, the graph whose blobs near the mirror line are centred on it
     (``AxisGraph.centred_on_mirror``), the stages show and the bones follow."""
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
@@ -235,8 +238,9 @@ def _pruned_tree(graph, merge, prune, reaches, mirror=None):
     if mirror is not None:
         graph = graph.centred_on_mirror(alive[graph.junction[alive]], mirror)
     _, chains = chains_of(alive.tolist(), merged)
+    prune, pair_prune = prunes
     return graph, alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, *reaches, mirror=mirror,
-                                             blobs=graph.junction)
+                                             blobs=graph.junction, pair_prune=pair_prune)
 
 
 def _placed_islands(sil, graph, alive, kept, speck, side, split_layers, mirror):
@@ -265,12 +269,12 @@ def _other_view(vertices, triangles, axis, resolution, spacing, min_hole):
     return view_sil, view_graph
 
 
-def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prune, reaches, bone_length, split_layers, mirror):
+def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prunes, reaches, bone_length, split_layers, mirror):
     """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``);
     the view's chains are placed in depth only when a leaf tip lies off the primary skeleton. With ``mirror`` (the
     view's ``reflection_in_view``, None when it does not look across the mirror plane) the tree is pruned as the
     primary view's is: blobs near the mirror line are centred on it, and a spur whose mirror image is kept stays."""
-    view_graph, alive, _, kept = _pruned_tree(view_graph, merge, prune, reaches, mirror)
+    view_graph, alive, _, kept = _pruned_tree(view_graph, merge, prunes, reaches, mirror)
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]
     cover = Cover(lines, view_sil.direction, HIDDEN_REACH * bone_length)

@@ -8,7 +8,7 @@ A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch p
 2. Spur pruning: a branch that pokes out of the disc it hangs on by less than ``prune`` times its own width is a
    bump or outline noise, not a limb; it is removed, repeatedly, since removing one can expose another. A branch
    reaching far enough is kept however wide, and so is one ending in a round part of its own (a head without a
-   neck) or one whose mirror image is kept.
+   neck), one whose mirror image is kept, or a mirror pair of stubbier ones (two ears).
 3. Rooting at the most central branch point (smallest largest distance to any end), then cutting every cycle (holes
    in the silhouette) where the two ways around it from the root meet. A path without branch points is rooted at
    its widest node, or at its thicker end when it is about equally wide throughout.
@@ -96,7 +96,8 @@ def _walk(start, first, neighbours, keys, arrived):
     return path
 
 
-def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, mirror=None, blobs=None):
+def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, mirror=None, blobs=None,
+                pair_prune=None):
     """Drop leaf chains that stick out of the disc of the node they hang on by less than ``prune`` times their own
     width, or by less than ``min_reach``, but never by ``max_reach`` or more, until none does. ``chains`` are node
     lists; returns the surviving links.
@@ -110,7 +111,9 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
     without a neck, and a cartoon's round feet hang straight off its hips.
     With ``mirror``, a function reflecting (P, 2) points across the mesh's mirror plane, a spur whose mirror image
     is a branch kept off the same base stays too: a figure's two arms off its chest, each near the threshold, are
-    kept or dropped together.
+    kept or dropped together. With ``pair_prune`` as well, two spurs off one base that mirror each other and stick
+    out by more than ``min_reach`` and ``pair_prune`` times their width both stay: a pair is a limb where a lone
+    bump of that size is not (a dog's two ears on its head; outline noise is not symmetric).
     """
     chains = [list(c) for c in chains]
     while True:
@@ -118,7 +121,8 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
         for chain in chains:
             for end in (chain[0], chain[-1]):
                 degree[end] = degree.get(end, 0) + 1
-        spurs, kept_leaves = {}, {}  # chain -> (base, tip); chain -> (base, its nodes outside the base's disc)
+        spurs, paired, leaves = {}, set(), []  # chain -> (base, tip); spurs that may pair; (chain, base, its nodes
+        # outside the base's disc) of the kept leaves and the spurs that may pair
         for i, chain in enumerate(chains):
             for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
                 if degree[tip] == 1 and degree[base] >= 3:
@@ -131,11 +135,13 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
                         blobs is not None and _round_part(points, radius, blobs, base, tip))
                     if beyond < max_reach and (beyond <= min_reach or bump):
                         spurs[i] = base, tip
-                    else:
-                        kept_leaves[i] = base, outside
+                        if pair_prune is None or beyond <= min_reach or beyond <= pair_prune * width:
+                            break
+                        paired.add(i)
+                    leaves.append((i, base, outside))
                     break
         if spurs and mirror is not None:
-            spurs = _unmirrored(spurs, kept_leaves.values(), points, radius, mirror)
+            spurs = _unmirrored(spurs, paired, leaves, points, radius, mirror)
         if not spurs:
             return _links_of(chains)
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
@@ -151,18 +157,20 @@ def _round_part(points, radius, blobs, base, tip):
         np.linalg.norm(points[tip] - points[base]) > radius[base])
 
 
-def _unmirrored(spurs, kept_leaves, points, radius, mirror):
-    """The ``spurs`` (chain -> (base, tip)) whose tip's mirror image lies in no disc of a leaf branch kept off the
-    same base (``kept_leaves``: (base, its nodes outside the base's disc) each; the base's own disc covers the body,
-    so a bump whose image falls on it still goes)."""
+def _unmirrored(spurs, paired, leaves, points, radius, mirror):
+    """The ``spurs`` (chain -> (base, tip)) whose tip's mirror image lies in no disc of a twin: a node outside the
+    base's disc of another leaf off the same base (``leaves``: (chain, base, those nodes) each). A kept leaf is a
+    twin to every spur; to a ``paired`` spur (long enough for a limb if it has a twin) so is another paired one, so
+    that two ears each under the threshold stay together. The base's own disc covers the body, so a bump whose
+    image falls on it still goes."""
     beside = {}
-    for base, outside in kept_leaves:
-        beside.setdefault(base, []).append(outside)
-    beside = {base: np.concatenate(parts) for base, parts in beside.items()}
+    for chain, base, outside in leaves:
+        beside.setdefault(base, []).append((chain, outside))
     images = mirror(points[[tip for _, tip in spurs.values()]])
     left = {}
     for (i, (base, tip)), image in zip(spurs.items(), images):
-        nodes = beside.get(base, np.zeros(0, np.int64))
+        twins = [outside for chain, outside in beside.get(base, ()) if chain != i and (i in paired or chain not in spurs)]
+        nodes = np.concatenate(twins) if twins else np.zeros(0, np.int64)
         if not (np.linalg.norm(points[nodes] - image, axis=1) <= radius[nodes]).any():
             left[i] = base, tip
     return left
