@@ -11,6 +11,8 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
+from rigger.core.mesh import fan_triangles
+
 HELPER_JOINT = re.compile(r"PoleTarget|^Dummy_|_rootJoint$")
 BONE_SAMPLE_STEP = 0.005
 # Point-triangle pairs per winding-number chunk: bounds memory to a few (chunk, 3) float arrays of ~24 MB each.
@@ -55,17 +57,7 @@ def load_obj(path):
     indices = np.where(raw_indices < 0, raw_indices + known_vertices, raw_indices - 1)
     if (indices < 0).any() or (indices >= len(vertices)).any():
         raise ValueError(f"{path}: face index out of range (the file defines {len(vertices)} vertices)")
-    return vertices, fan_triangulate(indices, face_sizes)
-
-
-def fan_triangulate(corners, face_sizes):
-    """Triangles (sum(size - 2), 3) fanning each polygon from its first corner; ``corners`` holds all faces flat."""
-    starts = np.cumsum(face_sizes) - face_sizes
-    triangles_per_face = face_sizes - 2
-    first = np.repeat(starts, triangles_per_face)
-    step = np.arange(triangles_per_face.sum()) - np.repeat(np.cumsum(triangles_per_face) - triangles_per_face,
-                                                           triangles_per_face)
-    return np.stack([corners[first], corners[first + step + 1], corners[first + step + 2]], axis=1)
+    return vertices, fan_triangles(indices, face_sizes)
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ from meshes import box, combine
 from rigger import silhouette
 from rigger.skeletonize import depth
 from rigger.skeletonize.chordal import AxisGraph
-from rigger.skeletonize.bones import (bone_names, chain_joints, mirror_completed, reflection_in_view,
+from rigger.skeletonize.bones import (bone_names, chain_joints, mirror_completed, mirror_plane, reflection_in_view,
                                      symmetric_joints)
 from rigger.skeletonize.polyline import arc_lengths, segment_distances
 from rigger.skeletonize.tree import Chain, chains_of, prune_spurs, rooted_chains
@@ -51,6 +51,11 @@ def test_a_wide_branch_reaching_far_is_a_limb_not_a_bump():
     assert (8, 9) not in bumped and len(bumped) == 12
 
 
+def reflect(points):
+    """The mirror image of (P, 2) points across x = 0."""
+    return points * [-1.0, 1.0]
+
+
 def chest_with_legs(*branches):
     """(points, radius, chains) of an axis: a chest (node 0, radius 1) with two thin legs (nodes 1-12) and the
     ``branches`` ((x, y, radius) node lists) off it, numbered on from 13."""
@@ -72,9 +77,6 @@ def test_a_spur_whose_mirror_image_is_kept_stays():
     bump = [(0.0, 1.3, 0.8), (0.0, 1.6, 0.8)]  # sticks out 1.4, 1.6 wide
     points, radius, chains = chest_with_legs(arm(1, 1.4), arm(-1, 1.3), bump)
 
-    def reflect(p):
-        return p * [-1.0, 1.0]
-
     def tips(links):  # of the right arm, the left arm and the bump
         return [tip in links for tip in (18, 24, 26)]
 
@@ -90,9 +92,6 @@ def test_a_mirror_pair_of_stubby_branches_stays_where_a_lone_one_goes():
     missing, and they go."""
     def ear(side, ratio, y=0.0):  # radius 0.3 off the chest's disc: sticks out ratio times its width 0.6
         return [(side * x, y, 0.3) for x in np.linspace(1.02, 0.7 + 0.6 * ratio, 5)]
-
-    def reflect(p):
-        return p * [-1.0, 1.0]
 
     def kept(right, left, **rules):  # whether each ear's tip (the last node of its part) stays
         points, radius, chains = chest_with_legs(right, left)
@@ -114,7 +113,7 @@ def test_outline_noise_is_not_kept_for_lying_on_the_body_it_mirrors_onto():
     speck's image lies on the chest, not on a kept branch, so both go."""
     specks = [(0.5, 0.85, 0.01)], [(-0.5, 0.85, 0.01)]  # 0.99 from the chest's centre, 1.0 its radius
     points, radius, chains = chest_with_legs(*specks)
-    kept = prune_spurs(points, radius, chains, 1.35, mirror=lambda p: p * [-1.0, 1.0])
+    kept = prune_spurs(points, radius, chains, 1.35, mirror=reflect)
     assert 13 not in kept and 14 not in kept and 12 in kept
 
 
@@ -144,7 +143,7 @@ def test_blobs_near_the_mirror_line_are_centred_on_it():
     points = np.array([(0.2, 0.0), (0.6, 1.0), (0.3, 2.0), (-0.05, 3.0)])
     radius = np.array([0.5, 1.0, 0.5, 0.1])
     graph = AxisGraph(points, radius, np.ones(4, bool), np.array([(0, 1), (1, 2), (2, 3)]), np.zeros(4, int))
-    centred = graph.centred_on_mirror(np.array([0, 1, 2]), lambda p: p * [-1.0, 1.0])
+    centred = graph.centred_on_mirror(np.array([0, 1, 2]), reflect)
     np.testing.assert_array_equal(centred.points, [(0.0, 0.0), (0.6, 1.0), (0.3, 2.0), (-0.05, 3.0)])
     assert graph.points[0, 0] == 0.2
     assert graph.centred_on_mirror(np.zeros(0, int), lambda p: -p).points.tolist() == points.tolist()
@@ -411,6 +410,21 @@ def test_a_limb_that_its_longer_twins_image_covers_becomes_that_image():
     pair = [(leg, widths[:2]), (leg * [-1, 1, 1], widths[:2])]
     limbs = mirror_completed([(ear, widths), (twin, widths)] + pair, (0, 0.0), 0.05)
     assert all(got is kept for (got, _), (kept, _) in zip(limbs[2:], pair))
+
+
+def test_a_flat_mesh_is_not_mirrored_across_its_own_plane():
+    """A flat cut-out lies on the plane through its thickness, so mirroring across it moves nothing: that is no
+    left and right. A flat T symmetric across x = 0 has that plane; a flat L has none."""
+    def plane(outline):
+        points = np.array([(x, y, 0.0) for x, y in outline], dtype=float)
+        points = np.concatenate([points + [dx, dy, 0.0] for dx in (0, 0.01) for dy in (0, 0.01)])
+        return mirror_plane(points, np.array([points.min(axis=0), points.max(axis=0)]), 0.02)
+
+    t_shape = [(x, 1.0) for x in np.linspace(-1, 1, 21)] + [(0.0, y) for y in np.linspace(-1, 1, 21)]
+    l_shape = [(x, -1.0) for x in np.linspace(0, 1, 21)] + [(0.0, y) for y in np.linspace(-1, 1, 21)]
+    axis, offset = plane(t_shape)
+    assert axis == 0 and offset == pytest.approx(0.005)
+    assert plane(l_shape) is None
 
 
 def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_at_all():

@@ -160,11 +160,17 @@ def triangulate_polygons(faces):
     int32 = np.iinfo(np.int32)
     if flat.min() < int32.min or flat.max() > int32.max:
         raise ValueError("face indices do not fit in 32 bits")
+    return fan_triangles(flat, counts).astype(np.int32)
+
+
+def fan_triangles(corners, counts):
+    """Triangles (sum(counts - 2), 3) fanning each polygon from its first corner: ``corners`` holds every face's
+    vertex indices one after the other, ``counts`` (F,) how many each has (at least 3)."""
     triangle_counts = counts - 2
     face_starts = np.cumsum(counts) - counts
-    base = np.repeat(face_starts, triangle_counts)  # a fan from each face's first corner
+    base = np.repeat(face_starts, triangle_counts)
     corner = concatenated_ranges(face_starts, triangle_counts)
-    return np.stack([flat[base], flat[corner + 1], flat[corner + 2]], axis=1).astype(np.int32)
+    return np.stack([corners[base], corners[corner + 1], corners[corner + 2]], axis=1)
 
 
 def _read_only(array):

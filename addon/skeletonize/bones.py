@@ -154,8 +154,8 @@ def _turns(line, tolerance):
 def mirror_plane(vertices, bounds, tolerance, samples=600):
     """The axis (0, 1, 2) and offset of a plane the ``vertices`` are mirror-symmetric about, or None.
 
-    Tries the planes through the centre of ``bounds`` (their (2, 3) bounding box) perpendicular to X, Y and Z; a
-    plane fits when at least 95% of (up to ``samples``) vertices have a mirror image among the vertices within
+    Tries the planes through the centre of ``bounds`` (their (2, 3) bounding box) perpendicular to X, Y and Z
+    where the box is more than two ``tolerance`` deep; a plane fits when at least 95% of (up to ``samples``) vertices have a mirror image among the vertices within
     ``tolerance``: vertices are hashed to a grid of that size and the mirrored ones looked up in the sorted hashes,
     with their 26 neighbour cells.
     """
@@ -167,7 +167,7 @@ def mirror_plane(vertices, bounds, tolerance, samples=600):
     probe = vertices[::step]
     offsets = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)])
     best = None
-    for axis in range(3):
+    for axis in np.flatnonzero(high - low > 2 * tolerance):  # across a flat mesh's own plane nothing has a side
         centre = 0.5 * (low[axis] + high[axis])
         cells = np.floor((mirrored(probe, (axis, centre)) - origin) / tolerance).astype(np.int64)
         around = np.clip(cells[:, None, :] + offsets[None], 0, span - 1).reshape(-1, 3)
@@ -175,7 +175,7 @@ def mirror_plane(vertices, bounds, tolerance, samples=600):
         at = np.minimum(np.searchsorted(table, keys), len(table) - 1)
         score = (table[at] == keys).reshape(len(probe), -1).any(axis=1).mean()
         if score >= 0.95 and (best is None or score > best[2]):
-            best = (axis, centre, score)
+            best = (int(axis), centre, score)
     return None if best is None else best[:2]
 
 
