@@ -764,8 +764,9 @@ cdef int insert_segment(Mesh *m, Work *w, Buffer *crossed, Buffer *fresh, Buffer
                         int count) noexcept nogil:
     """Make a-b an edge (or queue its pieces when a vertex lies on it or a constraint crosses it).
 
-    An existing edge a-b that the segment is routed around (through a sliver apex) goes to ``bypassed``: it may have
-    been Delaunay only behind a constraint since split, so it is flipped once every segment is in."""
+    An existing edge a-b that the segment is routed around (through a sliver apex) goes to ``bypassed``: it may lie
+    where a constraint split at a crossing ran, Delaunay only while that hid the apex, and as an ordinary edge it
+    is checked, and flipped if need be, once every segment is in."""
     cdef int h, start, p, q, o, r, s, head, u, v, x, y, k
     cdef long long guard
     h = find_edge(m, a, b)

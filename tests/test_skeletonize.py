@@ -56,11 +56,11 @@ def reflect(points):
     return points * [-1.0, 1.0]
 
 
-def chest_with_legs(*branches):
-    """(points, radius, chains) of an axis: a chest (node 0, radius 1) with two thin legs (nodes 1-12) and the
-    ``branches`` ((x, y, radius) node lists) off it, numbered on from 13."""
+def chest_with_legs(*branches, legs=(-0.5, 0.5)):
+    """(points, radius, chains) of an axis: a chest (node 0, radius 1) with a thin leg of 6 nodes at each x of
+    ``legs`` (nodes 1-12) and the ``branches`` ((x, y, radius) node lists) off it, numbered on from there (13)."""
     nodes, chains = [(0.0, 0.0, 1.0)], []
-    for part in [[(side, -y, 0.3) for y in range(2, 8)] for side in (-0.5, 0.5)] + list(branches):
+    for part in [[(side, -y, 0.3) for y in range(2, 8)] for side in legs] + list(branches):
         chains.append([0] + list(range(len(nodes), len(nodes) + len(part))))
         nodes += part
     nodes = np.array(nodes)
@@ -93,19 +93,24 @@ def test_a_mirror_pair_of_stubby_branches_stays_where_a_lone_one_goes():
     def ear(side, ratio, y=0.0):  # radius 0.3 off the chest's disc: sticks out ratio times its width 0.6
         return [(side * x, y, 0.3) for x in np.linspace(1.02, 0.7 + 0.6 * ratio, 5)]
 
-    def kept(right, left, **rules):  # whether each ear's tip (the last node of its part) stays
-        points, radius, chains = chest_with_legs(right, left)
+    def kept(right, left, legs=(-0.5, 0.5), **rules):  # whether each ear's tip (the last node of its part) stays
+        points, radius, chains = chest_with_legs(right, left, legs=legs)
         links = prune_spurs(points, radius, chains, 1.35, **rules)
-        return [tip in links for tip in (17, 22)]
+        first = 1 + 6 * len(legs)
+        return [tip in links for tip in (first + len(right) - 1, first + len(right) + len(left) - 1)]
 
     pair = {"mirror": reflect, "pair_prune": 0.74}
     assert kept(ear(1, 0.9), ear(-1, 0.9), **pair) == [True, True]
+    assert kept(ear(1, 0.9), [(-0.3, 1.05, 0.1)], **pair) == [False, False]  # a lone ear (and a speck)
     assert kept(ear(1, 0.9), ear(-1, 0.9), mirror=reflect) == [False, False]
     assert kept(ear(1, 0.9), ear(-1, 0.9), pair_prune=0.74) == [False, False]
     assert kept(ear(1, 0.9), ear(-1, 0.9, y=0.8), **pair) == [False, False]  # not each other's image
     assert kept(ear(1, 0.9), ear(-1, 0.6), **pair) == [False, False]
     assert kept(ear(1, 0.7), ear(-1, 0.7), **pair) == [False, False]
-
+    # a short ear's image lies on a long one but not the other way round: neither is the other's twin, so both go,
+    # also off a head with one neck, where dropping the long one alone would leave the short one part of the neck
+    for legs in ((-0.5, 0.5), (0.0,)):
+        assert kept(ear(1, 1.34), ear(-1, 0.8), legs=legs, **pair) == [False, False]
 
 
 def test_outline_noise_is_not_kept_for_lying_on_the_body_it_mirrors_onto():

@@ -39,7 +39,7 @@ KEEP_REACH = 0.25  # branches sticking out this share of the mesh's size are kep
 AXIS_NAMES = ("X", "Y", "Z")
 MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
 HIDDEN_REACH = 0.6  # perpendicular-view limb tips this many bone lengths off the skeleton (seen that way) are missing
-PAIRED_PRUNE = 0.55  # mirror twins sticking out at least this fraction of ``prune`` times their width are limbs
+PAIRED_PRUNE = 0.55  # mirror twins sticking out more than this fraction of ``prune`` times their width are limbs
 HIDDEN_PRUNE = 2 / 3  # the perpendicular views prune at this fraction of ``prune``: a limb they add must also be off
 # the primary skeleton and hidden in the primary view, so they can trust stubbier branches (a fox's ears)
 END_RESOLUTION = 1 / 3  # the end-on view (the remaining axis of larger spread: along the longest extent when the view
@@ -230,9 +230,9 @@ def _to_world(stages, frame, factor, *points):
 
 def _pruned_tree(graph, merge, prunes, reaches, mirror=None):
     """Blob merging and spur pruning of a chordal axis, ``prunes`` and ``reaches`` being ``prune_spurs``' (prune,
-    pair_prune) and (min_reach, max_reach), ``mirror`` its reflection; its junctions are the blobs that keep a spur ending in one. Returns (graph, alive
-    nodes, merged links, kept links): with ``mirror``, the graph whose blobs near the mirror line are centred on it
-    (``AxisGraph.centred_on_mirror``), the stages show and the bones follow."""
+    pair_prune) and (min_reach, max_reach), ``mirror`` its reflection; its junctions are the blobs that keep a spur
+    ending in one. Returns (graph, alive nodes, merged links, kept links): with ``mirror``, the graph whose blobs near
+    the mirror line are centred on it (``AxisGraph.centred_on_mirror``), the stages show and the bones follow."""
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
     alive = np.unique(representative)
     if mirror is not None:
@@ -273,7 +273,8 @@ def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prunes, reaches, bone
     """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``);
     the view's chains are placed in depth only when a leaf tip lies off the primary skeleton. With ``mirror`` (the
     view's ``reflection_in_view``, None when it does not look across the mirror plane) the tree is pruned as the
-    primary view's is: blobs near the mirror line are centred on it, and a spur whose mirror image is kept stays."""
+    primary view's is: blobs near the mirror line are centred on it, and a spur whose mirror image is kept stays, as
+    do mirror pairs of stubbier ones."""
     view_graph, alive, _, kept = _pruned_tree(view_graph, merge, prunes, reaches, mirror)
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]

@@ -154,10 +154,10 @@ def _turns(line, tolerance):
 def mirror_plane(vertices, bounds, tolerance, samples=600):
     """The axis (0, 1, 2) and offset of a plane the ``vertices`` are mirror-symmetric about, or None.
 
-    Tries the planes through the centre of ``bounds`` (their (2, 3) bounding box) perpendicular to X, Y and Z
-    where the box is more than two ``tolerance`` deep; a plane fits when at least 95% of (up to ``samples``) vertices have a mirror image among the vertices within
-    ``tolerance``: vertices are hashed to a grid of that size and the mirrored ones looked up in the sorted hashes,
-    with their 26 neighbour cells.
+    Tries the planes through the centre of ``bounds`` (their (2, 3) bounding box) perpendicular to X, Y and Z where the
+    box is more than two ``tolerance`` deep; a plane fits when at least 95% of (up to ``samples``) vertices have a
+    mirror image among the vertices within ``tolerance``: vertices are hashed to a grid of that size and the mirrored
+    ones looked up in the sorted hashes, with their 26 neighbour cells.
     """
     low, high = bounds
     origin = low - 2 * tolerance

@@ -121,8 +121,9 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
         for chain in chains:
             for end in (chain[0], chain[-1]):
                 degree[end] = degree.get(end, 0) + 1
-        spurs, paired, leaves = {}, set(), []  # chain -> (base, tip); spurs that may pair; (chain, base, its nodes
-        # outside the base's disc) of the kept leaves and the spurs that may pair
+        # chain -> (base, tip) of the spurs; those that may pair; (chain, base, its nodes outside the base's disc) of
+        # the kept leaves and the spurs that may pair
+        spurs, paired, leaves = {}, set(), []
         for i, chain in enumerate(chains):
             for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
                 if degree[tip] == 1 and degree[base] >= 3:
@@ -133,12 +134,14 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
                     width = 2 * float(radius[outside[:3]].mean()) if len(outside) else 2 * float(radius[tip])
                     bump = beyond <= prune * width and not (  # the round-part test only where it can matter
                         blobs is not None and _round_part(points, radius, blobs, base, tip))
-                    if beyond < max_reach and (beyond <= min_reach or bump):
+                    spur = beyond < max_reach and (beyond <= min_reach or bump)
+                    pairable = spur and pair_prune is not None and beyond > max(min_reach, pair_prune * width)
+                    if spur:
                         spurs[i] = base, tip
-                        if pair_prune is None or beyond <= min_reach or beyond <= pair_prune * width:
-                            break
+                    if pairable:
                         paired.add(i)
-                    leaves.append((i, base, outside))
+                    if pairable or not spur:
+                        leaves.append((i, base, outside))
                     break
         if spurs and mirror is not None:
             spurs = _unmirrored(spurs, paired, leaves, points, radius, mirror)
@@ -158,22 +161,25 @@ def _round_part(points, radius, blobs, base, tip):
 
 
 def _unmirrored(spurs, paired, leaves, points, radius, mirror):
-    """The ``spurs`` (chain -> (base, tip)) whose tip's mirror image lies in no disc of a twin: a node outside the
-    base's disc of another leaf off the same base (``leaves``: (chain, base, those nodes) each). A kept leaf is a
-    twin to every spur; to a ``paired`` spur (long enough for a limb if it has a twin) so is another paired one, so
-    that two ears each under the threshold stay together. The base's own disc covers the body, so a bump whose
+    """The ``spurs`` (chain -> (base, tip)) without a twin: another leaf off the same base (``leaves``: (chain,
+    base, its nodes outside the base's disc) each) that stays, with a node whose disc holds the spur tip's mirror
+    image. A kept leaf is a twin to every spur. Two ``paired`` spurs (long enough for limbs when they come in pairs)
+    are twins when each one's image lies on the other, so that two ears each under the threshold stay together,
+    and neither stays for lying on a longer one that goes. The base's own disc covers the body, so a bump whose
     image falls on it still goes."""
     beside = {}
     for chain, base, outside in leaves:
         beside.setdefault(base, []).append((chain, outside))
+    beside = {base: (np.concatenate([outside for _, outside in parts]),
+                     np.concatenate([np.full(len(outside), chain) for chain, outside in parts]))
+              for base, parts in beside.items()}
     images = mirror(points[[tip for _, tip in spurs.values()]])
-    left = {}
-    for (i, (base, tip)), image in zip(spurs.items(), images):
-        twins = [outside for chain, outside in beside.get(base, ()) if chain != i and (i in paired or chain not in spurs)]
-        nodes = np.concatenate(twins) if twins else np.zeros(0, np.int64)
-        if not (np.linalg.norm(points[nodes] - image, axis=1) <= radius[nodes]).any():
-            left[i] = base, tip
-    return left
+    lying_on = {}  # spur -> the leaves off its base whose discs hold its tip's image
+    for (i, (base, _)), image in zip(spurs.items(), images):
+        nodes, owners = beside.get(base, (np.zeros(0, np.int64), np.zeros(0, np.int64)))
+        lying_on[i] = set(owners[np.linalg.norm(points[nodes] - image, axis=1) <= radius[nodes]].tolist()) - {i}
+    return {i: spurs[i] for i, twins in lying_on.items() if not any(
+        chain not in spurs or (i in paired and i in lying_on[chain]) for chain in twins)}
 
 
 def _links_of(chains):
