@@ -11,8 +11,8 @@ from Cython.Build import cythonize
 from setuptools import Extension, setup
 
 # One version for the package, the extension manifest and bl_info (tools/build_addon.py and tests/test_addon_zip.py
-# check that the last two agree). Read here, not through rigger.compat.manifest_version: the package cannot be
-# imported before its extensions are built.
+# check that the last two agree). Read here, not through rigger.compat.manifest_version: while setup.py runs, addon/
+# is not importable as rigger (it only gets that name through package_dir).
 MANIFEST = pathlib.Path(__file__).parent / "addon" / "blender_manifest.toml"
 VERSION = tomllib.loads(MANIFEST.read_text(encoding="utf-8"))["version"]
 

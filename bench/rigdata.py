@@ -11,6 +11,7 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
+from rigger.core.arrays import concatenated_ranges
 from rigger.core.mesh import fan_triangles
 
 HELPER_JOINT = re.compile(r"PoleTarget|^Dummy_|_rootJoint$")
@@ -97,8 +98,7 @@ class Bones:
         lengths = np.linalg.norm(self.tails - self.heads, axis=1)
         segments = np.maximum(np.ceil(lengths / step).astype(np.int64), 1)
         bone_of_sample = np.repeat(np.arange(len(self)), segments + 1)
-        fraction = (np.arange(len(bone_of_sample)) - np.repeat(np.cumsum(segments + 1) - segments - 1, segments + 1)
-                    ) / segments[bone_of_sample]
+        fraction = concatenated_ranges(np.zeros_like(segments), segments + 1) / segments[bone_of_sample]
         heads = self.heads[bone_of_sample]
         return heads + fraction[:, None] * (self.tails[bone_of_sample] - heads)
 

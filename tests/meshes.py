@@ -22,6 +22,11 @@ def combine(*meshes):
     return np.concatenate(vertices), np.concatenate(triangles)
 
 
+def far_apart_cubes():
+    """Two unit cubes 1e5 apart along x: parts too small for the space between them, seen from the side."""
+    return combine(box((0, 0, 0), (1, 1, 1)), box((1e5, 0, 0), (1e5 + 1, 1, 1)))
+
+
 def uv_sphere(rings=16, segments=32):
     """A closed unit UV sphere: ``rings`` bands from pole to pole, ``segments`` around."""
     theta = np.linspace(0, np.pi, rings + 1)[1:-1]

@@ -27,7 +27,7 @@ from scipy.sparse.csgraph import connected_components
 
 from rigger import silhouette
 
-from meshes import box, combine, grid_surface, uv_sphere
+from meshes import box, combine, far_apart_cubes, grid_surface, uv_sphere
 from rigdata import load_obj
 from union_reference import exact_union, frame_points, iou, traced_region
 
@@ -604,7 +604,7 @@ def test_zero_area_message():
 
 def test_parts_smaller_than_a_cell_give_no_silhouette_not_an_empty_one():
     """Two unit cubes 1e5 apart: at 384 cells each covers no cell, so there is no outline to give."""
-    far_apart = combine(box((0, 0, 0), (1, 1, 1)), box((1e5, 0, 0), (1e5 + 1, 1, 1)))
+    far_apart = far_apart_cubes()
     with pytest.raises(silhouette.NoSilhouette, match="too small for the space between them"):
         silhouette.trace(*far_apart, "Y", resolution=384)
     assert len(silhouette.trace(*far_apart, "X", resolution=384).loops) == 1  # end-on they overlap

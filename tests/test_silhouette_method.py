@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 import rigger
 from cdt_checks import polygon_area
 from characters import strictly_inside_fraction, load_character
-from meshes import box, combine, ellipsoids, grid_surface, uv_sphere
+from meshes import box, combine, ellipsoids, far_apart_cubes, grid_surface, uv_sphere
 from rigger import samples
 from rigger.skeletonize.bones import bone_names
 
@@ -374,6 +374,11 @@ def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):
     return builder, first
 
 
+def _builder_names(builder):
+    """The bone names of a ``_body_with_feet`` builder mirrored across x = 0."""
+    return bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, (0, 0.0), 0.05)
+
+
 @pytest.mark.parametrize("bone_length", [1.0, 0.3])
 @pytest.mark.parametrize("foot_depth", [0.5, 1.01], ids=["inside", "grazing the surface"])
 def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh(foot_depth, bone_length):
@@ -438,10 +443,9 @@ def test_mirror_image_hidden_limbs_get_mirror_image_bones():
     tail = np.array([[0.0, 0.3, 0.5], [0.0, 0.1, 0.9]])
     for feet in ([left, left * [-1, 1, 1]], [left, tail, left * [-1, 1, 1]], [tail, left, left * [-1, 1, 1]]):
         builder, first = _body_with_feet(feet, plane=(0, 0.0))
-        names = bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, (0, 0.0), 0.05)
+        names = _builder_names(builder)
         heads, tails, parents = builder.arrays()
-        sides = {name[-2:]: [b for b in range(first, len(heads)) if names[b].endswith(name[-2:])]
-                 for name in (".L", ".R")}
+        sides = {side: [b for b in range(first, len(heads)) if names[b].endswith(side)] for side in (".L", ".R")}
         assert len(sides[".L"]) == len(sides[".R"]) >= 2
         assert parents[sides[".L"][0]] == parents[sides[".R"][0]] == first - 1
         for points in (heads, tails):
@@ -454,7 +458,7 @@ def test_hidden_limbs_starting_together_share_their_extension():
     ear = np.array([[0.0, 0.3, 0.5], [0.3, 0.1, 0.9]])
     builder, first = _body_with_feet([ear, ear * [-1, 1, 1]], plane=(0, 0.0))
     heads, tails, parents = builder.arrays()
-    names = bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, (0, 0.0), 0.05)
+    names = _builder_names(builder)
     segments = np.hstack([heads, tails])
     gaps = np.linalg.norm(segments[:, None] - segments[None], axis=2) + np.diag(np.full(len(heads), np.inf))
     assert gaps.min() > 0.1
@@ -506,7 +510,7 @@ def test_bad_meshes_get_a_clear_error(vertices, triangles, message):
 
 def test_parts_too_small_for_their_spacing_get_a_clear_error():
     """Not a rig of the two seen end-on, where they overlap: another view would not make them any bigger."""
-    vertices, triangles = combine(box((0, 0, 0), (1, 1, 1)), box((1e5, 0, 0), (1e5 + 1, 1, 1)))
+    vertices, triangles = far_apart_cubes()
     with pytest.raises(ValueError, match="too small for the space between them"):
         rigger.rig_mesh(vertices, triangles)
 

@@ -219,12 +219,18 @@ class FlatSilhouette:
         return np.column_stack([points, np.broadcast_to(depth, (len(points),))])
 
 
-def test_a_forked_chain_is_one_stem_then_a_chain_per_part():
-    count = 20
-    node_layers = [layers((1.4, 2.4))] * 12 + [layers((0, 0.8), (1, 1.8), (2, 2.8), (3, 3.8))] * 8
+def placed_along_x(node_layers, chains=None, side_axis=None, **options):
+    """``depth.place_chains`` on axis nodes 0, 1, ... along x (half-width 0.5), node k seeing ``node_layers[k]``,
+    rooted at node 0; ``chains`` defaults to one chain through them all."""
+    count = len(node_layers)
     points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
-    _, placed = depth.place_chains(FlatSilhouette(node_layers), points, np.full(count, 0.5), 0,
-                                   [Chain(list(range(count)), -1)])
+    return depth.place_chains(FlatSilhouette(node_layers), points, np.full(count, 0.5), 0,
+                              chains or [Chain(list(range(count)), -1)], side_axis, **options)
+
+
+def test_a_forked_chain_is_one_stem_then_a_chain_per_part():
+    node_layers = [layers((1.4, 2.4))] * 12 + [layers((0, 0.8), (1, 1.8), (2, 2.8), (3, 3.8))] * 8
+    _, placed = placed_along_x(node_layers)
     stem, *fingers = placed
     assert stem[1] == -1 and len(stem[0]) == 12  # nodes 0..11, the wrist last
     assert len(fingers) == 4 and all(parent == 0 for _, parent, _ in fingers)
@@ -242,15 +248,11 @@ def test_a_head_seen_across_the_mirror_plane_does_not_run_into_one_ear():
     count = 12
     ears = layers((-0.8, -0.7), (0.7, 0.8))
     node_layers = [layers((-0.5, 0.5))] * 5 + [ears] + [layers((-0.5, 0.5))] * 3 + [ears] * 3
-    points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
-    chains = [Chain(list(range(count)), -1)]
-    sil = FlatSilhouette(node_layers)
-    (_, [(line, _, _)]) = depth.place_chains(sil, points, np.full(count, 0.5), 0, chains, mirror=(0.0, 0.05))
+    (_, [(line, _, _)]) = placed_along_x(node_layers, mirror=(0.0, 0.05))
     assert len(line) == 9  # the ears' tips cut
     np.testing.assert_array_equal(line[:, 2], 0.0)  # on the plane throughout
     for plane in (None, (0.0, 0.05)):
-        (_, [(line, _, _)]) = depth.place_chains(sil, points, np.full(count, 0.5), 0, chains, split=False,
-                                                 mirror=plane)
+        (_, [(line, _, _)]) = placed_along_x(node_layers, split=False, mirror=plane)
         assert len(line) == count and line[-1, 2] == -0.75
 
 
@@ -263,10 +265,7 @@ def test_a_chain_that_cannot_end_before_its_tip_between_the_ears_follows_one_ear
     on_then_beside = [layers((-0.5, 0.5))] * 4 + [ears] * 2 + [layers((-0.8, -0.7))] * 2
     for node_layers, chains in ((beside, [Chain(list(range(6)), -1)]),
                                 (on_then_beside, [Chain(list(range(6)), -1), Chain([5, 6, 7], 0)])):
-        count = len(node_layers)
-        points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
-        _, placed = depth.place_chains(FlatSilhouette(node_layers), points, np.full(count, 0.5), 0, chains,
-                                       mirror=(0.0, 0.05))
+        _, placed = placed_along_x(node_layers, chains, mirror=(0.0, 0.05))
         line = placed[0][0]
         assert len(line) == 6 and line[-1, 2] == -0.75
 
@@ -351,12 +350,8 @@ def test_split_legs_keep_their_sides_where_they_merge_into_the_hips():
     """A leg pair seen from the side, one part per leg at depths -3 and 3, merging with the hips into one thick
     interval near the body: a side view that puts the merged nodes at the body's middle must not pull both copies
     onto one line there; each keeps its side."""
-    count = 20
     node_layers = [layers((-3.5, 3.5))] * 5 + [layers((-3.5, -2.5), (2.5, 3.5))] * 15
-    sil = FlatSilhouette(node_layers)
-    points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
-    _, placed = depth.place_chains(sil, points, np.full(count, 0.5), 0, [Chain(list(range(count)), -1)],
-                                   FixedSide())
+    _, placed = placed_along_x(node_layers, side_axis=FixedSide())
     assert len(placed) == 2
     np.testing.assert_array_equal(sorted(line[1, 2] for line, _, _ in placed), [-3.0, 3.0])
 

@@ -80,19 +80,19 @@ def test_modifiers_stay_and_the_armature_goes_last_weights_on_the_original_verti
     obj, armature = character_with_rig("humanoid")
     obj.modifiers.new("Smooth", 'SUBSURF').levels = 1
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    before = np.array([v.co for v in obj.evaluated_get(depsgraph).data.vertices])
+    before = mesh_vertices(obj.evaluated_get(depsgraph).data)
     report = skinning.skin(obj, armature)
     assert [m.type for m in obj.modifiers] == ['SUBSURF', 'ARMATURE']
     assert report.vertices == len(obj.data.vertices) < len(before)
     assert_skinned(obj, armature, report)
     # in rest pose the armature moves nothing; posing a bone moves the mesh there
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    rest = np.array([v.co for v in obj.evaluated_get(depsgraph).data.vertices])
+    rest = mesh_vertices(obj.evaluated_get(depsgraph).data)
     np.testing.assert_allclose(rest, before, atol=1e-5)
     armature.pose.bones["forearm.L"].rotation_mode = 'XYZ'
     armature.pose.bones["forearm.L"].rotation_euler = (1.0, 0.0, 0.0)
     bpy.context.view_layer.update()
-    posed = np.array([v.co for v in obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.vertices])
+    posed = mesh_vertices(obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data)
     moved = np.linalg.norm(posed - rest, axis=1) > 1e-3
     assert moved.any() and (rest[moved, 0] > 0.3).all()  # only the left forearm and hand (x > 0.3) move
 

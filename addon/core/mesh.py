@@ -97,9 +97,9 @@ class Mesh:
     @cached_property
     def centroid(self):
         """(3,) float64: the mean position of the used vertices."""
-        points, factor = self.used_vertices, self.unit_factor  # summed at unit size: no overflow, the same bits
-        scaled = points if factor == 1 else points * factor  # no copy of a mesh at unit size already
-        return _read_only(np.ones(len(points)) @ scaled / len(points) / factor)  # BLAS: faster than mean
+        points, factor = self.used_vertices, self.unit_factor
+        # summed at unit size (no overflow, the same bits at any scale), the factor in the weights: no scaled copy
+        return _read_only(np.full(len(points), factor) @ points / len(points) / factor)  # BLAS: faster than mean
 
     @cached_property
     def _scatter(self):

@@ -49,7 +49,7 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True, 
     placed = []
     for ci, chain in enumerate(chains):
         nodes = np.asarray(chain.nodes)
-        node_layers = [layers[slot[n]] for n in nodes]
+        node_layers = [layers[slot[n]] for n in chain.nodes]
         copies, parts, plane = 1, node_layers, None  # plane: the mirror this chain keeps to, if any
         if split:
             parts = [_parts(layer, r) for layer, r in zip(node_layers, radius[nodes])]
@@ -140,9 +140,7 @@ def _plane_course(node_layers, depth, tolerance, leaf):
     start = len(node_layers)
     while start > 0 and _beside(node_layers[start - 1], depth, tolerance):
         start -= 1
-    if start == len(node_layers):
-        return start, True
-    if leaf and start >= 2 and _holds(node_layers[start - 1], depth):
+    if start == len(node_layers) or (leaf and start >= 2 and _holds(node_layers[start - 1], depth)):
         return start, True
     return len(node_layers), False
 
@@ -150,9 +148,11 @@ def _plane_course(node_layers, depth, tolerance, leaf):
 def _beside(layer, depth, tolerance):
     """Whether one node's depth ``layer`` flanks the plane at ``depth``: two or more intervals, none holding it,
     mirroring each other across it (plain floats, as in ``_track``, which asks this of every node)."""
-    if len(layer) < 2 or _holds(layer, depth):
+    if len(layer) < 2:
         return False
     intervals = layer.tolist()  # the k-th interval's low end mirrors the k-th from the back's high end
+    if any(low <= depth <= high for low, high in intervals):
+        return False
     return max(abs(2 * depth - low - high) for (low, _), (_, high) in zip(intervals, reversed(intervals))) <= tolerance
 
 
@@ -231,10 +231,10 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis, sibl
     for other in siblings:
         thick &= [c is None or not c[0] <= d <= c[1] for c, d in zip(chosen, other.tolist())]
     thick &= np.r_[False, thick[:-1]] | np.r_[thick[1:], False]  # a single node is a tracing slip, not a body
-    on_plane = sil.lift(points, 0.0) if thick.any() else None
+    lifted = sil.lift(points, 0.0) if thick.any() else None
     for i, interval in enumerate(chosen):
         if thick[i]:
-            found = side_axis.depth_at(on_plane[i], radius[i], interval, previous)
+            found = side_axis.depth_at(lifted[i], radius[i], interval, previous)
             if found is not None:
                 out[i] = found
         previous = out[i]

@@ -127,13 +127,14 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
         for i, chain in enumerate(chains):
             for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
                 if degree[tip] == 1 and degree[base] >= 3:
-                    beyond = np.linalg.norm(points[tip] - points[base]) + radius[tip] - radius[base]
+                    apart = np.linalg.norm(points[tip] - points[base])
+                    beyond = apart + radius[tip] - radius[base]
                     # width where the branch leaves the base disc: a neck, not the head it carries
                     ordered = np.array(chain if chain[0] == base else chain[::-1])
                     outside = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]]
                     width = 2 * float(radius[outside[:3]].mean()) if len(outside) else 2 * float(radius[tip])
                     bump = beyond <= prune * width and not (  # the round-part test only where it can matter
-                        blobs is not None and _round_part(points, radius, blobs, base, tip))
+                        blobs is not None and _round_part(apart, radius, blobs, base, tip))
                     spur = beyond < max_reach and (beyond <= min_reach or bump)
                     pairable = spur and pair_prune is not None and beyond > max(min_reach, pair_prune * width)
                     if spur:
@@ -154,10 +155,10 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
         _, chains = chains_of(sorted({n for c in kept for n in c}), _links_of(kept))
 
 
-def _round_part(points, radius, blobs, base, tip):
-    """Whether leaf node ``tip`` is a blob as wide as a part of its own, lying off the disc of ``base``."""
-    return bool(blobs[tip]) and radius[tip] >= ROUND_TIP * radius[base] and (
-        np.linalg.norm(points[tip] - points[base]) > radius[base])
+def _round_part(apart, radius, blobs, base, tip):
+    """Whether leaf node ``tip``, ``apart`` from ``base``, is a blob as wide as a part of its own, lying off the disc
+    of ``base``."""
+    return bool(blobs[tip]) and radius[tip] >= ROUND_TIP * radius[base] and apart > radius[base]
 
 
 def _unmirrored(spurs, paired, leaves, points, radius, mirror):
