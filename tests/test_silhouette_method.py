@@ -354,6 +354,19 @@ def test_ears_of_a_symmetric_quadruped_seen_from_the_side_are_a_mirror_pair(mode
     assert ears, "no bone reaches up to the ears"
 
 
+@pytest.mark.parametrize("folder, model", [("nogt", "homer"), ("gt/rignet_17364", "rignet_17364"),
+                                           ("gt/rignet_8210", "rignet_8210"), ("gt/rignet_2586", "rignet_2586")])
+def test_limbs_pruned_unlike_on_a_symmetric_model_are_still_twins(folder, model):
+    """Pruning left the two sides of a limb unlike: one of homer's arms runs on into the hand while the other stops
+    at the wrist, one of 17364's feet keeps a toe, one of 8210's hands a finger. The two still pair and get one
+    bone count, so every ``.L`` bone has its ``.R`` twin (X-mirror posing needs that)."""
+    vertices, triangles = load_obj(shared_path("models", *folder.split("/"), f"{model}.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    pairs = mirror_pairs(skeleton)
+    assert len(pairs) >= 4 and None not in {right for _, right in pairs}
+    assert 2 * len(pairs) == sum(name.endswith((".L", ".R")) for name in skeleton.names)
+
+
 def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):
     """A box body (x in -0.5..0.5) with one bone down its middle, optionally a box hand hanging beside it across a
     gap, and ``feet`` (polylines) added as hidden limbs seen from the front; returns the builder and how many bones

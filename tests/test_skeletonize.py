@@ -366,15 +366,57 @@ def test_mirror_pair_chains_get_mirror_image_joints():
     spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     lines = [spine, left, right, leg, stepping]
     joints = [spine, left + [0, 0.02, 0], right + [0.01, -0.02, 0], leg, stepping]
-    result = symmetric_joints(joints, lines, (0, 0.0), 0.05)
+    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount=None)  # equal counts: nothing recounted
     np.testing.assert_allclose(result[1][0], joints[1][0])  # first joints stay where the chains attach
     np.testing.assert_allclose(result[2][0], joints[2][0])
     np.testing.assert_allclose(result[1][1:], (left + [-0.005, 0, 0])[1:], atol=1e-12)
     np.testing.assert_allclose(result[2][1:], (right + [0.005, 0, 0])[1:], atol=1e-12)
     for k in (0, 3, 4):
         assert result[k] is joints[k]
-    fewer = symmetric_joints([left, right[::2]], [left, right], (0, 0.0), 0.05)  # the one with more joints decides
-    np.testing.assert_allclose(fewer[1], right)
+
+
+def recounter(lines):
+    """``symmetric_joints``' recount for chains ``lines`` at a bone length of 0.1."""
+    return lambda chain, max_bones, min_bones: chain_joints(lines[chain], np.radians(40), 0.1, max_bones,
+                                                            min_bones=min_bones)
+
+
+def test_a_mirror_pair_gets_one_bone_count_so_every_bone_has_a_twin():
+    """Two legs whose ends mirror but whose shapes differ (one bent at the knee, one straight) keep their own joints
+    but get one bone count: the smaller, unless the one with more bones needs them for its corners; then the other
+    gets as many."""
+    knee = np.array([[0.0, 0.0, 0.0], [0.2, 0.0, 0.15], [0.4, 0.0, 0.0]])
+    lines = [knee, straight(-0.4)]
+    recount = recounter(lines)
+    assert (len(recount(0, 4, 0)), len(recount(1, 3, 0))) == (5, 4)
+    result = symmetric_joints([recount(0, 4, 0), recount(1, 3, 0)], lines, (0, 0.0), 0.05, recount)
+    assert len(result[0]) == len(result[1]) == 4
+    assert np.linalg.norm(result[0] - knee[1], axis=1).min() < 1e-9  # the knee keeps its joint
+    zigzag = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.1], [0.2, 0.0, 0.0], [0.3, 0.0, 0.1], [0.4, 0.0, 0.0]])
+    lines = [zigzag, straight(-0.4)]
+    recount = recounter(lines)
+    assert (len(recount(0, 2, 0)), len(recount(1, 2, 0))) == (5, 3)  # every corner gets a joint, whatever max_bones
+    result = symmetric_joints([recount(0, 2, 0), recount(1, 2, 0)], lines, (0, 0.0), 0.05, recount)
+    assert len(result[0]) == len(result[1]) == 5
+
+
+def test_min_bones_overrides_the_limit():
+    assert len(chain_joints(straight(0.07), np.radians(40), bone_length=0.1, max_bones=1, min_bones=3)) == 4
+
+
+def test_an_arm_whose_twin_reaches_into_the_hand_is_still_its_twin():
+    """Pruning kept a finger's branch on one side only: that arm runs on into the hand, past the other's tip. The
+    two still pair, either way round (their starts mirror, the shorter one's tip lies on the longer one's image),
+    and share a label, so every bone is named for its twin; a limb from the same place going elsewhere does not."""
+    arm = np.array([[0.1, 1.0, 0.0], [0.5, 1.0, 0.0], [0.9, 1.0, 0.0]])
+    into_hand = np.array([[-0.1, 1.0, 0.0], [-0.5, 1.0, 0.0], [-0.9, 1.0, 0.0], [-1.0, 1.1, 0.1]])
+    raised = np.array([[-0.1, 1.0, 0.0], [-0.4, 1.4, 0.0], [-0.6, 1.8, 0.0]])
+    spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    twins = ["trunk.00", "limb01.00.L", "limb01.01.L", "limb01.00.R", "limb01.01.R"]
+    for left, right in ((arm, into_hand), (into_hand * [-1, 1, 1], arm * [-1, 1, 1])):
+        assert bone_names([0, 1, 1, 2, 2], [0, 0, 1, 0, 1], [spine, left, right], (0, 0.0), 0.05) == twins
+    names = bone_names([0, 1, 1, 2, 2], [0, 0, 1, 0, 1], [spine, arm, raised], (0, 0.0), 0.05)
+    assert names == ["trunk.00", "limb01.00.L", "limb01.01.L", "limb02.00.R", "limb02.01.R"]
 
 
 def test_legs_from_the_middle_of_the_hips_are_named_for_the_side_their_feet_are_on():

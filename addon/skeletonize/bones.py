@@ -10,7 +10,7 @@ SHAPE_SAMPLES = 9  # points along each chain compared for that
 ALONG_PLANE = 1e-6  # a view whose direction has no larger component along a mirror plane's axis looks along it
 
 
-def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=False):
+def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=False, min_bones=0):
     """Joint positions along a polyline.
 
     ``widths`` are the half-widths of the part along the line. A chain leaving a branch point first gets a joint
@@ -24,7 +24,8 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=F
     lengths. Bones to spare go to the gentler bends that would take a straight bone out of the part's middle, from
     the chain's start: these place joints but add none (every wiggle of a feathered wing's outline would otherwise
     be a bone). The pieces between joints are cut evenly. A ``leaf`` chain (ending in a tip: a finger, a toe) at
-    least half a bone long gets at least two bones, as the artists' leaf chains that long have (1.9 on average).
+    least half a bone long gets at least two bones, as the artists' leaf chains that long have (1.9 on average). A
+    chain gets at least ``min_bones`` (its mirror twin's count), whatever ``max_bones`` says.
     """
     widths = np.zeros(len(line)) if widths is None else widths
     arc = arc_lengths(line)
@@ -33,6 +34,7 @@ def chain_joints(line, bone_angle, bone_length, max_bones=0, widths=None, leaf=F
         wanted = max(wanted, 2)
     if max_bones > 0:
         wanted = min(wanted, max_bones)
+    wanted = max(wanted, min_bones)
     stops, places = [0.0, arc[-1]], [line[0], line[-1]]
     candidates, needed = _candidate_stops(line, arc, widths, bone_angle, bone_length)
     for k, (at, place) in enumerate(zip(candidates, point_at(line, arc, np.array(candidates, dtype=float)))):
@@ -185,9 +187,10 @@ def _cell_keys(cells, span):
 
 def mirror_chain_pairs(lines, plane, tolerance):
     """Pairs (i, j) of chains (3D polylines) that are mirror images of each other across ``plane`` = (axis, offset):
-    their ends match the mirrored ends within ``tolerance``. Chains on the plane are never paired; one that lies on
-    it on average but whose tip is off it (legs from the middle of the hips, antennae from the middle of the head)
-    is on its tip's side."""
+    their ends match the mirrored ends within ``tolerance``, or else their starts match within two and one's tip
+    lies within one of the other's image (a hand whose finger's branch was pruned on one side only). Chains on the
+    plane are never paired; one that lies on it on average but whose tip is off it (legs from the middle of the
+    hips, antennae from the middle of the head) is on its tip's side."""
     ends = np.array([[line[0], line[-1]] for line in lines])  # (C, 2, 3)
     images = mirrored(ends, plane)
     side = np.array([_side(line, plane, tolerance, by_tip=True) for line in lines])
@@ -198,10 +201,29 @@ def mirror_chain_pairs(lines, plane, tolerance):
         cost = np.linalg.norm(ends - images[i], axis=2).sum(axis=1)
         cost[(side != -side[i]) | taken] = np.inf
         j = int(np.argmin(cost))
-        if cost[j] <= 2 * tolerance:
+        if cost[j] > 2 * tolerance:
+            j = _shorter_twin(lines, mirrored(lines[i], plane), np.isfinite(cost), tolerance)
+        if j is not None:
             pairs.append((i, j))
             taken[[i, j]] = True
     return pairs
+
+
+def _shorter_twin(lines, image, candidates, tolerance):
+    """The chain among ``candidates`` (a mask over ``lines``) that starts within two ``tolerance``s of the start of
+    a chain's mirror ``image`` and either ends within one of that image or has the image's tip within one of it (the
+    nearest such), or None."""
+    gaps = np.full(len(lines), np.inf)
+    for k in np.flatnonzero(candidates):
+        if np.linalg.norm(lines[k][0] - image[0]) <= 2 * tolerance:
+            gaps[k] = min(_tip_gap(lines[k], image), _tip_gap(image, lines[k]))
+    k = int(np.argmin(gaps))
+    return k if gaps[k] <= tolerance else None
+
+
+def _tip_gap(line, other):
+    """How far the tip of polyline ``line`` lies from polyline ``other``."""
+    return float(segment_distances(line[-1:], other[:-1], other[1:]).min())
 
 
 def mirror_completed(limbs, plane, tolerance):
@@ -220,7 +242,7 @@ def mirror_completed(limbs, plane, tolerance):
         if not twins:
             continue
         start_gaps = np.array([np.linalg.norm(line[0] - images[i][0]) for i in twins])
-        tip_gaps = np.array([segment_distances(line[-1:], images[i][:-1], images[i][1:]).min() for i in twins])
+        tip_gaps = np.array([_tip_gap(line, images[i]) for i in twins])
         misfits = start_gaps + tip_gaps
         best = int(np.argmin(misfits))
         i = twins[best]
@@ -233,22 +255,26 @@ def mirror_completed(limbs, plane, tolerance):
     return result
 
 
-def symmetric_joints(joints, lines, plane, tolerance):
-    """``joints`` per chain (3D polylines ``lines``), with each mirror pair of chains (``mirror_chain_pairs``) given
-    the average of one and the other's mirror image (the one with more joints decides their count); each chain keeps
-    its own first joint, where it attaches to its parent. Pairs whose ends mirror but whose shapes do not (a leg
-    stepping forward) keep their own joints."""
+def symmetric_joints(joints, lines, plane, tolerance, recount):
+    """``joints`` per chain (3D polylines ``lines``), each mirror pair of chains (``mirror_chain_pairs``) given one
+    bone count, so that every bone has a twin (``.L`` and ``.R`` names, X-mirror posing): the one with more bones
+    is recounted with at most as many as the other, and if its corners need more, the other with that many
+    (``recount(chain, max_bones, min_bones)`` gives a chain's joints anew). Pairs whose shapes agree then get the
+    average of one's joints and the other's mirror image; each chain keeps its own first joint, where it attaches to
+    its parent. Pairs whose ends mirror but whose shapes do not (a leg stepping forward) keep their own joints."""
     joints = list(joints)
     for i, j in mirror_chain_pairs(lines, plane, tolerance):
+        if len(joints[i]) != len(joints[j]):
+            more, fewer = (i, j) if len(joints[i]) > len(joints[j]) else (j, i)
+            joints[more] = recount(more, len(joints[fewer]) - 1, 0)
+            if len(joints[more]) > len(joints[fewer]):
+                joints[fewer] = recount(fewer, len(joints[more]) - 1, len(joints[more]) - 1)
         image_of_j = mirrored(resampled(lines[j], SHAPE_SAMPLES), plane)
-        if np.linalg.norm(resampled(lines[i], SHAPE_SAMPLES) - image_of_j, axis=1).max() > SAME_SHAPE * tolerance:
+        if (len(joints[i]) != len(joints[j]) or np.linalg.norm(resampled(lines[i], SHAPE_SAMPLES) - image_of_j,
+                                                                  axis=1).max() > SAME_SHAPE * tolerance):
             continue
         a, b = joints[i], joints[j]
-        b_image = mirrored(b, plane)
-        if len(a) == len(b):
-            mean = (a + b_image) / 2
-        else:
-            mean = a if len(a) > len(b) else b_image
+        mean = (a + mirrored(b, plane)) / 2
         joints[i] = np.vstack([a[:1], mean[1:]])
         joints[j] = np.vstack([b[:1], mirrored(mean, plane)[1:]])
     return joints
