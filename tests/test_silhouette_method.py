@@ -135,15 +135,22 @@ def mirror_pairs(skeleton):
     return [(i, index.get(name[:-2] + ".R")) for i, name in enumerate(skeleton.names) if name.endswith(".L")]
 
 
-def assert_mirror_image_pairs(skeleton, min_pairs, atol, heads, complete=True):
+def assert_side_bones_paired(skeleton, min_pairs, complete=True):
     """At least ``min_pairs`` ``.L`` bones, each with its ``.R`` twin (and with ``complete``, no ``.R`` bone without
-    one), whose tails mirror each other across x = 0 within ``atol``, and their heads too: all (``heads="all"``), or
-    those of twins that do not hang from one bone (``"off_trunk"``), or none. Returns the pairs."""
+    one). Returns the pairs."""
     pairs = mirror_pairs(skeleton)
     assert len(pairs) >= min_pairs
     if complete:
         assert 2 * len(pairs) == sum(name.endswith((".L", ".R")) for name in skeleton.names)
     assert None not in {right for _, right in pairs}
+    return pairs
+
+
+def assert_mirror_image_pairs(skeleton, min_pairs, atol, heads, complete=True):
+    """``assert_side_bones_paired``, and the twins' tails mirror each other across x = 0 within ``atol``, and their
+    heads too: all (``heads="all"``), or those of twins that do not hang from one bone (``"off_trunk"``), or none.
+    Returns the pairs."""
+    pairs = assert_side_bones_paired(skeleton, min_pairs, complete)
     mirror = np.array([-1.0, 1.0, 1.0])
     for left, right in pairs:
         np.testing.assert_allclose(skeleton.tails[left] * mirror, skeleton.tails[right], atol=atol)
@@ -358,13 +365,11 @@ def test_ears_of_a_symmetric_quadruped_seen_from_the_side_are_a_mirror_pair(mode
                                            ("gt/rignet_8210", "rignet_8210"), ("gt/rignet_2586", "rignet_2586")])
 def test_limbs_pruned_unlike_on_a_symmetric_model_are_still_twins(folder, model):
     """Pruning left the two sides of a limb unlike: one of homer's arms runs on into the hand while the other stops
-    at the wrist, one of 17364's feet keeps a toe, one of 8210's hands a finger. The two still pair and get one
-    bone count, so every ``.L`` bone has its ``.R`` twin (X-mirror posing needs that)."""
+    at the wrist, one of 17364's feet keeps a toe, one of 8210's hands a finger, one of 2586's arms a bend at its
+    tip. The two still pair and get one bone count, so every ``.L`` bone has its ``.R`` twin (X-mirror posing
+    needs that)."""
     vertices, triangles = load_obj(shared_path("models", *folder.split("/"), f"{model}.obj"))
-    skeleton = rigger.rig_mesh(vertices, triangles)
-    pairs = mirror_pairs(skeleton)
-    assert len(pairs) >= 4 and None not in {right for _, right in pairs}
-    assert 2 * len(pairs) == sum(name.endswith((".L", ".R")) for name in skeleton.names)
+    assert_side_bones_paired(rigger.rig_mesh(vertices, triangles), 4)
 
 
 def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):

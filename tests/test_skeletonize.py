@@ -6,8 +6,8 @@ from meshes import box, combine
 from rigger import silhouette
 from rigger.skeletonize import depth
 from rigger.skeletonize.chordal import AxisGraph
-from rigger.skeletonize.bones import (bone_names, chain_joints, mirror_completed, mirror_plane, reflection_in_view,
-                                     symmetric_joints)
+from rigger.skeletonize.bones import (bone_names, chain_joints, mirror_chain_pairs, mirror_completed, mirror_plane,
+                                     reflection_in_view, symmetric_joints)
 from rigger.skeletonize.polyline import arc_lengths, segment_distances
 from rigger.skeletonize.tree import Chain, chains_of, prune_spurs, rooted_chains
 
@@ -400,7 +400,34 @@ def test_a_mirror_pair_gets_one_bone_count_so_every_bone_has_a_twin():
     assert len(result[0]) == len(result[1]) == 5
 
 
+def test_twins_whose_recount_overshoots_still_get_one_count():
+    """Recounting can give a chain more bones than asked (its corners, or no bone longer than three bone lengths):
+    the counts go on rising, one chain then the other, until they agree."""
+    asked = []
+
+    def recount(chain, max_bones, min_bones):  # chain 0 needs four bones; chain 1 gets one more than asked below 5
+        asked.append((chain, max_bones, min_bones))
+        bones = max(max_bones, min_bones, 4) if chain == 0 else max(max_bones, min_bones) + (max_bones < 5)
+        return straight(0.1 * bones, bones + 1) * [1 - 2 * chain, 1, 1]
+
+    lines = [straight(0.5), straight(-0.5)]
+    result = symmetric_joints([recount(0, 4, 0), recount(1, 2, 0)], lines, (0, 0.0), 0.05, recount)
+    assert len(result[0]) == len(result[1]) == 6
+    assert asked[2:] == [(0, 3, 0), (1, 4, 4), (0, 5, 5)]
+
+
+def test_whole_twins_pair_before_partial_ones():
+    """A stub off the left shoulder whose tip lies on the right arm's image does not take that arm from its exact
+    twin, whichever chain comes first."""
+    arm = np.array([[0.1, 1.0, 0.0], [0.5, 1.0, 0.0], [0.9, 1.0, 0.0]])
+    stub = np.array([[0.1, 1.0, 0.0], [0.12, 1.0, 0.0]])
+    spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    assert mirror_chain_pairs([spine, stub, arm * [-1, 1, 1], arm], (0, 0.0), 0.05) == [(2, 3)]
+    assert mirror_chain_pairs([spine, arm, stub, arm * [-1, 1, 1]], (0, 0.0), 0.05) == [(1, 3)]
+
+
 def test_min_bones_overrides_the_limit():
+    """A mirror twin's count wins over ``max_bones``."""
     assert len(chain_joints(straight(0.07), np.radians(40), bone_length=0.1, max_bones=1, min_bones=3)) == 4
 
 

@@ -486,14 +486,15 @@ class _BoneBuilder:
 
     def _joints(self, chains):
         """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror pairs made symmetric."""
-        def along(chain, max_bones, min_bones=0):
+        def joints_of(chain, max_bones, min_bones=0):
+            """Joints along chain number ``chain`` (``chain_joints``), at most and at least that many bones."""
             line, widths, leaf = chains[chain]
             return chain_joints(line, self.bone_angle, self.bone_length, max_bones, widths, leaf, min_bones)
 
-        joints = [along(chain, self.max_bones) for chain in range(len(chains))]
+        joints = [joints_of(chain, self.max_bones) for chain in range(len(chains))]
         if self.plane is None:
             return joints
-        return symmetric_joints(joints, [line for line, _, _ in chains], self.plane, self.tolerance, along)
+        return symmetric_joints(joints, [line for line, _, _ in chains], self.plane, self.tolerance, joints_of)
 
     def _add_chain(self, line, joints, up):
         """Bones between consecutive ``joints`` of one chain, the first hanging from bone ``up``; returns the

@@ -187,43 +187,48 @@ def _cell_keys(cells, span):
 
 def mirror_chain_pairs(lines, plane, tolerance):
     """Pairs (i, j) of chains (3D polylines) that are mirror images of each other across ``plane`` = (axis, offset):
-    their ends match the mirrored ends within ``tolerance``, or else their starts match within two and one's tip
-    lies within one of the other's image (a hand whose finger's branch was pruned on one side only). Chains on the
-    plane are never paired; one that lies on it on average but whose tip is off it (legs from the middle of the
-    hips, antennae from the middle of the head) is on its tip's side."""
+    their ends match the mirrored ends within ``tolerance``; then, among the chains left, those whose starts match
+    within two tolerances and where one's tip lies within one tolerance of the other's image (a hand whose finger's
+    branch was pruned on one side only: one arm runs on into the hand). Chains on the plane are never paired; one
+    that lies on it on average but whose tip is off it (legs from the middle of the hips, antennae from the middle
+    of the head) is on its tip's side."""
     ends = np.array([[line[0], line[-1]] for line in lines])  # (C, 2, 3)
     images = mirrored(ends, plane)
     side = np.array([_side(line, plane, tolerance, by_tip=True) for line in lines])
     pairs, taken = [], np.zeros(len(lines), bool)
-    for i in range(len(lines)):
-        if taken[i] or side[i] == 0:
-            continue
-        cost = np.linalg.norm(ends - images[i], axis=2).sum(axis=1)
-        cost[(side != -side[i]) | taken] = np.inf
-        j = int(np.argmin(cost))
-        if cost[j] > 2 * tolerance:
-            j = _shorter_twin(lines, mirrored(lines[i], plane), np.isfinite(cost), tolerance)
-        if j is not None:
-            pairs.append((i, j))
-            taken[[i, j]] = True
+    for partial in (False, True):
+        for i in range(len(lines)):
+            if taken[i] or side[i] == 0:
+                continue
+            cost = np.linalg.norm(ends - images[i], axis=2).sum(axis=1)
+            cost[(side != -side[i]) | taken] = np.inf
+            j = int(np.argmin(cost))
+            if partial:
+                j = _partial_twin(lines, mirrored(lines[i], plane), np.isfinite(cost), tolerance)
+            elif cost[j] > 2 * tolerance:
+                j = None
+            if j is not None:
+                pairs.append((i, j))
+                taken[[i, j]] = True
     return pairs
 
 
-def _shorter_twin(lines, image, candidates, tolerance):
-    """The chain among ``candidates`` (a mask over ``lines``) that starts within two ``tolerance``s of the start of
-    a chain's mirror ``image`` and either ends within one of that image or has the image's tip within one of it (the
-    nearest such), or None."""
-    gaps = np.full(len(lines), np.inf)
-    for k in np.flatnonzero(candidates):
-        if np.linalg.norm(lines[k][0] - image[0]) <= 2 * tolerance:
-            gaps[k] = min(_tip_gap(lines[k], image), _tip_gap(image, lines[k]))
-    k = int(np.argmin(gaps))
-    return k if gaps[k] <= tolerance else None
+def _partial_twin(lines, image, candidates, tolerance):
+    """The chain among ``candidates`` (a mask over ``lines``) that fits a chain's mirror ``image`` best, either one
+    running on past the other's tip (``_fit``), if the longer one covers the shorter; else None."""
+    fits = [(sum(gaps), gaps, int(k)) for k in np.flatnonzero(candidates)
+            for gaps in (_fit(image, lines[k]), _fit(lines[k], image))]
+    if not fits:
+        return None
+    _, (start_gap, tip_gap), best = min(fits, key=lambda fit: fit[0])
+    return best if start_gap <= 2 * tolerance and tip_gap <= tolerance else None
 
 
-def _tip_gap(line, other):
-    """How far the tip of polyline ``line`` lies from polyline ``other``."""
-    return float(segment_distances(line[-1:], other[:-1], other[1:]).min())
+def _fit(long, short):
+    """(start gap, tip gap) of polyline ``short`` against ``long``: how far apart their starts lie and how far the
+    tip of ``short`` lies off ``long``; ``long`` covers ``short`` when they are within two and one tolerances."""
+    return (float(np.linalg.norm(short[0] - long[0])),
+            float(segment_distances(short[-1:], long[:-1], long[1:]).min()))
 
 
 def mirror_completed(limbs, plane, tolerance):
@@ -241,12 +246,11 @@ def mirror_completed(limbs, plane, tolerance):
         twins = [i for i in range(len(lines)) if side[i] != 0 and side[i] == -side[j]]
         if not twins:
             continue
-        start_gaps = np.array([np.linalg.norm(line[0] - images[i][0]) for i in twins])
-        tip_gaps = np.array([_tip_gap(line, images[i]) for i in twins])
-        misfits = start_gaps + tip_gaps
+        gaps = np.array([_fit(images[i], line) for i in twins])  # (start gap, tip gap) per twin
+        misfits = gaps.sum(axis=1)
         best = int(np.argmin(misfits))
         i = twins[best]
-        covered = start_gaps[best] <= 2 * tolerance and tip_gaps[best] <= tolerance and length(line) < length(lines[i])
+        covered = gaps[best, 0] <= 2 * tolerance and gaps[best, 1] <= tolerance and length(line) < length(lines[i])
         if covered and misfits[best] < fits.get(i, (np.inf,))[0]:
             fits[i] = (misfits[best], j)
     result = list(limbs)
@@ -258,20 +262,23 @@ def mirror_completed(limbs, plane, tolerance):
 def symmetric_joints(joints, lines, plane, tolerance, recount):
     """``joints`` per chain (3D polylines ``lines``), each mirror pair of chains (``mirror_chain_pairs``) given one
     bone count, so that every bone has a twin (``.L`` and ``.R`` names, X-mirror posing): the one with more bones
-    is recounted with at most as many as the other, and if its corners need more, the other with that many
-    (``recount(chain, max_bones, min_bones)`` gives a chain's joints anew). Pairs whose shapes agree then get the
-    average of one's joints and the other's mirror image; each chain keeps its own first joint, where it attaches to
-    its parent. Pairs whose ends mirror but whose shapes do not (a leg stepping forward) keep their own joints."""
+    is recounted with at most as many as the other, and while their counts differ (its corners need more bones, or
+    a bone would be too long), the one with fewer gets as many as the other (``recount(chain, max_bones,
+    min_bones)`` gives a chain's joints anew). Pairs whose shapes agree then get the average of one's joints and the
+    other's mirror image; each chain keeps its own first joint, where it attaches to its parent. Pairs whose ends
+    mirror but whose shapes do not (a leg stepping forward) keep their own joints."""
     joints = list(joints)
     for i, j in mirror_chain_pairs(lines, plane, tolerance):
         if len(joints[i]) != len(joints[j]):
             more, fewer = (i, j) if len(joints[i]) > len(joints[j]) else (j, i)
             joints[more] = recount(more, len(joints[fewer]) - 1, 0)
-            if len(joints[more]) > len(joints[fewer]):
+            while len(joints[more]) != len(joints[fewer]):  # the count only grows, up to what both need
+                more, fewer = (more, fewer) if len(joints[more]) > len(joints[fewer]) else (fewer, more)
                 joints[fewer] = recount(fewer, len(joints[more]) - 1, len(joints[more]) - 1)
         image_of_j = mirrored(resampled(lines[j], SHAPE_SAMPLES), plane)
-        if (len(joints[i]) != len(joints[j]) or np.linalg.norm(resampled(lines[i], SHAPE_SAMPLES) - image_of_j,
-                                                                  axis=1).max() > SAME_SHAPE * tolerance):
+        same_shape = np.linalg.norm(resampled(lines[i], SHAPE_SAMPLES) - image_of_j, axis=1).max() <= (
+            SAME_SHAPE * tolerance)
+        if not same_shape:
             continue
         a, b = joints[i], joints[j]
         mean = (a + mirrored(b, plane)) / 2
