@@ -452,7 +452,8 @@ def test_the_direction_view_offers_to_look_along_the_3d_view(scene):
 
 def test_from_view_sets_the_direction_the_view_looks_along(scene):
     """The operator run as the sidebar runs it, in a 3D view turned to look along +X (view_rotation maps the
-    camera's -Z there)."""
+    camera's -Z there; an unturned view looks along -Z); asked to fill a parameter that is not a vector, it cancels
+    with a report."""
     from mathutils import Quaternion
 
     from rigger.blender.operators import RIGGER_OT_direction_from_view, looking_along

@@ -361,14 +361,14 @@ def test_ears_of_a_symmetric_quadruped_seen_from_the_side_are_a_mirror_pair(mode
     assert ears, "no bone reaches up to the ears"
 
 
-@pytest.mark.parametrize("folder, model", [("nogt", "homer"), ("gt/rignet_17364", "rignet_17364"),
-                                           ("gt/rignet_8210", "rignet_8210"), ("gt/rignet_2586", "rignet_2586")])
-def test_limbs_pruned_unlike_on_a_symmetric_model_are_still_twins(folder, model):
+@pytest.mark.parametrize("model", ["nogt/homer.obj", "gt/rignet_17364/rignet_17364.obj",
+                                   "gt/rignet_8210/rignet_8210.obj", "gt/rignet_2586/rignet_2586.obj"])
+def test_limbs_pruned_unlike_on_a_symmetric_model_are_still_twins(model):
     """Pruning left the two sides of a limb unlike: one of homer's arms runs on into the hand while the other stops
     at the wrist, one of 17364's feet keeps a toe, one of 8210's hands a finger, one of 2586's arms a bend at its
     tip. The two still pair and get one bone count, so every ``.L`` bone has its ``.R`` twin (X-mirror posing
     needs that)."""
-    vertices, triangles = load_obj(shared_path("models", *folder.split("/"), f"{model}.obj"))
+    vertices, triangles = load_obj(shared_path("models", model))
     assert_side_bones_paired(rigger.rig_mesh(vertices, triangles), 4)
 
 
@@ -393,8 +393,8 @@ def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):
 
 
 def _builder_names(builder):
-    """The bone names of a ``_body_with_feet`` builder mirrored across x = 0."""
-    return bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, (0, 0.0), 0.05)
+    """The bone names of a ``_body_with_feet`` builder, with its mirror plane."""
+    return bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, builder.plane, builder.tolerance)
 
 
 @pytest.mark.parametrize("bone_length", [1.0, 0.3])

@@ -1,8 +1,9 @@
-"""The skeleton-building steps on hand-made inputs: rooting a path, counting stacked parts, joints along a chain."""
+"""The skeleton-building steps on hand-made inputs: spur pruning, rooting a path, counting stacked parts, joints
+along a chain, the mirror plane, mirror pairs of chains and their names."""
 import numpy as np
 import pytest
-from meshes import box, combine
 
+from meshes import box, combine
 from rigger import silhouette
 from rigger.skeletonize import depth
 from rigger.skeletonize.chordal import AxisGraph
@@ -70,8 +71,8 @@ def chest_with_legs(*branches, legs=(-0.5, 0.5)):
 def test_a_spur_whose_mirror_image_is_kept_stays():
     """A figure's two arms off its chest, mirror images across x = 0 but for the left one reaching a little less:
     at prune 1.35 the right arm (sticking out 1.4 times its width) is kept and the left (1.3) would go. With the
-    reflection the left one stays with its image; a bump on the mirror line (its own image) still goes, and both
-    arms go once neither is long enough."""
+    reflection the left one stays with its image; a bump on the mirror line (its own image) still goes, both arms
+    go once neither is long enough, and at prune 0.8 all three stay."""
     def arm(side, ratio):  # half-width 0.5 off a chest disc of radius 1: sticks out 0.5 + reach beyond it
         return [(side * x, 0.0, 0.5) for x in np.linspace(1.5, 0.5 + ratio, 6)]
     bump = [(0.0, 1.3, 0.8), (0.0, 1.6, 0.8)]  # sticks out 1.4, 1.6 wide
@@ -388,15 +389,17 @@ def test_a_mirror_pair_gets_one_bone_count_so_every_bone_has_a_twin():
     knee = np.array([[0.0, 0.0, 0.0], [0.2, 0.0, 0.15], [0.4, 0.0, 0.0]])
     lines = [knee, straight(-0.4)]
     recount = recounter(lines)
-    assert (len(recount(0, 4, 0)), len(recount(1, 3, 0))) == (5, 4)
-    result = symmetric_joints([recount(0, 4, 0), recount(1, 3, 0)], lines, (0, 0.0), 0.05, recount)
+    joints = [recount(0, 4, 0), recount(1, 3, 0)]
+    assert (len(joints[0]), len(joints[1])) == (5, 4)
+    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount)
     assert len(result[0]) == len(result[1]) == 4
     assert np.linalg.norm(result[0] - knee[1], axis=1).min() < 1e-9  # the knee keeps its joint
     zigzag = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.1], [0.2, 0.0, 0.0], [0.3, 0.0, 0.1], [0.4, 0.0, 0.0]])
     lines = [zigzag, straight(-0.4)]
     recount = recounter(lines)
-    assert (len(recount(0, 2, 0)), len(recount(1, 2, 0))) == (5, 3)  # every corner gets a joint, whatever max_bones
-    result = symmetric_joints([recount(0, 2, 0), recount(1, 2, 0)], lines, (0, 0.0), 0.05, recount)
+    joints = [recount(0, 2, 0), recount(1, 2, 0)]
+    assert (len(joints[0]), len(joints[1])) == (5, 3)  # every corner gets a joint, whatever max_bones
+    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount)
     assert len(result[0]) == len(result[1]) == 5
 
 
@@ -498,15 +501,16 @@ def test_a_flat_mesh_is_not_mirrored_across_its_own_plane():
 
 def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_at_all():
     """Two boxes mirrored across x = 2, joined by a bar: seen along Y or -Z every outline point reflects onto the
-    outline; seen along X, across the plane, there is no reflection in the view."""
+    outline; seen along X, across the plane, there is no reflection in the view, nor without a plane."""
     vertices, triangles = combine(box((0.0, 0.0, 0.0), (1.0, 2.0, 3.0)), box((3.0, 0.0, 0.0), (4.0, 2.0, 3.0)),
                                   box((0.5, 1.0, 0.0), (3.5, 1.5, 0.5)))
+    traces = {view: silhouette.trace(vertices, triangles, view) for view in ("Y", "-Z", "X")}
     for view in ("Y", "-Z"):
-        sil = silhouette.trace(vertices, triangles, view)
+        sil = traces[view]
         outline = np.concatenate(sil.loops)
         starts, ends = outline, np.concatenate([np.roll(loop, -1, axis=0) for loop in sil.loops])
         image = reflection_in_view(sil, (0, 2.0))(outline)
         assert segment_distances(image, starts, ends).min(axis=1).max() < sil.cell  # onto the outline
         assert np.abs(image - outline).max() > 1  # and moved
-    assert reflection_in_view(silhouette.trace(vertices, triangles, "X"), (0, 2.0)) is None
-    assert reflection_in_view(silhouette.trace(vertices, triangles, "Y"), None) is None
+    assert reflection_in_view(traces["X"], (0, 2.0)) is None
+    assert reflection_in_view(traces["Y"], None) is None

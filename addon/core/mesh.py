@@ -42,7 +42,7 @@ class Mesh:
         if factor == 1 and rotation is None:
             return self
         with np.errstate(over="ignore"):
-            vertices = self.vertices * factor
+            vertices = self.vertices if factor == 1 else self.vertices * factor  # turning alone copies once
         far = nonfinite_rows(vertices) if factor > 1 else ()  # scaling down cannot overflow
         if len(far):
             raise ValueError(f"vertex {far[0]} at {self.vertices[far[0]]} lies too far from a mesh {self.scale:.3g} "
@@ -77,8 +77,8 @@ class Mesh:
     @cached_property
     def scale(self):
         """The largest extent of the bounding box: the length that makes tolerances scale-free. ValueError when
-        it is not a normal float64 number at least 2**-1022 and below 2**1023 (so that ``unit_factor`` is a normal
-        power of two)."""
+        it is not 0 (a point, which the constructor refuses) or a normal float64 number at least 2**-1022 and below
+        2**1023 (so that ``unit_factor`` is a normal power of two)."""
         with np.errstate(over="ignore"):
             extent = float((self.bbox[1] - self.bbox[0]).max())
         if not extent < 2.0 ** 1023:

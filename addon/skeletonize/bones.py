@@ -200,13 +200,12 @@ def mirror_chain_pairs(lines, plane, tolerance):
         for i in range(len(lines)):
             if taken[i] or side[i] == 0:
                 continue
-            cost = np.linalg.norm(ends - images[i], axis=2).sum(axis=1)
-            cost[(side != -side[i]) | taken] = np.inf
-            j = int(np.argmin(cost))
+            candidates = (side == -side[i]) & ~taken
             if partial:
-                j = _partial_twin(lines, mirrored(lines[i], plane), np.isfinite(cost), tolerance)
-            elif cost[j] > 2 * tolerance:
-                j = None
+                j = _partial_twin(lines, mirrored(lines[i], plane), candidates, tolerance)
+            else:
+                cost = np.where(candidates, np.linalg.norm(ends - images[i], axis=2).sum(axis=1), np.inf)
+                j = int(np.argmin(cost)) if cost.min() <= 2 * tolerance else None
             if j is not None:
                 pairs.append((i, j))
                 taken[[i, j]] = True

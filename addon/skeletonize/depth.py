@@ -140,7 +140,7 @@ def _plane_course(node_layers, depth, tolerance, leaf):
     start = len(node_layers)
     while start > 0 and _beside(node_layers[start - 1], depth, tolerance):
         start -= 1
-    if start == len(node_layers) or (leaf and start >= 2 and _holds(node_layers[start - 1], depth)):
+    if start == len(node_layers) or (leaf and start >= 2 and _holds(node_layers[start - 1].tolist(), depth)):
         return start, True
     return len(node_layers), False
 
@@ -151,14 +151,14 @@ def _beside(layer, depth, tolerance):
     if len(layer) < 2:
         return False
     intervals = layer.tolist()  # the k-th interval's low end mirrors the k-th from the back's high end
-    if any(low <= depth <= high for low, high in intervals):
+    if _holds(intervals, depth):
         return False
     return max(abs(2 * depth - low - high) for (low, _), (_, high) in zip(intervals, reversed(intervals))) <= tolerance
 
 
-def _holds(layer, depth):
-    """Whether one of a node's depth intervals contains ``depth``."""
-    return any(low <= depth <= high for low, high in layer.tolist())
+def _holds(intervals, depth):
+    """Whether one of a node's depth ``intervals`` ((low, high) pairs of plain floats) contains ``depth``."""
+    return any(low <= depth <= high for low, high in intervals)
 
 
 def _layer_count(node_layers):
