@@ -28,6 +28,8 @@ REFERENCE_CD_J2J = {"stick": 0.147, "skeletor": 0.076}
 TARGETS = {"mean_cd_j2j": 0.045, "stretch_cd_j2j": 0.040, "mean_cd_b2b": 0.028, "max_cd_j2j": 0.08,
            "joint_ratio": (0.7, 1.5), "mean_inside": 0.95}
 METHOD_COLOURS = {"rigger": "tab:red", "skeletor": "tab:green", "stick": "tab:blue"}
+DETAIL_SETTINGS = ({}, {"min_branch": 1.0}, {"min_branch": 1.5}, {"max_chain_bones": 4}, {"bone_length": 0.13},
+                   {"prune": 1.0})  # Rigger's parameters that set how many bones it makes, changed one at a time
 
 
 def principal_stick(vertices, triangles):
@@ -156,8 +158,9 @@ class GroundTruth:
         self.inside = rigdata.inside_fraction(self.samples, self.unit_vertices, self.triangles)
 
 
-def evaluate(truth, method, params, timeout):
-    """Run one method on one model and score it; failures become a record with the error, never an exception."""
+def evaluate(truth, method, params, timeout, inside=True):
+    """Run one method on one model and score it (the inside fraction only with ``inside``: it is the costly
+    score); failures become a record with the error, never an exception."""
     record = {"model": truth.name, "method": method}
     try:
         started = time.perf_counter()
@@ -170,7 +173,8 @@ def evaluate(truth, method, params, timeout):
         record.update(rigdata.skeleton_distances(joints, samples, truth.joints, truth.samples))
         record["joints"] = len(joints)
         record["joint_ratio"] = len(joints) / len(truth.joints)
-        record["inside"] = rigdata.inside_fraction(samples, truth.unit_vertices, truth.triangles)
+        if inside:
+            record["inside"] = rigdata.inside_fraction(samples, truth.unit_vertices, truth.triangles)
         record["unit_bones"] = unit_bones
     except Exception as error:  # a method failing on one model must not stop the benchmark
         record["error"] = f"{type(error).__name__}: {error}".strip()
@@ -211,6 +215,47 @@ def summarise(records, methods):
     return summary
 
 
+def detail_sweep(truths, params, timeout):
+    """Rigger's joint counts and mean CD-J2J with each of ``DETAIL_SETTINGS`` applied over ``params``: whether any
+    one setting puts every model's joint count within the target range, and what it costs in CD-J2J."""
+    low, high = TARGETS["joint_ratio"]
+    rows = []
+    for change in DETAIL_SETTINGS:
+        records = [evaluate(truth, "rigger", {**params, **change}, timeout, inside=False) for truth in truths]
+        good = [r for r in records if succeeded(r)]
+        ratios = [r["joint_ratio"] for r in good]
+        label = ", ".join(f"{key}={value}" for key, value in change.items()) or ("as run" if params else "defaults")
+        rows.append({
+            "setting": label,
+            "failed": len(records) - len(good),
+            "cd_j2j": float(np.mean([r["cd_j2j"] for r in good])) if good else None,
+            "ratio_range": (min(ratios), max(ratios)) if good else None,
+            "over": {r["model"]: r["joint_ratio"] for r in good if r["joint_ratio"] > high},
+            "under": {r["model"]: r["joint_ratio"] for r in good if r["joint_ratio"] < low},
+        })
+    return rows
+
+
+def detail_lines(rows):
+    """The markdown section for ``detail_sweep``'s rows."""
+    low, high = TARGETS["joint_ratio"]
+
+    def listed(ratios):
+        return ", ".join(f"{name} {ratio:.2f}×" for name, ratio in sorted(ratios.items(), key=lambda kv: -kv[1]))
+
+    table = [[row["setting"], "—" if row["cd_j2j"] is None else f"{row['cd_j2j']:.4f}",
+              "—" if row["ratio_range"] is None else "{:.2f}–{:.2f}×".format(*row["ratio_range"]),
+              str(len(row["over"]) + len(row["under"])), listed(row["over"]) or "—", listed(row["under"]) or "—"]
+             for row in rows]
+    return ["", "## Joint count against the detail settings", "",
+            f"Rigger's method with one parameter changed at a time (inside fractions not scored). The artists differ "
+            f"in what they rig: some leave out spikes, shields, claws, toes or a bird's legs, others give a tail eight "
+            f"bones or every finger three, so a setting that brings the first kind within {high}× takes the second "
+            f"below {low}×.", ""] + markdown_table(
+        ["setting", "mean CD-J2J", "joints vs artist", "models out of range", f"above {high}×", f"below {low}×"],
+        table)
+
+
 def machine_description():
     cpu = cpu_model()
     return (f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}, "
@@ -226,8 +271,9 @@ def model_row(record):
             f"{record['seconds'] * 1e3:.0f}", note]
 
 
-def write_report(path, truths, records, summary, methods, notes, command):
-    """The markdown report: averages, targets, reference checks, per-model tables, per-stage times, plots."""
+def write_report(path, truths, records, summary, methods, notes, command, sweep):
+    """The markdown report: averages, targets, reference checks, the detail sweep (when run), per-model tables,
+    per-stage times, plots."""
     lines = [
         "# Quality benchmark", "",
         f"Generated {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')} by `{command}`  ",
@@ -274,6 +320,8 @@ def write_report(path, truths, records, summary, methods, notes, command):
     for method, reference in REFERENCE_CD_J2J.items():
         if "cd_j2j" in summary.get(method, {}):
             lines.append(f"- {method}: measured {summary[method]['cd_j2j']:.4f} vs reference {reference}")
+    if sweep:
+        lines += detail_lines(sweep)
     lines += ["", "## Per model", ""]
     lines += markdown_table(["model", "vertices", "triangles", "artist joints", "artist bones inside"],
                             [[t.name, len(t.vertices), len(t.triangles), len(t.joints), f"{t.inside:.1%}"]
@@ -471,13 +519,18 @@ def main(argv=None):
         else:
             print(f"{method:9s} failed on every model")
 
+    sweep = detail_sweep(truths, params, args.timeout) if "rigger" in methods else []
+    for row in sweep:
+        print(f"{row['setting']:22s} out of range: {len(row['over']) + len(row['under']):2d}  "
+              + (f"mean CD-J2J {row['cd_j2j']:.4f}" if row["cd_j2j"] is not None else "failed on every model"))
+
     args.out.mkdir(parents=True, exist_ok=True)
     command = " ".join(["bench/quality.py"] + (argv if argv is not None else sys.argv[1:]))
-    write_report(args.out / "quality.md", truths, records, summary, methods, notes, command)
+    write_report(args.out / "quality.md", truths, records, summary, methods, notes, command, sweep)
     (args.out / "quality.json").write_text(json.dumps({
         "machine": machine_description(), "command": command, "notes": notes,
         "artist_inside": {t.name: t.inside for t in truths},
-        "summary": summary,
+        "summary": summary, "detail_sweep": sweep,
         "records": [{k: v for k, v in r.items() if k != "unit_bones"} for r in records],
     }, indent=1, default=str))
     plot_cd_j2j(args.out / "quality_cd_j2j.png", [t.name for t in truths], records, methods)

@@ -232,6 +232,21 @@ def test_real_model_loads_and_scores_in_the_rignet_convention():
     assert 0.1 < record["cd_j2j"] < 0.2 and record["joints"] == 3 and record["tree_problem"] is None
 
 
+def test_detail_sweep_reports_each_setting_and_the_models_out_of_range(monkeypatch):
+    """Fewer bones at a higher ``min_branch`` on the antlered deer; every setting gets a row and a table line."""
+    truth = quality.GroundTruth(shared_path("models", "gt", "rignet_2982"))
+    monkeypatch.setattr(quality, "DETAIL_SETTINGS", ({}, {"min_branch": 3.0}))
+    rows = quality.detail_sweep([truth], {}, timeout=60)
+    assert [row["setting"] for row in rows] == ["defaults", "min_branch=3.0"]
+    (low, high), (sparse_low, sparse_high) = (row["ratio_range"] for row in rows)
+    assert low == high and sparse_low == sparse_high and sparse_high < high
+    for row in rows:
+        assert set(row["over"]) | set(row["under"]) <= {truth.name} and row["failed"] == 0
+        assert (truth.name in row["over"]) == (row["ratio_range"][1] > quality.TARGETS["joint_ratio"][1])
+    table = quality.detail_lines(rows)[-2:]
+    assert table[0].startswith("| defaults |") and table[1].startswith("| min_branch=3.0 |")
+
+
 def test_real_rig_helper_joints_are_ignored():
     folder = shared_path("models", "gt", "Quaternius_Fox")
     rig = rigdata.load_rig(folder / "Quaternius_Fox_rig.txt")

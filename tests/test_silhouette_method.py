@@ -182,6 +182,27 @@ def test_no_bone_is_longer_than_three_bone_lengths():
     assert lengths.max() <= 3 * 0.1 * np.ptp(vertices, axis=0).max()
 
 
+def test_min_branch_leaves_short_spikes_without_bones():
+    """A thin horn 0.2 long on a block with two legs and an arm 0.5 long (the mesh is 1.5 across: bones 0.15 long)
+    is a limb at the default ``min_branch`` (half a bone length), gone at three bone lengths (0.45), which still
+    keeps the arm."""
+    body = box((0.0, 0.0, 0.0), (1.0, 0.3, 0.6))
+    horn = box((0.2, 0.13, 0.6), (0.24, 0.17, 0.8))
+    arm = box((1.0, 0.1, 0.2), (1.5, 0.2, 0.3))
+    legs = [box((x, 0.1, -0.5), (x + 0.1, 0.2, 0.0)) for x in (0.15, 0.75)]
+    vertices, triangles = combine(body, horn, arm, *legs)
+    size = np.ptp(vertices, axis=0).max()
+
+    def reaches(skeleton, tip):
+        return np.linalg.norm(skeleton.joints() - tip, axis=1).min() < 0.05 * size
+
+    horn_tip, hand = np.array([0.22, 0.15, 0.8]), np.array([1.5, 0.15, 0.25])
+    default = rigger.rig_mesh(vertices, triangles)
+    assert reaches(default, horn_tip) and reaches(default, hand)
+    sparse = rigger.rig_mesh(vertices, triangles, min_branch=3.0)
+    assert not reaches(sparse, horn_tip) and reaches(sparse, hand)
+
+
 def test_the_hole_between_arm_and_body_is_cut():
     vertices, triangles = load_character("humanoid_hips")
     skeleton = rigger.rig_mesh(vertices, triangles, view="Y")

@@ -34,7 +34,6 @@ from ..skeletonize.tree import chains_of, merge_discs, prune_spurs, rooted_chain
 AXES = np.eye(3)
 SPECK = 0.25  # islands whose axis is shorter than this many bone lengths get no bones of their own
 SPREAD_SAMPLES = 100_000  # triangles sampled to choose the view
-MIN_BRANCH = 0.5  # branches sticking out less than this many bone lengths are dropped, however thin
 KEEP_REACH = 0.25  # branches sticking out this share of the mesh's size are kept, however wide (a cow's neck and head)
 AXIS_NAMES = ("X", "Y", "Z")
 MIRROR_TOLERANCE = 0.05  # chains whose ends mirror each other this close (in mesh sizes) are a left/right pair
@@ -89,6 +88,9 @@ class SilhouetteMethod(RigMethod):
               description="Branches sticking out of their base by less than this many times their width are "
                           "dropped as bumps (unless they reach a quarter of the mesh's size); lower keeps stubbier "
                           "branches"),
+        Param("min_branch", "float", 0.5, min=0.0, max=10.0,
+              description="Branches sticking out less than this many bone lengths are dropped, however thin; "
+                          "raise it to leave short spikes, claws and toes without bones"),
         Param("bone_angle", "float", 40.0, min=1.0, max=180.0,
               description="Start a new bone where a chain turns by more than this many degrees"),
         Param("bone_length", "float", 0.1, min=0.01, max=1.0,
@@ -107,8 +109,8 @@ class SilhouetteMethod(RigMethod):
         if props.view == "DIRECTION":
             layout.operator("rigger.direction_from_view", icon='VIEW_CAMERA').param = "view_direction"
 
-    def rig(self, mesh, *, view, view_direction, resolution, outline_spacing, min_hole, merge, prune, bone_angle,
-            bone_length, max_chain_bones, split_layers, side_view):
+    def rig(self, mesh, *, view, view_direction, resolution, outline_spacing, min_hole, merge, prune, min_branch,
+            bone_angle, bone_length, max_chain_bones, split_layers, side_view):
         clock = StageClock()
         frame = None
         if view == "DIRECTION":
@@ -127,7 +129,7 @@ class SilhouetteMethod(RigMethod):
         clock.lap("silhouette_cdt_axis")
 
         unit = bone_length * mesh.scale  # the bone length in mesh units
-        reaches = (MIN_BRANCH * unit, KEEP_REACH * mesh.scale)  # prune_spurs' min_reach and max_reach
+        reaches = (min_branch * unit, KEEP_REACH * mesh.scale)  # prune_spurs' min_reach and max_reach
         plane = mirror_plane(mesh.used_vertices, mesh.bbox, 0.01 * mesh.scale)
         tolerance = MIRROR_TOLERANCE * mesh.scale  # chains whose ends mirror this close are a pair
         graph, alive, merged, kept = _pruned_tree(graph, merge, (prune, PAIRED_PRUNE * prune), reaches,
