@@ -9,7 +9,7 @@ from cdt_checks import polygon_area
 from characters import strictly_inside_fraction, load_character
 from meshes import box, combine, ellipsoids, far_apart_cubes, grid_surface, uv_sphere
 from rigger import samples
-from rigger.skeletonize.bones import bone_names
+from rigger.skeletonize.bones import bone_names, mirrored
 
 from conftest import shared_path
 from rigdata import chamfer_distance, load_obj
@@ -146,16 +146,15 @@ def assert_side_bones_paired(skeleton, min_pairs, complete=True):
     return pairs
 
 
-def assert_mirror_image_pairs(skeleton, min_pairs, atol, heads, complete=True):
-    """``assert_side_bones_paired``, and the twins' tails mirror each other across x = 0 within ``atol``, and their
-    heads too: all (``heads="all"``), or those of twins that do not hang from one bone (``"off_trunk"``), or none.
-    Returns the pairs."""
+def assert_mirror_image_pairs(skeleton, min_pairs, atol, heads, complete=True, plane=(0, 0.0)):
+    """``assert_side_bones_paired``, and the twins' tails mirror each other across ``plane`` (axis, offset; x = 0
+    unless given) within ``atol``, and their heads too: all (``heads="all"``), or those of twins that do not hang
+    from one bone (``"off_trunk"``), or none. Returns the pairs."""
     pairs = assert_side_bones_paired(skeleton, min_pairs, complete)
-    mirror = np.array([-1.0, 1.0, 1.0])
     for left, right in pairs:
-        np.testing.assert_allclose(skeleton.tails[left] * mirror, skeleton.tails[right], atol=atol)
+        np.testing.assert_allclose(mirrored(skeleton.tails[left], plane), skeleton.tails[right], atol=atol)
         if heads == "all" or (heads == "off_trunk" and skeleton.parents[left] != skeleton.parents[right]):
-            np.testing.assert_allclose(skeleton.heads[left] * mirror, skeleton.heads[right], atol=atol)
+            np.testing.assert_allclose(mirrored(skeleton.heads[left], plane), skeleton.heads[right], atol=atol)
     return pairs
 
 
@@ -382,15 +381,23 @@ def test_ears_of_a_symmetric_quadruped_seen_from_the_side_are_a_mirror_pair(mode
     assert ears, "no bone reaches up to the ears"
 
 
-@pytest.mark.parametrize("model", ["nogt/homer.obj", "gt/rignet_17364/rignet_17364.obj",
-                                   "gt/rignet_8210/rignet_8210.obj", "gt/rignet_2586/rignet_2586.obj"])
-def test_limbs_pruned_unlike_on_a_symmetric_model_are_still_twins(model):
+@pytest.mark.parametrize("model, images", [("nogt/homer.obj", True), ("gt/rignet_17364/rignet_17364.obj", True),
+                                           ("gt/rignet_8210/rignet_8210.obj", True),
+                                           ("gt/rignet_2586/rignet_2586.obj", False)])
+def test_limbs_pruned_unlike_on_a_symmetric_model_are_still_twins(model, images):
     """Pruning left the two sides of a limb unlike: one of homer's arms runs on into the hand while the other stops
     at the wrist, one of 17364's feet keeps a toe, one of 8210's hands a finger, one of 2586's arms a bend at its
     tip. The two still pair and get one bone count, so every ``.L`` bone has its ``.R`` twin (X-mirror posing
-    needs that)."""
+    needs that); a limb that runs on past its twin's image takes that image, so on the first three every pair of
+    bones ends at mirror-image tails (each twin keeps its own first head, where it hangs from its parent); 2586's
+    bent arm ends where its twin does, and keeps its own shape."""
     vertices, triangles = load_obj(shared_path("models", model))
-    assert_side_bones_paired(rigger.rig_mesh(vertices, triangles), 4)
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    if images:
+        size = np.ptp(vertices, axis=0).max()
+        assert_mirror_image_pairs(skeleton, 4, 1e-9 * size, heads="none", plane=skeleton.stages["mirror_plane"])
+    else:
+        assert_side_bones_paired(skeleton, 4)
 
 
 def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):

@@ -403,6 +403,27 @@ def test_a_mirror_pair_gets_one_bone_count_so_every_bone_has_a_twin():
     assert len(result[0]) == len(result[1]) == 5
 
 
+def test_an_arm_running_on_into_the_hand_takes_its_twins_image():
+    """One arm stops at the wrist, its twin runs on into the hand (and starts a little apart in depth): after one
+    count, the longer takes the shorter's mirror image but keeps its own first joint, so both end at the wrist,
+    either way round. Twins whose ends mirror but whose shapes differ (a knee) keep their own joints."""
+    arm = np.array([[0.1, 1.0, 0.0], [0.5, 1.0, 0.0], [0.9, 1.0, 0.0]])
+    into_hand = np.array([[-0.1, 1.0, 0.03], [-0.5, 1.0, 0.0], [-0.9, 1.0, 0.0], [-1.0, 1.1, 0.1]])
+    for lines, longer in (([arm, into_hand], 1), ([into_hand * [-1, 1, 1], arm * [-1, 1, 1]], 0)):
+        recount = recounter(lines)
+        joints = [recount(0, 0, 0), recount(1, 0, 0)]
+        result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount)
+        assert len(result[0]) == len(result[1])
+        np.testing.assert_array_equal(result[longer][0], joints[longer][0])
+        np.testing.assert_allclose(result[longer][1:], result[1 - longer][1:] * [-1, 1, 1])
+        np.testing.assert_allclose(result[1 - longer][-1], lines[1 - longer][-1])  # the wrist
+    knee = np.array([[0.0, 0.0, 0.0], [0.2, 0.0, 0.15], [0.4, 0.0, 0.0]])
+    lines = [knee, straight(-0.4)]
+    recount = recounter(lines)
+    result = symmetric_joints([recount(0, 4, 0), recount(1, 4, 0)], lines, (0, 0.0), 0.05, recount)
+    assert np.linalg.norm(result[0] - knee[1], axis=1).min() < 1e-9  # not the straight leg's image
+
+
 def test_twins_whose_recount_overshoots_still_get_one_count():
     """Recounting can give a chain more bones than asked (its corners, or no bone longer than three bone lengths):
     the counts go on rising, one chain then the other, until they agree."""

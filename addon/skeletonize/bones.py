@@ -264,8 +264,10 @@ def symmetric_joints(joints, lines, plane, tolerance, recount):
     is recounted with at most as many as the other, and while their counts differ (its corners need more bones, or
     a bone would be too long), the one with fewer gets as many as the other (``recount(chain, max_bones,
     min_bones)`` gives a chain's joints anew). Pairs whose shapes agree then get the average of one's joints and the
-    other's mirror image; each chain keeps its own first joint, where it attaches to its parent. Pairs whose ends
-    mirror but whose shapes do not (a leg stepping forward) keep their own joints."""
+    other's mirror image; each chain keeps its own first joint, where it attaches to its parent. Where one twin runs
+    on past the image of the other's tip (``_runs_on``: pruning kept a hand's branch on one side only), the longer
+    takes the shorter's mirror image, so both arms end at the wrist. Pairs whose ends mirror but whose shapes do
+    not (a leg stepping forward) keep their own joints."""
     joints = list(joints)
     for i, j in mirror_chain_pairs(lines, plane, tolerance):
         if len(joints[i]) != len(joints[j]):
@@ -277,13 +279,25 @@ def symmetric_joints(joints, lines, plane, tolerance, recount):
         image_of_j = mirrored(resampled(lines[j], SHAPE_SAMPLES), plane)
         same_shape = np.linalg.norm(resampled(lines[i], SHAPE_SAMPLES) - image_of_j, axis=1).max() <= (
             SAME_SHAPE * tolerance)
-        if not same_shape:
-            continue
-        a, b = joints[i], joints[j]
-        mean = (a + mirrored(b, plane)) / 2
-        joints[i] = np.vstack([a[:1], mean[1:]])
-        joints[j] = np.vstack([b[:1], mirrored(mean, plane)[1:]])
+        if same_shape:
+            a, b = joints[i], joints[j]
+            mean = (a + mirrored(b, plane)) / 2
+            joints[i] = np.vstack([a[:1], mean[1:]])
+            joints[j] = np.vstack([b[:1], mirrored(mean, plane)[1:]])
+        elif (ends := _runs_on(lines, i, j, plane, tolerance)) is not None:
+            longer, shorter = ends
+            joints[longer] = np.vstack([joints[longer][:1], mirrored(joints[shorter], plane)[1:]])
     return joints
+
+
+def _runs_on(lines, i, j, plane, tolerance):
+    """(longer, shorter) of mirror twins ``i`` and ``j`` when the longer runs on more than a ``tolerance`` past the
+    image of the shorter's tip, which lies on it (``_fit``); else None."""
+    longer, shorter = (i, j) if length(lines[i]) > length(lines[j]) else (j, i)
+    image = mirrored(lines[shorter], plane)
+    start_gap, tip_gap = _fit(lines[longer], image)
+    past = np.linalg.norm(lines[longer][-1] - image[-1]) > tolerance
+    return (longer, shorter) if past and start_gap <= 2 * tolerance and tip_gap <= tolerance else None
 
 
 def _side(line, plane, tolerance, by_tip=False):
