@@ -2,6 +2,8 @@
 
 Runs the single-stick and skeletor baselines, and Rigger's own method whenever ``rigger.rig_mesh`` is importable;
 scores in the RigNet convention (bench/rigdata.py) and writes bench/results/quality.md, quality.json and PNG plots.
+Rigger's method is then run again with each of ``DETAIL_SETTINGS`` (the parameters that set how many bones it
+makes) to show how the joint counts move against the artists'.
 
     .venv/bin/python bench/quality.py [--models SUBSTR,...] [--methods stick,skeletor,rigger] [--set key=value ...]
 """
@@ -247,11 +249,15 @@ def detail_lines(rows):
               "—" if row["ratio_range"] is None else "{:.2f}–{:.2f}×".format(*row["ratio_range"]),
               str(len(row["over"]) + len(row["under"])), listed(row["over"]) or "—", listed(row["under"]) or "—"]
              for row in rows]
+    in_range = [row["setting"] for row in rows if row["ratio_range"] and not row["over"] and not row["under"]]
+    verdict = (f"Settings with every model within {low}–{high}×: {', '.join(in_range)}." if in_range else
+               f"None of these settings has every model within {low}–{high}×: the artists differ in what they rig "
+               f"(some leave out spikes, shields, claws, toes or a bird's legs, others give a tail eight bones or "
+               f"every finger three), and a setting that brings the first kind within {high}× takes the second "
+               f"below {low}×.")
     return ["", "## Joint count against the detail settings", "",
-            f"Rigger's method with one parameter changed at a time (inside fractions not scored). The artists differ "
-            f"in what they rig: some leave out spikes, shields, claws, toes or a bird's legs, others give a tail eight "
-            f"bones or every finger three, so a setting that brings the first kind within {high}× takes the second "
-            f"below {low}×.", ""] + markdown_table(
+            f"Rigger's method with one parameter changed at a time (inside fractions not scored). {verdict}",
+            ""] + markdown_table(
         ["setting", "mean CD-J2J", "joints vs artist", "models out of range", f"above {high}×", f"below {low}×"],
         table)
 

@@ -182,24 +182,21 @@ def test_no_bone_is_longer_than_three_bone_lengths():
 
 
 def test_min_branch_leaves_short_spikes_without_bones():
-    """A thin horn 0.2 long on a block with two legs and an arm 0.5 long (the mesh is 1.5 across: bones 0.15 long)
-    is a limb at the default ``min_branch`` (half a bone length), gone at three bone lengths (0.45), which still
-    keeps the arm."""
+    """A block 1.3 across (bones 0.13 long) with a thin horn sticking out 0.2 (1.5 bone lengths), an arm 0.3 (2.3)
+    and two legs 0.5: all have bones at the default ``min_branch`` (half a bone length); at two bone lengths the
+    horn goes, at two and a half the arm too, while the legs stay (they reach a quarter of the mesh's size)."""
     body = box((0.0, 0.0, 0.0), (1.0, 0.3, 0.6))
     horn = box((0.2, 0.13, 0.6), (0.24, 0.17, 0.8))
-    arm = box((1.0, 0.1, 0.2), (1.5, 0.2, 0.3))
+    arm = box((1.0, 0.1, 0.2), (1.3, 0.2, 0.3))
     legs = [box((x, 0.1, -0.5), (x + 0.1, 0.2, 0.0)) for x in (0.15, 0.75)]
     vertices, triangles = combine(body, horn, arm, *legs)
-    size = np.ptp(vertices, axis=0).max()
-
-    def reaches(skeleton, tip):
-        return np.linalg.norm(skeleton.joints() - tip, axis=1).min() < 0.05 * size
-
-    horn_tip, hand = np.array([0.22, 0.15, 0.8]), np.array([1.5, 0.15, 0.25])
-    default = rigger.rig_mesh(vertices, triangles)
-    assert reaches(default, horn_tip) and reaches(default, hand)
-    sparse = rigger.rig_mesh(vertices, triangles, min_branch=3.0)
-    assert not reaches(sparse, horn_tip) and reaches(sparse, hand)
+    tips = np.array([[0.22, 0.15, 0.8], [1.3, 0.15, 0.25], [0.2, 0.15, -0.5], [0.8, 0.15, -0.5]])
+    for min_branch, reached in ((None, [True] * 4), (2.0, [False, True, True, True]),
+                                (2.5, [False, False, True, True])):
+        params = {} if min_branch is None else {"min_branch": min_branch}
+        joints = rigger.rig_mesh(vertices, triangles, **params).joints()
+        reaches = np.linalg.norm(joints[None] - tips[:, None], axis=2).min(axis=1) < 0.05 * 1.3
+        assert list(reaches) == reached, f"min_branch {min_branch}: tips reached {reaches}"
 
 
 def test_the_hole_between_arm_and_body_is_cut():
@@ -388,9 +385,9 @@ def test_limbs_pruned_unlike_on_a_symmetric_model_are_still_twins(model, images)
     """Pruning left the two sides of a limb unlike: one of homer's arms runs on into the hand while the other stops
     at the wrist, one of 17364's feet keeps a toe, one of 8210's hands a finger, one of 2586's arms a bend at its
     tip. The two still pair and get one bone count, so every ``.L`` bone has its ``.R`` twin (X-mirror posing
-    needs that); a limb that runs on past its twin's image takes that image, so on the first three every pair of
-    bones ends at mirror-image tails (each twin keeps its own first head, where it hangs from its parent); 2586's
-    bent arm ends where its twin does, and keeps its own shape."""
+    needs that); a limb that runs on along its twin's image takes that image, so on the first three every pair of
+    bones ends at mirror-image tails (each twin keeps its own first head, where it hangs from its parent). 2586's
+    bent arm does not run along its twin's image: the two only share a bone count."""
     vertices, triangles = load_obj(shared_path("models", model))
     skeleton = rigger.rig_mesh(vertices, triangles)
     if images:

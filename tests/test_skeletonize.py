@@ -367,7 +367,7 @@ def test_mirror_pair_chains_get_mirror_image_joints():
     spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     lines = [spine, left, right, leg, stepping]
     joints = [spine, left + [0, 0.02, 0], right + [0.01, -0.02, 0], leg, stepping]
-    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount=None)  # equal counts: nothing recounted
+    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, None, leaves=[True] * 5)  # equal counts: no recount
     np.testing.assert_allclose(result[1][0], joints[1][0])  # first joints stay where the chains attach
     np.testing.assert_allclose(result[2][0], joints[2][0])
     np.testing.assert_allclose(result[1][1:], (left + [-0.005, 0, 0])[1:], atol=1e-12)
@@ -391,7 +391,7 @@ def test_a_mirror_pair_gets_one_bone_count_so_every_bone_has_a_twin():
     recount = recounter(lines)
     joints = [recount(0, 4, 0), recount(1, 3, 0)]
     assert (len(joints[0]), len(joints[1])) == (5, 4)
-    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount)
+    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount, leaves=[True, True])
     assert len(result[0]) == len(result[1]) == 4
     assert np.linalg.norm(result[0] - knee[1], axis=1).min() < 1e-9  # the knee keeps its joint
     zigzag = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.1], [0.2, 0.0, 0.0], [0.3, 0.0, 0.1], [0.4, 0.0, 0.0]])
@@ -399,29 +399,31 @@ def test_a_mirror_pair_gets_one_bone_count_so_every_bone_has_a_twin():
     recount = recounter(lines)
     joints = [recount(0, 2, 0), recount(1, 2, 0)]
     assert (len(joints[0]), len(joints[1])) == (5, 3)  # every corner gets a joint, whatever max_bones
-    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount)
+    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount, leaves=[True, True])
     assert len(result[0]) == len(result[1]) == 5
 
 
-def test_an_arm_running_on_into_the_hand_takes_its_twins_image():
-    """One arm stops at the wrist, its twin runs on into the hand (and starts a little apart in depth): after one
-    count, the longer takes the shorter's mirror image but keeps its own first joint, so both end at the wrist,
-    either way round. Twins whose ends mirror but whose shapes differ (a knee) keep their own joints."""
-    arm = np.array([[0.1, 1.0, 0.0], [0.5, 1.0, 0.0], [0.9, 1.0, 0.0]])
-    into_hand = np.array([[-0.1, 1.0, 0.03], [-0.5, 1.0, 0.0], [-0.9, 1.0, 0.0], [-1.0, 1.1, 0.1]])
-    for lines, longer in (([arm, into_hand], 1), ([into_hand * [-1, 1, 1], arm * [-1, 1, 1]], 0)):
+def test_a_leaf_running_on_along_its_twins_image_takes_that_image():
+    """One arm stops at the wrist, its twin runs on into a hand whose two corners would want more bones (and starts
+    a little apart in depth): the longer takes the shorter's mirror image, its bone count too, but keeps its own
+    first joint, so both end at the wrist, either way round. So does a leg ending a little lower than its twin
+    along the same line. A longer twin with chains hanging from its tip (fingers) keeps its own joints."""
+    arm = np.array([[0.1, 1.0, 0.0], [0.25, 1.0, 0.0]])  # two bones
+    into_hand = np.array([[-0.1, 1.0, 0.03], [-0.25, 1.0, 0.0], [-0.35, 1.1, 0.0], [-0.45, 1.0, 0.0]])
+    leg, lower = np.array([[0.2, 0.0, 0.0], [0.2, -0.33, 0.0]]), np.array([[-0.2, 0.0, 0.0], [-0.2, -0.4, 0.0]])
+    assert len(recounter([into_hand])(0, 2, 0)) > 3  # the hand's corners want more bones than the arm's two
+    for lines, longer in (([arm, into_hand], 1), ([into_hand * [-1, 1, 1], arm * [-1, 1, 1]], 0), ([leg, lower], 1)):
         recount = recounter(lines)
         joints = [recount(0, 0, 0), recount(1, 0, 0)]
-        result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount)
-        assert len(result[0]) == len(result[1])
+        result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount, leaves=[True, True])
+        assert result[1 - longer] is joints[1 - longer]  # the shorter is not recounted
         np.testing.assert_array_equal(result[longer][0], joints[longer][0])
-        np.testing.assert_allclose(result[longer][1:], result[1 - longer][1:] * [-1, 1, 1])
-        np.testing.assert_allclose(result[1 - longer][-1], lines[1 - longer][-1])  # the wrist
-    knee = np.array([[0.0, 0.0, 0.0], [0.2, 0.0, 0.15], [0.4, 0.0, 0.0]])
-    lines = [knee, straight(-0.4)]
+        np.testing.assert_allclose(result[longer][1:], joints[1 - longer][1:] * [-1, 1, 1])
+    lines = [arm, into_hand]
     recount = recounter(lines)
-    result = symmetric_joints([recount(0, 4, 0), recount(1, 4, 0)], lines, (0, 0.0), 0.05, recount)
-    assert np.linalg.norm(result[0] - knee[1], axis=1).min() < 1e-9  # not the straight leg's image
+    joints = [recount(0, 0, 0), recount(1, 0, 0)]
+    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount, leaves=[True, False])
+    np.testing.assert_allclose(result[1][-1], into_hand[-1])
 
 
 def test_twins_whose_recount_overshoots_still_get_one_count():
@@ -435,7 +437,8 @@ def test_twins_whose_recount_overshoots_still_get_one_count():
         return straight(0.1 * bones, bones + 1) * [1 - 2 * chain, 1, 1]
 
     lines = [straight(0.5), straight(-0.5)]
-    result = symmetric_joints([recount(0, 4, 0), recount(1, 2, 0)], lines, (0, 0.0), 0.05, recount)
+    result = symmetric_joints([recount(0, 4, 0), recount(1, 2, 0)], lines, (0, 0.0), 0.05, recount,
+                              leaves=[True, True])
     assert len(result[0]) == len(result[1]) == 6
     assert asked[2:] == [(0, 3, 0), (1, 4, 4), (0, 5, 5)]
 

@@ -38,11 +38,10 @@ def bone_names(armature):
 
 
 def bone_ends(armature, names):
-    """World-space heads and tails (B, 3) of the named bones in rest pose, read here rather than through the
-    code under test."""
-    matrix = np.array(armature.matrix_world)
-    ends = np.array([(bone.head_local, bone.tail_local) for bone in map(armature.data.bones.get, names)])
-    ends = ends @ matrix[:3, :3].T + matrix[:3, 3]
+    """World-space heads and tails (B, 3) of the named bones in rest pose, read from the armature here rather than
+    through the skinning code under test."""
+    bones = [armature.data.bones[name] for name in names]
+    ends = world_points(np.array([(bone.head_local, bone.tail_local) for bone in bones]), armature.matrix_world)
     return ends[:, 0], ends[:, 1]
 
 

@@ -89,8 +89,9 @@ class SilhouetteMethod(RigMethod):
                           "dropped as bumps (unless they reach a quarter of the mesh's size); lower keeps stubbier "
                           "branches"),
         Param("min_branch", "float", 0.5, min=0.0, max=10.0,
-              description="Branches sticking out less than this many bone lengths are dropped, however thin; "
-                          "raise it to leave short spikes, claws and toes without bones"),
+              description="Branches sticking out less than this many bone lengths are dropped, however thin "
+                          "(unless they reach a quarter of the mesh's size); raise it to leave short spikes, claws "
+                          "and toes without bones"),
         Param("bone_angle", "float", 40.0, min=1.0, max=180.0,
               description="Start a new bone where a chain turns by more than this many degrees"),
         Param("bone_length", "float", 0.1, min=0.01, max=1.0,
@@ -496,7 +497,8 @@ class _BoneBuilder:
         joints = [joints_of(chain, self.max_bones) for chain in range(len(chains))]
         if self.plane is None:
             return joints
-        return symmetric_joints(joints, [line for line, _, _ in chains], self.plane, self.tolerance, joints_of)
+        return symmetric_joints(joints, [line for line, _, _ in chains], self.plane, self.tolerance, joints_of,
+                                leaves=[leaf for _, _, leaf in chains])
 
     def _add_chain(self, line, joints, up):
         """Bones between consecutive ``joints`` of one chain, the first hanging from bone ``up``; returns the

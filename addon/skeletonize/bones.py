@@ -219,15 +219,22 @@ def _partial_twin(lines, image, candidates, tolerance):
             for gaps in (_fit(image, lines[k]), _fit(lines[k], image))]
     if not fits:
         return None
-    _, (start_gap, tip_gap), best = min(fits, key=lambda fit: fit[0])
-    return best if start_gap <= 2 * tolerance and tip_gap <= tolerance else None
+    _, gaps, best = min(fits, key=lambda fit: fit[0])
+    return best if _covers(gaps, tolerance) else None
 
 
 def _fit(long, short):
     """(start gap, tip gap) of polyline ``short`` against ``long``: how far apart their starts lie and how far the
-    tip of ``short`` lies off ``long``; ``long`` covers ``short`` when they are within two and one tolerances."""
+    tip of ``short`` lies off ``long`` (``_covers``)."""
     return (float(np.linalg.norm(short[0] - long[0])),
             float(segment_distances(short[-1:], long[:-1], long[1:]).min()))
+
+
+def _covers(gaps, tolerance):
+    """Whether a polyline covers another whose ``_fit`` against it is ``gaps``: their starts lie within two
+    ``tolerance``s, the other's tip within one of the polyline."""
+    start_gap, tip_gap = gaps
+    return start_gap <= 2 * tolerance and tip_gap <= tolerance
 
 
 def mirror_completed(limbs, plane, tolerance):
@@ -249,7 +256,7 @@ def mirror_completed(limbs, plane, tolerance):
         misfits = gaps.sum(axis=1)
         best = int(np.argmin(misfits))
         i = twins[best]
-        covered = gaps[best, 0] <= 2 * tolerance and gaps[best, 1] <= tolerance and length(line) < length(lines[i])
+        covered = _covers(gaps[best], tolerance) and length(line) < length(lines[i])
         if covered and misfits[best] < fits.get(i, (np.inf,))[0]:
             fits[i] = (misfits[best], j)
     result = list(limbs)
@@ -258,18 +265,25 @@ def mirror_completed(limbs, plane, tolerance):
     return result
 
 
-def symmetric_joints(joints, lines, plane, tolerance, recount):
-    """``joints`` per chain (3D polylines ``lines``), each mirror pair of chains (``mirror_chain_pairs``) given one
-    bone count, so that every bone has a twin (``.L`` and ``.R`` names, X-mirror posing): the one with more bones
-    is recounted with at most as many as the other, and while their counts differ (its corners need more bones, or
-    a bone would be too long), the one with fewer gets as many as the other (``recount(chain, max_bones,
-    min_bones)`` gives a chain's joints anew). Pairs whose shapes agree then get the average of one's joints and the
-    other's mirror image; each chain keeps its own first joint, where it attaches to its parent. Where one twin runs
-    on past the image of the other's tip (``_runs_on``: pruning kept a hand's branch on one side only), the longer
-    takes the shorter's mirror image, so both arms end at the wrist. Pairs whose ends mirror but whose shapes do
-    not (a leg stepping forward) keep their own joints."""
+def symmetric_joints(joints, lines, plane, tolerance, recount, *, leaves):
+    """``joints`` per chain (3D polylines ``lines``, ``leaves`` telling which end in a tip), each mirror pair of
+    chains (``mirror_chain_pairs``) made to match, so that every bone has a twin (``.L`` and ``.R`` names, X-mirror
+    posing). Where one twin is a leaf that runs on along the other's image past its tip (``_runs_on``: pruning kept
+    a hand's branch on one side only, or the triangulation ended one leg a little lower), it takes the other's
+    mirror image, its bone count too, so both arms end at the wrist. Otherwise
+    the pair gets one bone count: the one with more bones is recounted with at most as many as the other, and
+    while their counts differ (its corners need more bones, or a bone would be too long), the one with fewer gets
+    as many as the other (``recount(chain, max_bones, min_bones)`` gives a chain's joints anew). Pairs whose shapes
+    agree then get the average of one's joints and the other's mirror image; pairs whose shapes do not (a leg
+    stepping forward) keep their own joints. Each chain keeps its own first joint, where it attaches to its
+    parent."""
     joints = list(joints)
     for i, j in mirror_chain_pairs(lines, plane, tolerance):
+        runs_on = _runs_on(lines, i, j, plane, tolerance, leaves)
+        if runs_on is not None:
+            longer, shorter = runs_on
+            joints[longer] = np.vstack([joints[longer][:1], mirrored(joints[shorter], plane)[1:]])
+            continue
         if len(joints[i]) != len(joints[j]):
             more, fewer = (i, j) if len(joints[i]) > len(joints[j]) else (j, i)
             joints[more] = recount(more, len(joints[fewer]) - 1, 0)
@@ -284,20 +298,19 @@ def symmetric_joints(joints, lines, plane, tolerance, recount):
             mean = (a + mirrored(b, plane)) / 2
             joints[i] = np.vstack([a[:1], mean[1:]])
             joints[j] = np.vstack([b[:1], mirrored(mean, plane)[1:]])
-        elif (ends := _runs_on(lines, i, j, plane, tolerance)) is not None:
-            longer, shorter = ends
-            joints[longer] = np.vstack([joints[longer][:1], mirrored(joints[shorter], plane)[1:]])
     return joints
 
 
-def _runs_on(lines, i, j, plane, tolerance):
-    """(longer, shorter) of mirror twins ``i`` and ``j`` when the longer runs on more than a ``tolerance`` past the
-    image of the shorter's tip, which lies on it (``_fit``); else None."""
-    longer, shorter = (i, j) if length(lines[i]) > length(lines[j]) else (j, i)
-    image = mirrored(lines[shorter], plane)
-    start_gap, tip_gap = _fit(lines[longer], image)
-    past = np.linalg.norm(lines[longer][-1] - image[-1]) > tolerance
-    return (longer, shorter) if past and start_gap <= 2 * tolerance and tip_gap <= tolerance else None
+def _runs_on(lines, i, j, plane, tolerance, leaves):
+    """(longer, shorter) of mirror twins ``i`` and ``j`` when the longer is a leaf (``leaves``) that covers the
+    shorter's mirror image (``_covers``) and whose tip lies more than a ``tolerance`` from the image's tip; else
+    None. A leg stepping forward does not cover its twin's image."""
+    for longer, shorter in ((i, j), (j, i)):
+        image = mirrored(lines[shorter], plane)
+        if leaves[longer] and _covers(_fit(lines[longer], image), tolerance) and (
+                np.linalg.norm(lines[longer][-1] - image[-1]) > tolerance):
+            return longer, shorter
+    return None
 
 
 def _side(line, plane, tolerance, by_tip=False):
