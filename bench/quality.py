@@ -217,13 +217,16 @@ def summarise(records, methods):
     return summary
 
 
-def detail_sweep(truths, params, timeout):
+def detail_sweep(truths, params, timeout, as_run):
     """Rigger's joint counts and mean CD-J2J with each of ``DETAIL_SETTINGS`` applied over ``params``: whether any
-    one setting puts every model's joint count within the target range, and what it costs in CD-J2J."""
+    one setting puts every model's joint count within the target range, and what it costs in CD-J2J. ``as_run``
+    are the main run's Rigger records (one per truth, in order), reused for a setting that changes nothing."""
     low, high = TARGETS["joint_ratio"]
     rows = []
     for change in DETAIL_SETTINGS:
-        records = [evaluate(truth, "rigger", {**params, **change}, timeout, inside=False) for truth in truths]
+        setting = {**params, **change}
+        records = as_run if setting == params else [evaluate(truth, "rigger", setting, timeout, inside=False)
+                                                    for truth in truths]
         good = [r for r in records if succeeded(r)]
         ratios = [r["joint_ratio"] for r in good]
         label = ", ".join(f"{key}={value}" for key, value in change.items()) or ("as run" if params else "defaults")
@@ -525,7 +528,8 @@ def main(argv=None):
         else:
             print(f"{method:9s} failed on every model")
 
-    sweep = detail_sweep(truths, params, args.timeout) if "rigger" in methods else []
+    as_run = [r for r in records if r["method"] == "rigger"]
+    sweep = detail_sweep(truths, params, args.timeout, as_run) if as_run else []
     for row in sweep:
         print(f"{row['setting']:22s} out of range: {len(row['over']) + len(row['under']):2d}  "
               + (f"mean CD-J2J {row['cd_j2j']:.4f}" if row["cd_j2j"] is not None else "failed on every model"))

@@ -68,9 +68,8 @@ void sil_release(void *memory);
 
 /* Give `trace` the welded connected components `source` has found (finding them now if it has not): they belong to
  * the mesh, not the view (welded as `source` sees its vertices, exactly equal there), so the views of one mesh find
- * them once. Both must trace the same vertices and
- * triangles (SIL_ERR_MISMATCH when the vertex counts or the triangles differ). A trace that has its components
- * keeps them. */
+ * them once. Both must trace the same vertices and triangles (SIL_ERR_MISMATCH when the vertex counts or the
+ * triangles differ). A trace that has its components keeps them. */
 int sil_share_components(SilTrace *trace, SilTrace *source);
 
 #ifdef __cplusplus

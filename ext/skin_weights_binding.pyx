@@ -1,7 +1,7 @@
 """Thin binding over ext/skin_weights.c, compiled as ``rigger._rigger_weights``.
 
-Inputs arrive validated and C-contiguous from ``rigger.weights``; this layer only moves buffers across and turns
-error codes into exceptions.
+Inputs arrive validated and C-contiguous from ``rigger.weights``; this layer moves buffers across, checks the
+shapes and the bone count that C's int32 indices need, and turns error codes into exceptions.
 """
 from libc.stdint cimport int32_t, int64_t
 

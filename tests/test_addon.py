@@ -426,7 +426,7 @@ def drawn_panel():
     return panel.layout
 
 
-def test_the_panel_shows_method_parameters_actions_and_overlay_toggles(registered, scene):
+def test_the_panel_shows_method_parameters_actions_and_overlay_toggles(scene):
     from rigger.blender.overlays import OVERLAY_KINDS
     from rigger.blender.panel import RIGGER_PT_main
     assert (RIGGER_PT_main.bl_space_type, RIGGER_PT_main.bl_region_type) == ('VIEW_3D', 'UI')

@@ -221,8 +221,14 @@ def test_stick_baseline_spans_the_main_axis_with_a_middle_joint():
 
 # --- one real model -----------------------------------------------------------------------------------------------
 
-def test_real_model_loads_and_scores_in_the_rignet_convention():
-    truth = quality.GroundTruth(shared_path("models", "gt", "rignet_2982"))
+@pytest.fixture(scope="module")
+def deer():
+    """The antlered deer's ground truth (rignet_2982), loaded once."""
+    return quality.GroundTruth(shared_path("models", "gt", "rignet_2982"))
+
+
+def test_real_model_loads_and_scores_in_the_rignet_convention(deer):
+    truth = deer
     assert truth.vertices.shape == (935, 3) and truth.triangles.shape == (1866, 3)
     assert len(truth.rig.names) == 27 and (truth.rig.parents < 0).sum() == 1
     assert len(truth.joints) == 25  # RigNet's root_dup_* joints repeat the root's position: one joint each place
@@ -232,11 +238,12 @@ def test_real_model_loads_and_scores_in_the_rignet_convention():
     assert 0.1 < record["cd_j2j"] < 0.2 and record["joints"] == 3 and record["tree_problem"] is None
 
 
-def test_detail_sweep_reports_each_setting_and_the_models_out_of_range(monkeypatch):
-    """Fewer bones at a higher ``min_branch`` on the antlered deer; every setting gets a row and a table line."""
-    truth = quality.GroundTruth(shared_path("models", "gt", "rignet_2982"))
+def test_detail_sweep_reports_each_setting_and_the_models_out_of_range(monkeypatch, deer):
+    """Fewer bones at ``min_branch`` 3 on the antlered deer; every setting gets a row and a table line."""
+    truth = deer
     monkeypatch.setattr(quality, "DETAIL_SETTINGS", ({}, {"min_branch": 3.0}))
-    rows = quality.detail_sweep([truth], {}, timeout=60)
+    as_run = [quality.evaluate(truth, "rigger", {}, timeout=60)]
+    rows = quality.detail_sweep([truth], {}, 60, as_run)
     assert [row["setting"] for row in rows] == ["defaults", "min_branch=3.0"]
     (low, high), (sparse_low, sparse_high) = (row["ratio_range"] for row in rows)
     assert low == high and sparse_low == sparse_high and sparse_high < high

@@ -9,7 +9,7 @@ from cdt_checks import polygon_area
 from characters import strictly_inside_fraction, load_character
 from meshes import box, combine, ellipsoids, far_apart_cubes, grid_surface, uv_sphere
 from rigger import samples
-from rigger.skeletonize.bones import bone_names, mirrored
+from rigger.skeletonize.bones import mirrored
 
 from conftest import shared_path
 from rigdata import chamfer_distance, load_obj
@@ -417,11 +417,6 @@ def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):
     return builder, first
 
 
-def _builder_names(builder):
-    """The bone names of a ``_body_with_feet`` builder, with its mirror plane."""
-    return bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, builder.plane, builder.tolerance)
-
-
 @pytest.mark.parametrize("bone_length", [1.0, 0.3])
 @pytest.mark.parametrize("foot_depth", [0.5, 1.01], ids=["inside", "grazing the surface"])
 def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh(foot_depth, bone_length):
@@ -486,7 +481,7 @@ def test_mirror_image_hidden_limbs_get_mirror_image_bones():
     tail = np.array([[0.0, 0.3, 0.5], [0.0, 0.1, 0.9]])
     for feet in ([left, left * [-1, 1, 1]], [left, tail, left * [-1, 1, 1]], [tail, left, left * [-1, 1, 1]]):
         builder, first = _body_with_feet(feet, plane=(0, 0.0))
-        names = _builder_names(builder)
+        names = builder.names()
         heads, tails, parents = builder.arrays()
         sides = {side: [b for b in range(first, len(heads)) if names[b].endswith(side)] for side in (".L", ".R")}
         assert len(sides[".L"]) == len(sides[".R"]) >= 2
@@ -501,7 +496,7 @@ def test_hidden_limbs_starting_together_share_their_extension():
     ear = np.array([[0.0, 0.3, 0.5], [0.3, 0.1, 0.9]])
     builder, first = _body_with_feet([ear, ear * [-1, 1, 1]], plane=(0, 0.0))
     heads, tails, parents = builder.arrays()
-    names = _builder_names(builder)
+    names = builder.names()
     segments = np.hstack([heads, tails])
     gaps = np.linalg.norm(segments[:, None] - segments[None], axis=2) + np.diag(np.full(len(heads), np.inf))
     assert gaps.min() > 0.1

@@ -79,7 +79,7 @@ def test_a_spur_whose_mirror_image_is_kept_stays():
     points, radius, chains = chest_with_legs(arm(1, 1.4), arm(-1, 1.3), bump)
 
     def tips(links):  # of the right arm, the left arm and the bump
-        return [tip in links for tip in (18, 24, 26)]
+        return [chain[-1] in links for chain in chains[2:]]
 
     assert tips(prune_spurs(points, radius, chains, 1.35)) == [True, False, False]
     assert tips(prune_spurs(points, radius, chains, 1.35, mirror=reflect)) == [True, True, False]
@@ -97,8 +97,7 @@ def test_a_mirror_pair_of_stubby_branches_stays_where_a_lone_one_goes():
     def kept(right, left, legs=(-0.5, 0.5), **rules):  # whether each ear's tip (the last node of its part) stays
         points, radius, chains = chest_with_legs(right, left, legs=legs)
         links = prune_spurs(points, radius, chains, 1.35, **rules)
-        first = 1 + 6 * len(legs)
-        return [tip in links for tip in (first + len(right) - 1, first + len(right) + len(left) - 1)]
+        return [chain[-1] in links for chain in chains[-2:]]
 
     pair = {"mirror": reflect, "pair_prune": 0.74}
     assert kept(ear(1, 0.9), ear(-1, 0.9), **pair) == [True, True]
@@ -120,7 +119,8 @@ def test_outline_noise_is_not_kept_for_lying_on_the_body_it_mirrors_onto():
     specks = [(0.5, 0.85, 0.01)], [(-0.5, 0.85, 0.01)]  # 0.99 from the chest's centre, 1.0 its radius
     points, radius, chains = chest_with_legs(*specks)
     kept = prune_spurs(points, radius, chains, 1.35, mirror=reflect)
-    assert 13 not in kept and 14 not in kept and 12 in kept
+    leg, *speck_tips = (chain[-1] for chain in chains[1:])
+    assert all(tip not in kept for tip in speck_tips) and leg in kept
 
 
 def test_a_round_part_without_a_neck_is_kept():
@@ -130,11 +130,12 @@ def test_a_round_part_without_a_neck_is_kept():
     a smaller blob, one centred on the body's disc, or one sticking out less than ``min_reach`` goes."""
     def head_kept(head, is_blob=True, min_reach=0.0):
         points, radius, chains = chest_with_legs([(0.0, 1.05, head[2]), head])
+        leg, tip = chains[1][-1], chains[2][-1]
         blobs = np.zeros(len(points), bool)
-        blobs[[0, 14]] = True, is_blob
+        blobs[[0, tip]] = True, is_blob
         kept = prune_spurs(points, radius, chains, 1.35, min_reach, blobs=blobs)
-        assert 12 in kept  # the legs are limbs whatever happens to the head
-        return 14 in kept
+        assert leg in kept  # the legs are limbs whatever happens to the head
+        return tip in kept
 
     assert head_kept((0.0, 1.1, 0.85))
     assert not head_kept((0.0, 1.1, 0.85), is_blob=False)
@@ -246,7 +247,6 @@ def test_a_head_seen_across_the_mirror_plane_does_not_run_into_one_ear():
     where the rays pass only beside the plane (a gap in the head's outline, and the ears' tips) the chain neither
     steps into one ear nor ends in one. Without the plane, or without splitting, it follows one ear to its tip, as
     it must for a single part off to one side."""
-    count = 12
     ears = layers((-0.8, -0.7), (0.7, 0.8))
     node_layers = [layers((-0.5, 0.5))] * 5 + [ears] + [layers((-0.5, 0.5))] * 3 + [ears] * 3
     (_, [(line, _, _)]) = placed_along_x(node_layers, mirror=(0.0, 0.05))
@@ -254,7 +254,7 @@ def test_a_head_seen_across_the_mirror_plane_does_not_run_into_one_ear():
     np.testing.assert_array_equal(line[:, 2], 0.0)  # on the plane throughout
     for plane in (None, (0.0, 0.05)):
         (_, [(line, _, _)]) = placed_along_x(node_layers, split=False, mirror=plane)
-        assert len(line) == count and line[-1, 2] == -0.75
+        assert len(line) == len(node_layers) and line[-1, 2] == -0.75
 
 
 def test_a_chain_that_cannot_end_before_its_tip_between_the_ears_follows_one_ear():
@@ -382,24 +382,26 @@ def recounter(lines):
                                                             min_bones=min_bones)
 
 
+def twins(lines, max_bones, leaves=(True, True)):
+    """(each chain's own joints at most ``max_bones`` (a pair) bones long, ``symmetric_joints``' result) for a pair
+    of chains ``lines`` across x = 0, tolerance 0.05, bone length 0.1."""
+    recount = recounter(lines)
+    joints = [recount(chain, bones, 0) for chain, bones in enumerate(max_bones)]
+    return joints, symmetric_joints(joints, lines, (0, 0.0), 0.05, recount, leaves=list(leaves))
+
+
 def test_a_mirror_pair_gets_one_bone_count_so_every_bone_has_a_twin():
     """Two legs whose ends mirror but whose shapes differ (one bent at the knee, one straight) keep their own joints
     but get one bone count: the smaller, unless the one with more bones needs them for its corners; then the other
     gets as many."""
     knee = np.array([[0.0, 0.0, 0.0], [0.2, 0.0, 0.15], [0.4, 0.0, 0.0]])
-    lines = [knee, straight(-0.4)]
-    recount = recounter(lines)
-    joints = [recount(0, 4, 0), recount(1, 3, 0)]
+    joints, result = twins([knee, straight(-0.4)], (4, 3))
     assert (len(joints[0]), len(joints[1])) == (5, 4)
-    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount, leaves=[True, True])
     assert len(result[0]) == len(result[1]) == 4
     assert np.linalg.norm(result[0] - knee[1], axis=1).min() < 1e-9  # the knee keeps its joint
     zigzag = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.1], [0.2, 0.0, 0.0], [0.3, 0.0, 0.1], [0.4, 0.0, 0.0]])
-    lines = [zigzag, straight(-0.4)]
-    recount = recounter(lines)
-    joints = [recount(0, 2, 0), recount(1, 2, 0)]
+    joints, result = twins([zigzag, straight(-0.4)], (2, 2))
     assert (len(joints[0]), len(joints[1])) == (5, 3)  # every corner gets a joint, whatever max_bones
-    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount, leaves=[True, True])
     assert len(result[0]) == len(result[1]) == 5
 
 
@@ -413,16 +415,11 @@ def test_a_leaf_running_on_along_its_twins_image_takes_that_image():
     leg, lower = np.array([[0.2, 0.0, 0.0], [0.2, -0.33, 0.0]]), np.array([[-0.2, 0.0, 0.0], [-0.2, -0.4, 0.0]])
     assert len(recounter([into_hand])(0, 2, 0)) > 3  # the hand's corners want more bones than the arm's two
     for lines, longer in (([arm, into_hand], 1), ([into_hand * [-1, 1, 1], arm * [-1, 1, 1]], 0), ([leg, lower], 1)):
-        recount = recounter(lines)
-        joints = [recount(0, 0, 0), recount(1, 0, 0)]
-        result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount, leaves=[True, True])
+        joints, result = twins(lines, (0, 0))
         assert result[1 - longer] is joints[1 - longer]  # the shorter is not recounted
         np.testing.assert_array_equal(result[longer][0], joints[longer][0])
         np.testing.assert_allclose(result[longer][1:], joints[1 - longer][1:] * [-1, 1, 1])
-    lines = [arm, into_hand]
-    recount = recounter(lines)
-    joints = [recount(0, 0, 0), recount(1, 0, 0)]
-    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, recount, leaves=[True, False])
+    _, result = twins([arm, into_hand], (0, 0), leaves=(True, False))
     np.testing.assert_allclose(result[1][-1], into_hand[-1])
 
 

@@ -164,7 +164,7 @@ class SilhouetteMethod(RigMethod):
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()
-        names = bone_names(builder.chain_of_bone, builder.index_in_chain, builder.lines, plane, tolerance)
+        names = builder.names()
         clock.lap("names")
 
         stages = {
@@ -554,3 +554,7 @@ class _BoneBuilder:
 
     def arrays(self):
         return np.array(self.heads), np.array(self.tails), np.array(self.parents, dtype=np.int64)
+
+    def names(self):
+        """The bones' names (``bone_names``), mirror-suffixed across the builder's plane."""
+        return bone_names(self.chain_of_bone, self.index_in_chain, self.lines, self.plane, self.tolerance)

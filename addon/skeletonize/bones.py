@@ -270,13 +270,12 @@ def symmetric_joints(joints, lines, plane, tolerance, recount, *, leaves):
     chains (``mirror_chain_pairs``) made to match, so that every bone has a twin (``.L`` and ``.R`` names, X-mirror
     posing). Where one twin is a leaf that runs on along the other's image past its tip (``_runs_on``: pruning kept
     a hand's branch on one side only, or the triangulation ended one leg a little lower), it takes the other's
-    mirror image, its bone count too, so both arms end at the wrist. Otherwise
-    the pair gets one bone count: the one with more bones is recounted with at most as many as the other, and
-    while their counts differ (its corners need more bones, or a bone would be too long), the one with fewer gets
-    as many as the other (``recount(chain, max_bones, min_bones)`` gives a chain's joints anew). Pairs whose shapes
-    agree then get the average of one's joints and the other's mirror image; pairs whose shapes do not (a leg
-    stepping forward) keep their own joints. Each chain keeps its own first joint, where it attaches to its
-    parent."""
+    mirror image, its bone count too, so both arms end at the wrist. Otherwise the pair gets one bone count: the
+    one with more bones is recounted with at most as many as the other, and while their counts differ (its corners
+    need more bones, or a bone would be too long), the one with fewer gets as many as the other (``recount(chain,
+    max_bones, min_bones)`` gives a chain's joints anew). Pairs whose shapes agree then get the average of one's
+    joints and the other's mirror image; pairs whose shapes do not (a leg stepping forward) keep their own joints.
+    Each chain keeps its own first joint, where it attaches to its parent."""
     joints = list(joints)
     for i, j in mirror_chain_pairs(lines, plane, tolerance):
         runs_on = _runs_on(lines, i, j, plane, tolerance, leaves)
