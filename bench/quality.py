@@ -22,6 +22,7 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
+import rigger  # noqa: E402
 from benchkit import RESULTS_DIR, SHARED_MODELS, cpu_model, markdown_table, table_cell  # noqa: E402
 
 MODELS_DIR = SHARED_MODELS / "gt"
@@ -108,22 +109,11 @@ def segment_distances(point, starts, ends):
 
 def rigger_silhouette(vertices, triangles, **params):
     """Rigger's own method; its per-stage timings come from ``stages["timings"]``."""
-    import rigger
-
     skeleton = rigger.rig_mesh(vertices, triangles.astype(np.int32), method="silhouette", **params)
     return rigdata.Bones.of(skeleton), dict(skeleton.stages.get("timings", {}))
 
 
 METHODS = {"stick": principal_stick, "skeletor": skeletor_wavefront, "rigger": rigger_silhouette}
-
-
-def rigger_unavailable():
-    """Why Rigger's method cannot run here, or None when ``rigger.rig_mesh`` is importable."""
-    try:
-        import rigger
-    except Exception as error:  # any import failure just leaves rigger out of the run
-        return f"import rigger failed: {error}"
-    return None if callable(getattr(rigger, "rig_mesh", None)) else "rigger has no rig_mesh yet"
 
 
 class Timeout(Exception):
@@ -175,6 +165,7 @@ def evaluate(truth, method, params, timeout, inside=True):
         record.update(rigdata.skeleton_distances(joints, samples, truth.joints, truth.samples))
         record["joints"] = len(joints)
         record["joint_ratio"] = len(joints) / len(truth.joints)
+        record["length_ratio"] = unit_bones.total_length() / truth.bones.total_length()
         if inside:
             record["inside"] = rigdata.inside_fraction(samples, truth.unit_vertices, truth.triangles)
         record["unit_bones"] = unit_bones
@@ -265,6 +256,24 @@ def detail_lines(rows):
         table)
 
 
+def density_lines(truths, records):
+    """Two measurements behind the joint-count verdict: how many joints the artists place per unit of their own
+    bone length, against the width of the target window, and on which models Rigger's bones are much longer in
+    total than the artist's (parts the artist left without bones)."""
+    low, high = TARGETS["joint_ratio"]
+    density = {t.name: len(t.joints) / t.bones.total_length() for t in truths}
+    sparse, dense = min(density, key=density.get), max(density, key=density.get)
+    longer = {r["model"]: r["length_ratio"] for r in records if succeeded(r) and r["length_ratio"] > high}
+    lines = [f"The artists place {density[sparse]:.1f} ({sparse}) to {density[dense]:.1f} ({dense}) joints per "
+             f"unit of their own bone length: a factor {density[dense] / density[sparse]:.2f}, where the "
+             f"{low}–{high}× window is a factor {high / low:.2f} wide."]
+    if longer:
+        listed = ", ".join(f"{name} {ratio:.2f}×" for name, ratio in sorted(longer.items(), key=lambda kv: -kv[1]))
+        lines.append(f"Rigger's bones add up to more than {high}× the artist's length on {listed}: parts the artist "
+                     f"left without bones.")
+    return ["", " ".join(lines)]
+
+
 def machine_description():
     cpu = cpu_model()
     return (f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}, "
@@ -330,7 +339,7 @@ def write_report(path, truths, records, summary, methods, notes, command, sweep)
         if "cd_j2j" in summary.get(method, {}):
             lines.append(f"- {method}: measured {summary[method]['cd_j2j']:.4f} vs reference {reference}")
     if sweep:
-        lines += detail_lines(sweep)
+        lines += detail_lines(sweep) + density_lines(truths, [r for r in records if r["method"] == "rigger"])
     lines += ["", "## Per model", ""]
     lines += markdown_table(["model", "vertices", "triangles", "artist joints", "artist bones inside"],
                             [[t.name, len(t.vertices), len(t.triangles), len(t.joints), f"{t.inside:.1%}"]
@@ -474,18 +483,10 @@ def main(argv=None):
             raise SystemExit(f"No model name contains any of {wanted}.")
 
     notes = []
-    unavailable = rigger_unavailable()
-    if args.methods:
-        methods = [m for m in args.methods.split(",") if m]
-        unknown = [m for m in methods if m not in METHODS]
-        if unknown:
-            raise SystemExit(f"Unknown methods {unknown}; choose from {list(METHODS)}.")
-        if "rigger" in methods and unavailable:
-            raise SystemExit(f"rigger requested but unavailable: {unavailable}")
-    else:
-        methods = [m for m in METHODS if m != "rigger" or not unavailable]
-        if unavailable:
-            notes.append(f"rigger not run: {unavailable}.")
+    methods = [m for m in args.methods.split(",") if m] if args.methods else list(METHODS)
+    unknown = [m for m in methods if m not in METHODS]
+    if unknown:
+        raise SystemExit(f"Unknown methods {unknown}; choose from {list(METHODS)}.")
     params = parse_params(args.set)
     if params:
         notes.append(f"rigger parameters: {params}.")

@@ -93,6 +93,10 @@ class Bones:
         has_child[self.parents[self.parents >= 0]] = True
         return np.unique(np.concatenate([self.heads, self.tails[~has_child]]), axis=0)
 
+    def total_length(self):
+        """The summed length of the bones."""
+        return float(np.linalg.norm(self.tails - self.heads, axis=1).sum())
+
     def samples(self, step=BONE_SAMPLE_STEP):
         """Points every ``step`` (or closer) along each bone, both ends included; (S, 3)."""
         lengths = np.linalg.norm(self.tails - self.heads, axis=1)

@@ -1,4 +1,6 @@
 """The quality benchmark's data and scoring library (bench/rigdata.py) and its baseline skeleton helpers."""
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from scipy.sparse import csr_matrix
@@ -252,6 +254,21 @@ def test_detail_sweep_reports_each_setting_and_the_models_out_of_range(monkeypat
         assert (truth.name in row["over"]) == (row["ratio_range"][1] > quality.TARGETS["joint_ratio"][1])
     table = quality.detail_lines(rows)[-2:]
     assert table[0].startswith("| defaults |") and table[1].startswith("| min_branch=3.0 |")
+
+
+def test_density_lines_measure_the_artists_joint_spacing_and_rigger_s_extra_parts(deer):
+    """The deer's 25 joints over its bones against a 3-joint stick 2 long; only the stick's rig is 2× longer."""
+    stick = rigdata.Bones(np.array([[0.0, 0, 0], [1, 0, 0]]), np.array([[1.0, 0, 0], [2, 0, 0]]), np.array([-1, 0]))
+    assert stick.total_length() == 2.0
+    sparse = SimpleNamespace(name="stick", joints=stick.joints(), bones=stick)
+    records = [{"model": "stick", "length_ratio": 2.0},
+               {"model": deer.name, "length_ratio": quality.evaluate(deer, "rigger", {}, 60)["length_ratio"]}]
+    assert 1.0 < records[1]["length_ratio"] < 1.5  # the antlers, unboned by the artist, add a little
+    text = quality.density_lines([sparse, deer], records)[-1]
+    factor = 25 / deer.bones.total_length() / 1.5
+    assert text.startswith(f"The artists place 1.5 (stick) to {25 / deer.bones.total_length():.1f} ({deer.name}) ")
+    assert f"a factor {factor:.2f}, where the 0.7–1.5× window is a factor 2.14 wide." in text
+    assert text.endswith("length on stick 2.00×: parts the artist left without bones.")
 
 
 def test_real_rig_helper_joints_are_ignored():
