@@ -397,6 +397,23 @@ def test_limbs_pruned_unlike_on_a_symmetric_model_are_still_twins(model, images)
         assert_side_bones_paired(skeleton, 4)
 
 
+@pytest.mark.parametrize("model, hands", [("woody", [(0.02, 0.55), (0.96, 0.57)]),
+                                          ("cheburashka", [(0.24, 0.27), (0.72, 0.28)])])
+def test_stubby_arms_of_a_figure_without_a_mirror_plane_get_bones(model, hands):
+    """Woody (a flat gingerbread man) and cheburashka are hand-made, so not mirror images to within 1% of their
+    size: their stubby arms, each sticking out less than ``prune`` times its width, stay as a pair alike in size.
+    A leaf bone ends at each hand (``hands``: where, as fractions of the bounding box in x and y)."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", f"{model}.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert skeleton.stages["mirror_plane"] is None
+    low, extent = vertices.min(axis=0), np.ptp(vertices, axis=0)
+    leaf = np.ones(len(skeleton.parents), bool)
+    leaf[skeleton.parents[skeleton.parents >= 0]] = False
+    tips = (skeleton.tails[leaf, :2] - low[:2]) / extent[:2]
+    for hand in hands:
+        assert np.linalg.norm(tips - hand, axis=1).min() < 0.05, f"no bone ends at the hand at {hand}"
+
+
 def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):
     """A box body (x in -0.5..0.5) with one bone down its middle, optionally a box hand hanging beside it across a
     gap, and ``feet`` (polylines) added as hidden limbs seen from the front; returns the builder and how many bones

@@ -113,6 +113,28 @@ def test_a_mirror_pair_of_stubby_branches_stays_where_a_lone_one_goes():
         assert kept(ear(1, 1.34), ear(-1, 0.8), legs=legs, **pair) == [False, False]
 
 
+def test_without_a_mirror_plane_two_stubby_branches_alike_in_size_stay_as_a_pair():
+    """A hand-made figure's two stubby arms off its chest (radius 1) are never exact mirror images: with
+    ``local_pairs`` two spurs over pair_prune (0.74) that stick out about as far and are about as wide both stay,
+    wherever they point; a lone one, a pair unlike in width or reach, or one under pair_prune goes."""
+    def arm(direction, ratio, radius=0.3):  # sticks out ratio times its width off the chest's disc
+        direction = np.array(direction) / np.linalg.norm(direction)
+        return [(*(direction * x), radius) for x in np.linspace(1.02, 1 - radius + 2 * radius * ratio, 5)]
+
+    def kept(*arms, rules=(("pair_prune", 0.74), ("local_pairs", True))):  # whether each arm's tip stays
+        points, radius, chains = chest_with_legs(*arms)
+        links = prune_spurs(points, radius, chains, 1.35, **dict(rules))
+        return [chain[-1] in links for chain in chains[-len(arms):]]
+
+    assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.8)) == [True, True]
+    assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.8), rules=(("pair_prune", 0.74),)) == [False, False]
+    assert kept(arm((1, 0.2), 0.9)) == [False]
+    assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.9, radius=0.15)) == [False, False]
+    assert kept(arm((1, 0.2), 1.3), arm((-1, 0.4), 0.78)) == [False, False]
+    assert kept(arm((1, 0.2), 0.7), arm((-1, 0.4), 0.7)) == [False, False]
+    assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.8), arm((0, 1), 0.85)).count(True) == 2
+
+
 def test_outline_noise_is_not_kept_for_lying_on_the_body_it_mirrors_onto():
     """Two specks of outline noise mirroring each other on the edge of the chest's disc, between two legs: each
     speck's image lies on the chest, not on a kept branch, so both go."""

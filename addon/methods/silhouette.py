@@ -134,7 +134,7 @@ class SilhouetteMethod(RigMethod):
         plane = mirror_plane(mesh.used_vertices, mesh.bbox, 0.01 * mesh.scale)
         tolerance = MIRROR_TOLERANCE * mesh.scale  # chains whose ends mirror this close are a pair
         graph, alive, merged, kept = _pruned_tree(graph, merge, (prune, PAIRED_PRUNE * prune), reaches,
-                                                  reflection_in_view(sil, plane))
+                                                  reflection_in_view(sil, plane), local_pairs=plane is None)
         clock.lap("merge_prune")
 
         side, other_views = None, []  # other_views: (silhouette, chordal axis) of the perpendicular views
@@ -159,7 +159,7 @@ class SilhouetteMethod(RigMethod):
         for view_sil, view_graph in other_views:
             limbs = _hidden_limbs(sil, view_sil, view_graph, builder.lines, merge,
                                   (HIDDEN_PRUNE * prune, PAIRED_PRUNE * prune), reaches, unit, split_layers,
-                                  reflection_in_view(view_sil, plane))
+                                  reflection_in_view(view_sil, plane), plane is None)
             builder.add_limbs(limbs, (sil, view_sil))
         clock.lap("depth_bones")
 
@@ -231,10 +231,10 @@ def _to_world(stages, frame, factor, *points):
     return [place(array) for array in points]
 
 
-def _pruned_tree(graph, merge, prunes, reaches, mirror=None):
+def _pruned_tree(graph, merge, prunes, reaches, mirror=None, local_pairs=False):
     """Blob merging and spur pruning of a chordal axis, ``prunes`` and ``reaches`` being ``prune_spurs``' (prune,
-    pair_prune) and (min_reach, max_reach), ``mirror`` its reflection; its junctions are the blobs that keep a spur
-    ending in one. Returns (graph, alive nodes, merged links, kept links): with ``mirror``, the graph whose blobs near
+    pair_prune) and (min_reach, max_reach), ``mirror`` its reflection and ``local_pairs`` whether pairs of spurs are
+    judged without one (the mesh has no mirror plane); its junctions are the blobs that keep a spur ending in one. Returns (graph, alive nodes, merged links, kept links): with ``mirror``, the graph whose blobs near
     the mirror line are centred on it (``AxisGraph.centred_on_mirror``), the stages show and the bones follow."""
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
     alive = np.unique(representative)
@@ -243,7 +243,7 @@ def _pruned_tree(graph, merge, prunes, reaches, mirror=None):
     _, chains = chains_of(alive.tolist(), merged)
     prune, pair_prune = prunes
     return graph, alive, merged, prune_spurs(graph.points, graph.radius, chains, prune, *reaches, mirror=mirror,
-                                             blobs=graph.junction, pair_prune=pair_prune)
+                                             blobs=graph.junction, pair_prune=pair_prune, local_pairs=local_pairs)
 
 
 def _placed_islands(sil, graph, alive, kept, speck, side, split_layers, mirror):
@@ -272,13 +272,14 @@ def _other_view(vertices, triangles, axis, resolution, spacing, min_hole):
     return view_sil, view_graph
 
 
-def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prunes, reaches, bone_length, split_layers, mirror):
+def _hidden_limbs(sil, view_sil, view_graph, lines, merge, prunes, reaches, bone_length, split_layers, mirror,
+                  local_pairs):
     """Limbs the primary view hides behind the body, from a perpendicular view's pruned tree (see ``second_view``);
     the view's chains are placed in depth only when a leaf tip lies off the primary skeleton. With ``mirror`` (the
     view's ``reflection_in_view``, None when it does not look across the mirror plane) the tree is pruned as the
     primary view's is: blobs near the mirror line are centred on it, and a spur whose mirror image is kept stays, as
-    do mirror pairs of stubbier ones."""
-    view_graph, alive, _, kept = _pruned_tree(view_graph, merge, prunes, reaches, mirror)
+    do mirror pairs of stubbier ones; with ``local_pairs`` (no mirror plane), pairs of such spurs alike in size."""
+    view_graph, alive, _, kept = _pruned_tree(view_graph, merge, prunes, reaches, mirror, local_pairs)
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]
     cover = Cover(lines, view_sil.direction, HIDDEN_REACH * bone_length)

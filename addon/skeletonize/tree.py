@@ -8,7 +8,8 @@ A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch p
 2. Spur pruning: a branch that pokes out of the disc it hangs on by less than ``prune`` times its own width is a
    bump or outline noise, not a limb; it is removed, repeatedly, since removing one can expose another. A branch
    reaching far enough is kept however wide, and so is one ending in a round part of its own (a head without a
-   neck), one whose mirror image is kept, or a mirror pair of stubbier ones (two ears).
+   neck), one whose mirror image is kept, or a mirror pair of stubbier ones (two ears); on a mesh without a mirror
+   plane, a pair of stubbier ones alike in size (a hand-made figure's arms).
 3. Rooting at the most central branch point (smallest largest distance to any end), then cutting every cycle (holes
    in the silhouette) where the two ways around it from the root meet. A path without branch points is rooted at
    its widest node, or at its thicker end when it is about equally wide throughout.
@@ -21,6 +22,7 @@ import numpy as np
 from .polyline import arc_lengths, length
 
 UNIFORM = 1.25  # a path whose widest node is at most this many times its median width is a column, not a body
+LOCAL_PAIR = 1.5  # spurs off one base whose reaches times widths differ by at most this factor are a pair
 ROUND_TIP = 0.7  # a spur ending in a blob at least this share of its base's width, outside the base's disc, is a part
 
 
@@ -97,7 +99,7 @@ def _walk(start, first, neighbours, keys, arrived):
 
 
 def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, mirror=None, blobs=None,
-                pair_prune=None):
+                pair_prune=None, local_pairs=False):
     """Drop leaf chains that stick out of the disc of the node they hang on by less than ``prune`` times their own
     width, or by less than ``min_reach``, but never by ``max_reach`` or more, until none does. ``chains`` are node
     lists; returns the surviving links.
@@ -113,9 +115,12 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
     is a branch kept off the same base stays too: a figure's two arms off its chest, each near the threshold, are
     kept or dropped together. With ``pair_prune`` as well, two spurs off one base that mirror each other and stick
     out by more than ``min_reach`` and ``pair_prune`` times their width both stay: a pair is a limb where a lone
-    bump of that size is not (a dog's two ears on its head; outline noise is not symmetric).
+    bump of that size is not (a dog's two ears on its head; outline noise is not symmetric). With ``pair_prune`` and
+    ``local_pairs`` instead (a mesh without a mirror plane), two such spurs off one base that stick out about as far
+    and are about as wide both stay (``_local_pairs``).
     """
     chains = [list(c) for c in chains]
+    dropped = []  # with local_pairs: (base, nodes from base to tip, reach beyond the base, width) of pairable spurs
     while True:
         degree = {}
         for chain in chains:
@@ -143,11 +148,13 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
                         paired.add(i)
                     if pairable or not spur:
                         leaves.append((i, base, outside))
+                    if pairable and local_pairs:
+                        dropped.append((base, ordered, beyond, width))
                     break
         if spurs and mirror is not None:
             spurs = _unmirrored(spurs, paired, leaves, points, radius, mirror)
         if not spurs:
-            return _links_of(chains)
+            return _links_of(chains + _local_pairs(dropped, {n for c in chains for n in c}, points))
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
         kept = [c for i, c in enumerate(chains) if i not in spurs]
         if not kept:
@@ -181,6 +188,33 @@ def _unmirrored(spurs, paired, leaves, points, radius, mirror):
         lying_on[i] = set(owners[np.linalg.norm(points[nodes] - image, axis=1) <= radius[nodes]].tolist()) - {i}
     return {i: spurs[i] for i, twins in lying_on.items() if not any(
         chain not in spurs or (i in paired and i in lying_on[chain]) for chain in twins)}
+
+
+def _local_pairs(dropped, alive, points):
+    """The spurs among ``dropped`` ((base, nodes from base to tip, reach, width) each, pruned although long enough
+    to be a limb in a pair) that come in pairs off a base still ``alive``: reaches
+    and widths within ``LOCAL_PAIR`` of each other, tips farther apart than either is wide. A hand-made figure's two
+    stubby arms or ears are never exact mirror images, while outline noise does not come in such pairs."""
+    by_base = {}
+    for spur in dropped:
+        if spur[0] in alive:
+            by_base.setdefault(spur[0], []).append(spur)
+    restored = []
+    for spurs in by_base.values():
+        pairs = []
+        for a in range(len(spurs)):
+            for b in range(a):
+                (_, nodes_a, reach_a, width_a), (_, nodes_b, reach_b, width_b) = spurs[a], spurs[b]
+                unlike = max(reach_a / reach_b, reach_b / reach_a) * max(width_a / width_b, width_b / width_a)
+                apart = np.linalg.norm(points[nodes_a[-1]] - points[nodes_b[-1]])
+                if unlike <= LOCAL_PAIR and apart > max(width_a, width_b):
+                    pairs.append((unlike, a, b))
+        used = set()
+        for _, a, b in sorted(pairs):
+            if a not in used and b not in used:
+                used |= {a, b}
+                restored += [list(spurs[a][1]), list(spurs[b][1])]
+    return restored
 
 
 def _links_of(chains):
