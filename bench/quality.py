@@ -33,6 +33,7 @@ TARGETS = {"mean_cd_j2j": 0.045, "stretch_cd_j2j": 0.040, "mean_cd_b2b": 0.028, 
 METHOD_COLOURS = {"rigger": "tab:red", "skeletor": "tab:green", "stick": "tab:blue"}
 DETAIL_SETTINGS = ({}, {"min_branch": 1.0}, {"min_branch": 1.5}, {"max_chain_bones": 4}, {"bone_length": 0.13},
                    {"prune": 1.0})  # Rigger's parameters that set how many bones it makes, changed one at a time
+MUCH_LONGER = 1.5  # Rigger's bones this many times as long in total as the artist's cover parts the artist left out
 
 
 def principal_stick(vertices, triangles):
@@ -235,13 +236,10 @@ def detail_sweep(truths, params, timeout, as_run):
 def detail_lines(rows):
     """The markdown section for ``detail_sweep``'s rows."""
     low, high = TARGETS["joint_ratio"]
-
-    def listed(ratios):
-        return ", ".join(f"{name} {ratio:.2f}×" for name, ratio in sorted(ratios.items(), key=lambda kv: -kv[1]))
-
     table = [[row["setting"], "—" if row["cd_j2j"] is None else f"{row['cd_j2j']:.4f}",
               "—" if row["ratio_range"] is None else "{:.2f}–{:.2f}×".format(*row["ratio_range"]),
-              str(len(row["over"]) + len(row["under"])), listed(row["over"]) or "—", listed(row["under"]) or "—"]
+              str(len(row["over"]) + len(row["under"])), ratios_listed(row["over"]) or "—",
+              ratios_listed(row["under"]) or "—"]
              for row in rows]
     in_range = [row["setting"] for row in rows if row["ratio_range"] and not row["over"] and not row["under"]]
     verdict = (f"Settings with every model within {low}–{high}×: {', '.join(in_range)}." if in_range else
@@ -256,21 +254,25 @@ def detail_lines(rows):
         table)
 
 
+def ratios_listed(ratios):
+    """``{model: ratio}`` as text, the largest ratio first."""
+    return ", ".join(f"{name} {ratio:.2f}×" for name, ratio in sorted(ratios.items(), key=lambda kv: -kv[1]))
+
+
 def density_lines(truths, records):
     """Two measurements behind the joint-count verdict: how many joints the artists place per unit of their own
-    bone length, against the width of the target window, and on which models Rigger's bones are much longer in
-    total than the artist's (parts the artist left without bones)."""
+    bone length, against the width of the target window, and on which models Rigger's bones are more than
+    ``MUCH_LONGER`` times as long in total as the artist's (more of the mesh has bones)."""
     low, high = TARGETS["joint_ratio"]
     density = {t.name: len(t.joints) / t.bones.total_length() for t in truths}
     sparse, dense = min(density, key=density.get), max(density, key=density.get)
-    longer = {r["model"]: r["length_ratio"] for r in records if succeeded(r) and r["length_ratio"] > high}
+    longer = {r["model"]: r["length_ratio"] for r in records if succeeded(r) and r["length_ratio"] > MUCH_LONGER}
     lines = [f"The artists place {density[sparse]:.1f} ({sparse}) to {density[dense]:.1f} ({dense}) joints per "
              f"unit of their own bone length: a factor {density[dense] / density[sparse]:.2f}, where the "
              f"{low}–{high}× window is a factor {high / low:.2f} wide."]
     if longer:
-        listed = ", ".join(f"{name} {ratio:.2f}×" for name, ratio in sorted(longer.items(), key=lambda kv: -kv[1]))
-        lines.append(f"Rigger's bones add up to more than {high}× the artist's length on {listed}: parts the artist "
-                     f"left without bones.")
+        lines.append(f"Rigger's bones add up to more than {MUCH_LONGER}× the artist's length on "
+                     f"{ratios_listed(longer)}: more of the mesh has bones than in the artist's rig.")
     return ["", " ".join(lines)]
 
 

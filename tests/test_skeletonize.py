@@ -129,10 +129,24 @@ def test_without_a_mirror_plane_two_stubby_branches_alike_in_size_stay_as_a_pair
     assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.8)) == [True, True]
     assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.8), rules=(("pair_prune", 0.74),)) == [False, False]
     assert kept(arm((1, 0.2), 0.9)) == [False]
-    assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.9, radius=0.15)) == [False, False]
-    assert kept(arm((1, 0.2), 1.3), arm((-1, 0.4), 0.78)) == [False, False]
+    assert kept(arm((1, 0.2), 0.8), arm((-1, 0.4), 0.48 / 0.36, radius=0.18)) == [False, False]  # reach alike
+    assert kept(arm((1, 0.2), 1.3), arm((-1, 0.4), 0.78)) == [False, False]  # width alike
+    assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.9, radius=0.3 / 1.3)) == [False, False]  # 1.3 x 1.3 > 1.5
     assert kept(arm((1, 0.2), 0.7), arm((-1, 0.4), 0.7)) == [False, False]
+    assert kept(arm((1, 0.2), 0.9), arm((1, 0.5), 0.9)) == [False, False]  # side by side: tips 0.33 apart
     assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.8), arm((0, 1), 0.85)).count(True) == 2
+
+
+def test_without_a_mirror_plane_the_two_corner_branches_at_a_limb_s_end_still_go():
+    """An arm ending at a hand node (radius 0.3) that forks into two alike corner branches, each sticking out 1.1
+    times its width: pruning them leaves the hand the arm's end, no base the tree runs through, so they go."""
+    points, radius, chains = chest_with_legs([(x, 0.0, 0.3) for x in np.linspace(1.2, 3.0, 7)])
+    hand = chains[-1][-1]
+    corners = np.array([(3.2, 0.2, 0.12), (3.4, 0.35, 0.2), (3.2, -0.2, 0.12), (3.4, -0.35, 0.2)])
+    points, radius = np.vstack([points, corners[:, :2]]), np.r_[radius, corners[:, 2]]
+    chains += [[hand, len(points) - 4, len(points) - 3], [hand, len(points) - 2, len(points) - 1]]
+    links = prune_spurs(points, radius, chains, 1.35, pair_prune=0.74, local_pairs=True)
+    assert hand in links and len(points) - 3 not in links and len(points) - 1 not in links
 
 
 def test_outline_noise_is_not_kept_for_lying_on_the_body_it_mirrors_onto():

@@ -234,8 +234,9 @@ def _to_world(stages, frame, factor, *points):
 def _pruned_tree(graph, merge, prunes, reaches, mirror=None, local_pairs=False):
     """Blob merging and spur pruning of a chordal axis, ``prunes`` and ``reaches`` being ``prune_spurs``' (prune,
     pair_prune) and (min_reach, max_reach), ``mirror`` its reflection and ``local_pairs`` whether pairs of spurs are
-    judged without one (the mesh has no mirror plane); its junctions are the blobs that keep a spur ending in one. Returns (graph, alive nodes, merged links, kept links): with ``mirror``, the graph whose blobs near
-    the mirror line are centred on it (``AxisGraph.centred_on_mirror``), the stages show and the bones follow."""
+    judged without one (the mesh has no mirror plane); its junctions are the blobs that keep a spur ending in one.
+    Returns (graph, alive nodes, merged links, kept links): with ``mirror``, the graph whose blobs near the mirror
+    line are centred on it (``AxisGraph.centred_on_mirror``), the stages show and the bones follow."""
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
     alive = np.unique(representative)
     if mirror is not None:

@@ -22,7 +22,7 @@ import numpy as np
 from .polyline import arc_lengths, length
 
 UNIFORM = 1.25  # a path whose widest node is at most this many times its median width is a column, not a body
-LOCAL_PAIR = 1.5  # spurs off one base whose reaches times widths differ by at most this factor are a pair
+LOCAL_PAIR = 1.5  # spurs off one base are a pair when (ratio of their reaches) x (ratio of their widths) <= this
 ROUND_TIP = 0.7  # a spur ending in a blob at least this share of its base's width, outside the base's disc, is a part
 
 
@@ -120,15 +120,16 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
     and are about as wide both stay (``_local_pairs``).
     """
     chains = [list(c) for c in chains]
-    dropped = []  # with local_pairs: (base, nodes from base to tip, reach beyond the base, width) of pairable spurs
+    dropped = []  # with local_pairs, the pairable spurs removed so far (``pairable`` entries below)
     while True:
         degree = {}
         for chain in chains:
             for end in (chain[0], chain[-1]):
                 degree[end] = degree.get(end, 0) + 1
-        # chain -> (base, tip) of the spurs; those that may pair; (chain, base, its nodes outside the base's disc) of
-        # the kept leaves and the spurs that may pair
-        spurs, paired, leaves = {}, set(), []
+        # chain -> (base, tip) of the spurs; chain -> (base, nodes from base to tip, reach beyond the base, width) of
+        # those that may pair; (chain, base, its nodes outside the base's disc) of the kept leaves and those that may
+        # pair
+        spurs, pairable, leaves = {}, {}, []
         for i, chain in enumerate(chains):
             for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
                 if degree[tip] == 1 and degree[base] >= 3:
@@ -141,20 +142,20 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
                     bump = beyond <= prune * width and not (  # the round-part test only where it can matter
                         blobs is not None and _round_part(apart, radius, blobs, base, tip))
                     spur = beyond < max_reach and (beyond <= min_reach or bump)
-                    pairable = spur and pair_prune is not None and beyond > max(min_reach, pair_prune * width)
+                    may_pair = spur and pair_prune is not None and beyond > max(min_reach, pair_prune * width)
                     if spur:
                         spurs[i] = base, tip
-                    if pairable:
-                        paired.add(i)
-                    if pairable or not spur:
+                    if may_pair:
+                        pairable[i] = base, ordered, beyond, width
+                    if may_pair or not spur:
                         leaves.append((i, base, outside))
-                    if pairable and local_pairs:
-                        dropped.append((base, ordered, beyond, width))
                     break
         if spurs and mirror is not None:
-            spurs = _unmirrored(spurs, paired, leaves, points, radius, mirror)
+            spurs = _unmirrored(spurs, pairable, leaves, points, radius, mirror)
         if not spurs:
-            return _links_of(chains + _local_pairs(dropped, {n for c in chains for n in c}, points))
+            return _links_of(chains + _local_pairs(dropped, _links_of(chains), points))
+        if local_pairs:
+            dropped += [pairable[i] for i in spurs if i in pairable]
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
         kept = [c for i, c in enumerate(chains) if i not in spurs]
         if not kept:
@@ -190,14 +191,17 @@ def _unmirrored(spurs, paired, leaves, points, radius, mirror):
         chain not in spurs or (i in paired and i in lying_on[chain]) for chain in twins)}
 
 
-def _local_pairs(dropped, alive, points):
-    """The spurs among ``dropped`` ((base, nodes from base to tip, reach, width) each, pruned although long enough
-    to be a limb in a pair) that come in pairs off a base still ``alive``: reaches
-    and widths within ``LOCAL_PAIR`` of each other, tips farther apart than either is wide. A hand-made figure's two
-    stubby arms or ears are never exact mirror images, while outline noise does not come in such pairs."""
+def _local_pairs(dropped, links, points):
+    """Node lists of the spurs among ``dropped`` ((base, nodes from base to tip, reach, width) each, pruned although
+    they stick out enough to be limbs in a pair) that pair up off a base the kept tree (``links``) still runs through
+    (two links at least: not the end a limb's two corner branches forked from): the ratio of their reaches times the
+    ratio of their widths at most ``LOCAL_PAIR``, their tips farther apart than either is wide, the most alike paired
+    first. A hand-made figure's two stubby arms or ears are never exact mirror images, while outline noise does not
+    come in such pairs."""
+    degree = np.bincount(links.ravel(), minlength=len(points))
     by_base = {}
     for spur in dropped:
-        if spur[0] in alive:
+        if degree[spur[0]] >= 2:
             by_base.setdefault(spur[0], []).append(spur)
     restored = []
     for spurs in by_base.values():
