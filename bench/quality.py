@@ -1,7 +1,7 @@
 """Quality benchmark: skeletons from each method scored against the artist rigs in ../shared/models/gt.
 
-Runs the single-stick and skeletor baselines, and Rigger's own method whenever ``rigger.rig_mesh`` is importable;
-scores in the RigNet convention (bench/rigdata.py) and writes bench/results/quality.md, quality.json and PNG plots.
+Runs the single-stick and skeletor baselines and Rigger's own method, scores them in the RigNet convention
+(bench/rigdata.py) and writes bench/results/quality.md, quality.json and PNG plots.
 Rigger's method is then run again with each of ``DETAIL_SETTINGS`` (the parameters that set how many bones it
 makes) to show how the joint counts move against the artists'.
 
@@ -33,7 +33,7 @@ TARGETS = {"mean_cd_j2j": 0.045, "stretch_cd_j2j": 0.040, "mean_cd_b2b": 0.028, 
 METHOD_COLOURS = {"rigger": "tab:red", "skeletor": "tab:green", "stick": "tab:blue"}
 DETAIL_SETTINGS = ({}, {"min_branch": 1.0}, {"min_branch": 1.5}, {"max_chain_bones": 4}, {"bone_length": 0.13},
                    {"prune": 1.0})  # Rigger's parameters that set how many bones it makes, changed one at a time
-MUCH_LONGER = 1.5  # Rigger's bones this many times as long in total as the artist's cover parts the artist left out
+MUCH_LONGER = 1.5  # Rigger's bones this many times as long in total as the artist's: more of the mesh has bones
 
 
 def principal_stick(vertices, triangles):
@@ -136,7 +136,8 @@ def run_limited(function, seconds, *args, **kwargs):
 
 
 class GroundTruth:
-    """One model's mesh and artist rig, both in the normalised frame, with the rig's joints and bone samples."""
+    """One model's mesh and artist rig, both in the normalised frame, with the rig's joints, bone samples and total
+    bone length."""
 
     def __init__(self, folder):
         self.name = folder.name
@@ -148,6 +149,7 @@ class GroundTruth:
             raise ValueError("the rig has no bones")
         self.joints = self.bones.joints()  # the same joint-set rule as for predictions: RigNet's root_dup_* collapse
         self.samples = self.bones.samples()
+        self.length = self.bones.total_length()
         self.inside = rigdata.inside_fraction(self.samples, self.unit_vertices, self.triangles)
 
 
@@ -166,7 +168,7 @@ def evaluate(truth, method, params, timeout, inside=True):
         record.update(rigdata.skeleton_distances(joints, samples, truth.joints, truth.samples))
         record["joints"] = len(joints)
         record["joint_ratio"] = len(joints) / len(truth.joints)
-        record["length_ratio"] = unit_bones.total_length() / truth.bones.total_length()
+        record["length_ratio"] = unit_bones.total_length() / truth.length
         if inside:
             record["inside"] = rigdata.inside_fraction(samples, truth.unit_vertices, truth.triangles)
         record["unit_bones"] = unit_bones
@@ -264,7 +266,7 @@ def density_lines(truths, records):
     bone length, against the width of the target window, and on which models Rigger's bones are more than
     ``MUCH_LONGER`` times as long in total as the artist's (more of the mesh has bones)."""
     low, high = TARGETS["joint_ratio"]
-    density = {t.name: len(t.joints) / t.bones.total_length() for t in truths}
+    density = {t.name: len(t.joints) / t.length for t in truths}
     sparse, dense = min(density, key=density.get), max(density, key=density.get)
     longer = {r["model"]: r["length_ratio"] for r in records if succeeded(r) and r["length_ratio"] > MUCH_LONGER}
     lines = [f"The artists place {density[sparse]:.1f} ({sparse}) to {density[dense]:.1f} ({dense}) joints per "

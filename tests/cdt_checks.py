@@ -279,9 +279,10 @@ def _chain_along(a, b, adjacent, v, pairs):
         if path[-1] == b:
             return path
         here = key(v[path[-1]])
-        ahead = [w for w in adjacent.get(path[-1], ()) if here < key(v[w]) <= end
+        along = {w: key(v[w]) for w in adjacent.get(path[-1], ())}
+        ahead = [w for w, at in along.items() if here < at <= end
                  and (orient(pairs[a], pairs[b], pairs[w]) == 0 or _near_line(v[w], v[a], v[b]))]
-        paths += [path + [w] for w in sorted(ahead, key=lambda w: -key(v[w]))]
+        paths += [path + [w] for w in sorted(ahead, key=lambda w: -along[w])]
     return None
 
 
@@ -332,9 +333,9 @@ def check_convex_hull(tri):
     for start, end in zip(hull, np.roll(hull, -1)):
         a, b = tri.vertices[start], tri.vertices[end]
         key = _direction_key(a, b)
-        on_edge = live[orient_signs(a, b, tri.vertices[live]) == 0]
-        on_edge = sorted((w for w in on_edge.tolist() if key(a) <= key(tri.vertices[w]) <= key(b)),
-                         key=lambda w: key(tri.vertices[w]))
+        end = key(b)  # key(a) is 0
+        along = {w: key(tri.vertices[w]) for w in live[orient_signs(a, b, tri.vertices[live]) == 0].tolist()}
+        on_edge = sorted((w for w, at in along.items() if 0 <= at <= end), key=along.get)
         expected.update(zip(on_edge[:-1], on_edge[1:]))
     twin_t, _ = edge_twins(tri.triangles)
     t, k = np.nonzero(twin_t < 0)

@@ -229,43 +229,46 @@ def deer():
     return quality.GroundTruth(shared_path("models", "gt", "rignet_2982"))
 
 
+@pytest.fixture(scope="module")
+def deer_rigged(deer):
+    """Rigger's scored record on the deer, with its default settings."""
+    return quality.evaluate(deer, "rigger", {}, timeout=60)
+
+
 def test_real_model_loads_and_scores_in_the_rignet_convention(deer):
-    truth = deer
-    assert truth.vertices.shape == (935, 3) and truth.triangles.shape == (1866, 3)
-    assert len(truth.rig.names) == 27 and (truth.rig.parents < 0).sum() == 1
-    assert len(truth.joints) == 25  # RigNet's root_dup_* joints repeat the root's position: one joint each place
-    assert np.ptp(truth.unit_vertices, axis=0).max() == pytest.approx(1.0)
-    assert truth.inside == 1.0  # the artist's bones lie inside this watertight mesh
-    record = quality.evaluate(truth, "stick", {}, timeout=60)
+    assert deer.vertices.shape == (935, 3) and deer.triangles.shape == (1866, 3)
+    assert len(deer.rig.names) == 27 and (deer.rig.parents < 0).sum() == 1
+    assert len(deer.joints) == 25  # RigNet's root_dup_* joints repeat the root's position: one joint each place
+    assert np.ptp(deer.unit_vertices, axis=0).max() == pytest.approx(1.0)
+    assert deer.inside == 1.0  # the artist's bones lie inside this watertight mesh
+    record = quality.evaluate(deer, "stick", {}, timeout=60)
     assert 0.1 < record["cd_j2j"] < 0.2 and record["joints"] == 3 and record["tree_problem"] is None
 
 
-def test_detail_sweep_reports_each_setting_and_the_models_out_of_range(monkeypatch, deer):
+def test_detail_sweep_reports_each_setting_and_the_models_out_of_range(monkeypatch, deer, deer_rigged):
     """Fewer bones at ``min_branch`` 3 on the antlered deer; every setting gets a row and a table line."""
-    truth = deer
     monkeypatch.setattr(quality, "DETAIL_SETTINGS", ({}, {"min_branch": 3.0}))
-    as_run = [quality.evaluate(truth, "rigger", {}, timeout=60)]
-    rows = quality.detail_sweep([truth], {}, 60, as_run)
+    rows = quality.detail_sweep([deer], {}, 60, [deer_rigged])
     assert [row["setting"] for row in rows] == ["defaults", "min_branch=3.0"]
     (low, high), (sparse_low, sparse_high) = (row["ratio_range"] for row in rows)
     assert low == high and sparse_low == sparse_high and sparse_high < high
     for row in rows:
-        assert set(row["over"]) | set(row["under"]) <= {truth.name} and row["failed"] == 0
-        assert (truth.name in row["over"]) == (row["ratio_range"][1] > quality.TARGETS["joint_ratio"][1])
+        assert set(row["over"]) | set(row["under"]) <= {deer.name} and row["failed"] == 0
+        assert (deer.name in row["over"]) == (row["ratio_range"][1] > quality.TARGETS["joint_ratio"][1])
     table = quality.detail_lines(rows)[-2:]
     assert table[0].startswith("| defaults |") and table[1].startswith("| min_branch=3.0 |")
 
 
-def test_density_lines_measure_the_artists_joint_spacing_and_rigger_s_extra_parts(deer):
+def test_density_lines_measure_the_artists_joint_spacing_and_rigger_s_extra_parts(deer, deer_rigged):
     """The deer's joints over its bones against a 3-joint stick 2 long; only the stick's rig is 2× longer."""
     stick = rigdata.Bones(np.array([[0.0, 0, 0], [1, 0, 0]]), np.array([[1.0, 0, 0], [2, 0, 0]]), np.array([-1, 0]))
     assert stick.total_length() == 2.0
-    sparse = SimpleNamespace(name="stick", joints=stick.joints(), bones=stick)
+    sparse = SimpleNamespace(name="stick", joints=stick.joints(), length=stick.total_length())
     records = [{"model": "stick", "length_ratio": 2.0},
-               {"model": deer.name, "length_ratio": quality.evaluate(deer, "rigger", {}, 60)["length_ratio"]}]
+               {"model": deer.name, "length_ratio": deer_rigged["length_ratio"]}]
     assert 1.0 < records[1]["length_ratio"] < quality.MUCH_LONGER  # Rigger boned the antlers; the artist did not
     text = quality.density_lines([sparse, deer], records)[-1]
-    dense = len(deer.joints) / deer.bones.total_length()
+    dense = len(deer.joints) / deer.length
     assert text.startswith(f"The artists place 1.5 (stick) to {dense:.1f} ({deer.name}) ")
     assert f"a factor {dense / 1.5:.2f}, where the 0.7–1.5× window is a factor 2.14 wide." in text
     assert text.endswith("length on stick 2.00×: more of the mesh has bones than in the artist's rig.")

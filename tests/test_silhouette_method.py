@@ -407,9 +407,8 @@ def test_stubby_arms_of_a_figure_without_a_mirror_plane_get_bones(model, hands):
     skeleton = rigger.rig_mesh(vertices, triangles)
     assert skeleton.stages["mirror_plane"] is None
     low, extent = vertices.min(axis=0), np.ptp(vertices, axis=0)
-    leaf = np.ones(len(skeleton.parents), bool)
-    leaf[skeleton.parents[skeleton.parents >= 0]] = False
-    tips = (skeleton.tails[leaf, :2] - low[:2]) / extent[:2]
+    leaf_tails = skeleton.tails[[i for i in range(len(skeleton)) if not skeleton.children(i)]]
+    tips = (leaf_tails[:, :2] - low[:2]) / extent[:2]
     for hand in hands:
         assert np.linalg.norm(tips - hand, axis=1).min() < 0.05, f"no bone ends at the hand at {hand}"
 

@@ -5,6 +5,7 @@ import pytest
 
 from meshes import box, combine
 from rigger import silhouette
+from rigger.core.arrays import column_bounds
 from rigger.skeletonize import depth
 from rigger.skeletonize.chordal import AxisGraph
 from rigger.skeletonize.bones import (bone_names, chain_joints, mirror_chain_pairs, mirror_completed, mirror_plane,
@@ -68,6 +69,21 @@ def chest_with_legs(*branches, legs=(-0.5, 0.5)):
     return nodes[:, :2], nodes[:, 2], chains
 
 
+def tips_kept(*branches, prune=1.35, legs=(-0.5, 0.5), **rules):
+    """Whether each of the ``branches`` off ``chest_with_legs``' chest keeps its tip after ``prune_spurs``."""
+    points, radius, chains = chest_with_legs(*branches, legs=legs)
+    links = prune_spurs(points, radius, chains, prune, **rules)
+    return [chain[-1] in links for chain in chains[-len(branches):]]
+
+
+def stub(direction, ratio, radius=0.3, y=0.0):
+    """Five nodes of a branch of half-width ``radius`` leaving the chest's disc (radius 1) along ``direction``
+    (raised by ``y``), sticking out ``ratio`` times its width beyond it."""
+    direction = np.array(direction) / np.linalg.norm(direction)
+    reach = np.linspace(1.02, 1 - radius + 2 * radius * ratio, 5)
+    return [(direction[0] * x, direction[1] * x + y, radius) for x in reach]
+
+
 def test_a_spur_whose_mirror_image_is_kept_stays():
     """A figure's two arms off its chest, mirror images across x = 0 but for the left one reaching a little less:
     at prune 1.35 the right arm (sticking out 1.4 times its width) is kept and the left (1.3) would go. With the
@@ -75,66 +91,50 @@ def test_a_spur_whose_mirror_image_is_kept_stays():
     go once neither is long enough, and at prune 0.8 all three stay."""
     def arm(side, ratio):  # half-width 0.5 off a chest disc of radius 1: sticks out 0.5 + reach beyond it
         return [(side * x, 0.0, 0.5) for x in np.linspace(1.5, 0.5 + ratio, 6)]
-    bump = [(0.0, 1.3, 0.8), (0.0, 1.6, 0.8)]  # sticks out 1.4, 1.6 wide
-    points, radius, chains = chest_with_legs(arm(1, 1.4), arm(-1, 1.3), bump)
-
-    def tips(links):  # of the right arm, the left arm and the bump
-        return [chain[-1] in links for chain in chains[2:]]
-
-    assert tips(prune_spurs(points, radius, chains, 1.35)) == [True, False, False]
-    assert tips(prune_spurs(points, radius, chains, 1.35, mirror=reflect)) == [True, True, False]
-    assert tips(prune_spurs(points, radius, chains, 1.45, mirror=reflect)) == [False, False, False]
-    assert tips(prune_spurs(points, radius, chains, 0.8, mirror=reflect)) == [True, True, True]
+    parts = (arm(1, 1.4), arm(-1, 1.3), [(0.0, 1.3, 0.8), (0.0, 1.6, 0.8)])  # the bump sticks out 1.4, 1.6 wide
+    assert tips_kept(*parts) == [True, False, False]
+    assert tips_kept(*parts, mirror=reflect) == [True, True, False]
+    assert tips_kept(*parts, prune=1.45, mirror=reflect) == [False, False, False]
+    assert tips_kept(*parts, prune=0.8, mirror=reflect) == [True, True, True]
 
 
 def test_a_mirror_pair_of_stubby_branches_stays_where_a_lone_one_goes():
     """Two ears off a head (a chest disc of radius 1), each sticking out 0.9 times its width: under prune (1.35),
     over pair_prune (0.74). With the reflection the pair stays; a lone ear, a pair under pair_prune, or either rule
     missing, and they go."""
-    def ear(side, ratio, y=0.0):  # radius 0.3 off the chest's disc: sticks out ratio times its width 0.6
-        return [(side * x, y, 0.3) for x in np.linspace(1.02, 0.7 + 0.6 * ratio, 5)]
-
-    def kept(right, left, legs=(-0.5, 0.5), **rules):  # whether each ear's tip (the last node of its part) stays
-        points, radius, chains = chest_with_legs(right, left, legs=legs)
-        links = prune_spurs(points, radius, chains, 1.35, **rules)
-        return [chain[-1] in links for chain in chains[-2:]]
+    def ear(side, ratio, y=0.0):
+        return stub((side, 0.0), ratio, y=y)
 
     pair = {"mirror": reflect, "pair_prune": 0.74}
-    assert kept(ear(1, 0.9), ear(-1, 0.9), **pair) == [True, True]
-    assert kept(ear(1, 0.9), [(-0.3, 1.05, 0.1)], **pair) == [False, False]  # a lone ear (and a speck)
-    assert kept(ear(1, 0.9), ear(-1, 0.9), mirror=reflect) == [False, False]
-    assert kept(ear(1, 0.9), ear(-1, 0.9), pair_prune=0.74) == [False, False]
-    assert kept(ear(1, 0.9), ear(-1, 0.9, y=0.8), **pair) == [False, False]  # not each other's image
-    assert kept(ear(1, 0.9), ear(-1, 0.6), **pair) == [False, False]
-    assert kept(ear(1, 0.7), ear(-1, 0.7), **pair) == [False, False]
+    assert tips_kept(ear(1, 0.9), ear(-1, 0.9), **pair) == [True, True]
+    assert tips_kept(ear(1, 0.9), [(-0.3, 1.05, 0.1)], **pair) == [False, False]  # a lone ear (and a speck)
+    assert tips_kept(ear(1, 0.9), ear(-1, 0.9), mirror=reflect) == [False, False]
+    assert tips_kept(ear(1, 0.9), ear(-1, 0.9), pair_prune=0.74) == [False, False]
+    assert tips_kept(ear(1, 0.9), ear(-1, 0.9, y=0.8), **pair) == [False, False]  # not each other's image
+    assert tips_kept(ear(1, 0.9), ear(-1, 0.6), **pair) == [False, False]
+    assert tips_kept(ear(1, 0.7), ear(-1, 0.7), **pair) == [False, False]
     # a short ear's image lies on a long one but not the other way round: neither is the other's twin, so both go,
     # also off a head with one neck, where dropping the long one alone would leave the short one part of the neck
     for legs in ((-0.5, 0.5), (0.0,)):
-        assert kept(ear(1, 1.34), ear(-1, 0.8), legs=legs, **pair) == [False, False]
+        assert tips_kept(ear(1, 1.34), ear(-1, 0.8), legs=legs, **pair) == [False, False]
 
 
 def test_without_a_mirror_plane_two_stubby_branches_alike_in_size_stay_as_a_pair():
     """A hand-made figure's two stubby arms off its chest (radius 1) are never exact mirror images: with
     ``local_pairs`` two spurs over pair_prune (0.74) that stick out about as far and are about as wide both stay,
     wherever they point; a lone one, a pair unlike in width or reach, or one under pair_prune goes."""
-    def arm(direction, ratio, radius=0.3):  # sticks out ratio times its width off the chest's disc
-        direction = np.array(direction) / np.linalg.norm(direction)
-        return [(*(direction * x), radius) for x in np.linspace(1.02, 1 - radius + 2 * radius * ratio, 5)]
+    def kept(*arms, local_pairs=True):  # whether each arm's tip stays
+        return tips_kept(*arms, pair_prune=0.74, local_pairs=local_pairs)
 
-    def kept(*arms, rules=(("pair_prune", 0.74), ("local_pairs", True))):  # whether each arm's tip stays
-        points, radius, chains = chest_with_legs(*arms)
-        links = prune_spurs(points, radius, chains, 1.35, **dict(rules))
-        return [chain[-1] in links for chain in chains[-len(arms):]]
-
-    assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.8)) == [True, True]
-    assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.8), rules=(("pair_prune", 0.74),)) == [False, False]
-    assert kept(arm((1, 0.2), 0.9)) == [False]
-    assert kept(arm((1, 0.2), 0.8), arm((-1, 0.4), 0.48 / 0.36, radius=0.18)) == [False, False]  # reach alike
-    assert kept(arm((1, 0.2), 1.3), arm((-1, 0.4), 0.78)) == [False, False]  # width alike
-    assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.9, radius=0.3 / 1.3)) == [False, False]  # 1.3 x 1.3 > 1.5
-    assert kept(arm((1, 0.2), 0.7), arm((-1, 0.4), 0.7)) == [False, False]
-    assert kept(arm((1, 0.2), 0.9), arm((1, 0.5), 0.9)) == [False, False]  # side by side: tips 0.33 apart
-    assert kept(arm((1, 0.2), 0.9), arm((-1, 0.4), 0.8), arm((0, 1), 0.85)).count(True) == 2
+    assert kept(stub((1, 0.2), 0.9), stub((-1, 0.4), 0.8)) == [True, True]
+    assert kept(stub((1, 0.2), 0.9), stub((-1, 0.4), 0.8), local_pairs=False) == [False, False]
+    assert kept(stub((1, 0.2), 0.9)) == [False]
+    assert kept(stub((1, 0.2), 0.8), stub((-1, 0.4), 0.48 / 0.36, radius=0.18)) == [False, False]  # reach alike
+    assert kept(stub((1, 0.2), 1.3), stub((-1, 0.4), 0.78)) == [False, False]  # width alike
+    assert kept(stub((1, 0.2), 0.9), stub((-1, 0.4), 0.9, radius=0.3 / 1.3)) == [False, False]  # 1.3 x 1.3 > 1.5
+    assert kept(stub((1, 0.2), 0.7), stub((-1, 0.4), 0.7)) == [False, False]
+    assert kept(stub((1, 0.2), 0.9), stub((1, 0.5), 0.9)) == [False, False]  # side by side: tips 0.33 apart
+    assert kept(stub((1, 0.2), 0.9), stub((-1, 0.4), 0.8), stub((0, 1), 0.85)).count(True) == 2
 
 
 def test_without_a_mirror_plane_the_two_corner_branches_at_a_limb_s_end_still_go():
@@ -499,9 +499,9 @@ def test_an_arm_whose_twin_reaches_into_the_hand_is_still_its_twin():
     into_hand = np.array([[-0.1, 1.0, 0.0], [-0.5, 1.0, 0.0], [-0.9, 1.0, 0.0], [-1.0, 1.1, 0.1]])
     raised = np.array([[-0.1, 1.0, 0.0], [-0.4, 1.4, 0.0], [-0.6, 1.8, 0.0]])
     spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
-    twins = ["trunk.00", "limb01.00.L", "limb01.01.L", "limb01.00.R", "limb01.01.R"]
+    paired = ["trunk.00", "limb01.00.L", "limb01.01.L", "limb01.00.R", "limb01.01.R"]
     for left, right in ((arm, into_hand), (into_hand * [-1, 1, 1], arm * [-1, 1, 1])):
-        assert bone_names([0, 1, 1, 2, 2], [0, 0, 1, 0, 1], [spine, left, right], (0, 0.0), 0.05) == twins
+        assert bone_names([0, 1, 1, 2, 2], [0, 0, 1, 0, 1], [spine, left, right], (0, 0.0), 0.05) == paired
     names = bone_names([0, 1, 1, 2, 2], [0, 0, 1, 0, 1], [spine, arm, raised], (0, 0.0), 0.05)
     assert names == ["trunk.00", "limb01.00.L", "limb01.01.L", "limb02.00.R", "limb02.01.R"]
 
@@ -547,7 +547,7 @@ def test_a_flat_mesh_is_not_mirrored_across_its_own_plane():
     def plane(outline):
         points = np.array([(x, y, 0.0) for x, y in outline], dtype=float)
         points = np.concatenate([points + [dx, dy, 0.0] for dx in (0, 0.01) for dy in (0, 0.01)])
-        return mirror_plane(points, np.array([points.min(axis=0), points.max(axis=0)]), 0.02)
+        return mirror_plane(points, column_bounds(points), 0.02)
 
     t_shape = [(x, 1.0) for x in np.linspace(-1, 1, 21)] + [(0.0, y) for y in np.linspace(-1, 1, 21)]
     l_shape = [(x, -1.0) for x in np.linspace(0, 1, 21)] + [(0.0, y) for y in np.linspace(-1, 1, 21)]

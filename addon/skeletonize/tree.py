@@ -153,7 +153,8 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
         if spurs and mirror is not None:
             spurs = _unmirrored(spurs, pairable, leaves, points, radius, mirror)
         if not spurs:
-            return _links_of(chains + _local_pairs(dropped, _links_of(chains), points))
+            links = _links_of(chains)
+            return np.vstack([links, _links_of(_local_pairs(dropped, links, points))]) if dropped else links
         if local_pairs:
             dropped += [pairable[i] for i in spurs if i in pairable]
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
@@ -169,10 +170,10 @@ def _round_part(apart, radius, blobs, base, tip):
     return bool(blobs[tip]) and radius[tip] >= ROUND_TIP * radius[base] and apart > radius[base]
 
 
-def _unmirrored(spurs, paired, leaves, points, radius, mirror):
+def _unmirrored(spurs, pairable, leaves, points, radius, mirror):
     """The ``spurs`` (chain -> (base, tip)) without a twin: another leaf off the same base (``leaves``: (chain,
     base, its nodes outside the base's disc) each) that stays, with a node whose disc holds the spur tip's mirror
-    image. A kept leaf is a twin to every spur. Two ``paired`` spurs (long enough for limbs when they come in pairs)
+    image. A kept leaf is a twin to every spur. Two ``pairable`` spurs (long enough for limbs when they come in pairs)
     are twins when each one's image lies on the other, so that two ears each under the threshold stay together,
     and neither stays for lying on a longer one that goes. The base's own disc covers the body, so a bump whose
     image falls on it still goes."""
@@ -188,7 +189,7 @@ def _unmirrored(spurs, paired, leaves, points, radius, mirror):
         nodes, owners = beside.get(base, (np.zeros(0, np.int64), np.zeros(0, np.int64)))
         lying_on[i] = set(owners[np.linalg.norm(points[nodes] - image, axis=1) <= radius[nodes]].tolist()) - {i}
     return {i: spurs[i] for i, twins in lying_on.items() if not any(
-        chain not in spurs or (i in paired and i in lying_on[chain]) for chain in twins)}
+        chain not in spurs or (i in pairable and i in lying_on[chain]) for chain in twins)}
 
 
 def _local_pairs(dropped, links, points):
