@@ -8,7 +8,8 @@ STAMP := $(VENV)/.installed
 BPY42_VENV := $(VENV)/bpy42
 BPY42_STAMP := $(BPY42_VENV)/.installed
 
-.PHONY: test build demo addon bpy42 bench bench-quality bench-silhouette bench-skinning bench-rig-time clean
+.PHONY: test build demo addon bpy42 bench bench-quality bench-silhouette bench-skinning bench-rig-time regress \
+	regress-baseline clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -52,6 +53,14 @@ bench-skinning: build
 
 bench-rig-time: build
 	$(PY) bench/rig_time.py
+
+# Skeletons and stages of every ../shared model and sample character under several settings, bit for bit:
+# regress-baseline fingerprints them (on the commit to compare against), regress compares with that baseline.
+regress: build
+	$(PY) tools/regress.py
+
+regress-baseline: build
+	$(PY) tools/regress.py --baseline
 
 clean:
 	rm -rf build dist out *.egg-info addon/*.so ext/cdt.c ext/silhouette_binding.c ext/skin_weights_binding.c
