@@ -8,7 +8,7 @@ import sys
 import tomllib
 
 from Cython.Build import cythonize
-from setuptools import Extension, setup
+from setuptools import Extension, find_packages, setup
 
 # One version for the package, the extension manifest and bl_info (tools/build_addon.py and tests/test_addon_zip.py
 # check that the last two agree). Read here, not through rigger.compat.manifest_version: while setup.py runs, addon/
@@ -37,7 +37,7 @@ setup(
     license="GPL-3.0-or-later",
     python_requires=">=3.11",
     package_dir={"rigger": "addon"},
-    packages=["rigger", "rigger.blender", "rigger.core", "rigger.methods", "rigger.skeletonize"],
+    packages=["rigger"] + [f"rigger.{package}" for package in find_packages("addon")],  # method packages too
     ext_modules=cythonize(
         EXTENSIONS,
         language_level=3,

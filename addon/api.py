@@ -27,30 +27,34 @@ def rig_mesh(vertices, triangles, method="silhouette", **params):
     Args:
         vertices: (N, 3) array-like of finite coordinates.
         triangles: (M, 3) array-like of vertex indices.
-        method: a method name from :func:`method_registry`, or a :class:`~rigger.core.registry.RigMethod`
-            subclass (e.g. one defined in a script).
+        method: a method name from :func:`method_registry`, a :class:`~rigger.core.registry.RigMethod` subclass
+            (e.g. one defined in a script) or an instance of one (e.g. with its tuning changed).
         **params: the method's parameters by name; values may be strings as typed on a command line.
 
     Raises ValueError for an unknown method (naming the available ones and any that failed to load), unknown or
-    out-of-range parameters, and bad meshes. The skeleton's ``stages`` gain ``"params"`` (the resolved values) and
-    ``stages["timings"]["total"]`` (seconds for this whole call).
+    out-of-range parameters, and bad meshes. The skeleton's ``params`` are the resolved values and its
+    ``timings["total"]`` the seconds for this whole call.
     """
     start = time.perf_counter()
-    method_class = _method_class(method)
-    values = resolve(method_class.params, params)
+    rigging = _method(method)
+    values = resolve(rigging.params, params)
     mesh = Mesh(vertices, triangles)
-    skeleton = method_class().rig(mesh, **values)
+    skeleton = rigging.rig(mesh, **values)
     if not isinstance(skeleton, Skeleton):
-        raise TypeError(f"method {method_class.name!r} returned {type(skeleton).__name__}, not a Skeleton")
-    skeleton.stages["params"] = values
-    skeleton.stages.setdefault("timings", {})["total"] = time.perf_counter() - start
+        raise TypeError(f"method {rigging.name!r} returned {type(skeleton).__name__}, not a Skeleton")
+    skeleton.params = values
+    skeleton.timings["total"] = time.perf_counter() - start
     return skeleton
 
 
-def _method_class(method):
+def _method(method):
+    """An instance of the method ``method`` names or is."""
     if isinstance(method, str):
-        return method_registry().lookup(method)
+        return method_registry().lookup(method)()
     if isinstance(method, type) and issubclass(method, RigMethod):
         check_method(method)
+        return method()
+    if isinstance(method, RigMethod):
+        check_method(type(method))
         return method
-    raise ValueError(f"method must be a method name or a RigMethod subclass, got {method!r}")
+    raise ValueError(f"method must be a method name, a RigMethod subclass or an instance of one, got {method!r}")

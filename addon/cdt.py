@@ -14,6 +14,7 @@ Example::
     square = [(0, 0), (1, 0), (1, 1), (0, 1)]
     tri = cdt.triangulate(square, [(0, 1), (1, 2), (2, 3), (3, 0)])
     tri.triangles        # (2, 3) int32, counter-clockwise
+    cdt.orient2d((0, 0), (1, 0), (0, 1))   # 1: the exact predicates it decides with
 """
 from dataclasses import dataclass
 
@@ -89,6 +90,18 @@ def triangulate(points, segments=None, *, mode="inside", holes=None):
                          "convex hull of the points")
     raw = _rigger_cdt.triangulate(pts, segs, mode == "inside", seeds)
     return Triangulation(**raw)
+
+
+def orient2d(a, b, c):
+    """Exact sign of the orientation of points ``a``, ``b``, ``c`` (pairs of floats): +1 counter-clockwise, -1
+    clockwise, 0 collinear; the predicate the triangulation decides with."""
+    return _rigger_cdt.orient2d(*map(float, a), *map(float, b), *map(float, c))
+
+
+def incircle(a, b, c, d):
+    """Exact sign of point ``d`` against the circle through counter-clockwise ``a``, ``b``, ``c``: +1 inside, -1
+    outside, 0 on it; the predicate the triangulation decides with."""
+    return _rigger_cdt.incircle(*map(float, a), *map(float, b), *map(float, c), *map(float, d))
 
 
 def _as_segments(values, n_points):

@@ -61,6 +61,8 @@ def _parser():
     batch.set_defaults(run=_run_batch)
 
     methods = commands.add_parser("methods", help="list the rigging methods and their parameters")
+    methods.add_argument("--tuning", action="store_true",
+                         help="also list each method's tuned numbers: value, reason, and where they are declared")
     methods.set_defaults(run=_run_methods)
     return parser
 
@@ -91,6 +93,10 @@ def _run_methods(args):
         for param in method.params:
             choices = f" {{{', '.join(param.items)}}}" if param.items else ""
             print(f"  --set {param.name}=VALUE  ({param.type}{choices}, default {param.default}) {param.description}")
+        if args.tuning and method.tuning_type is not None:
+            print(f"  tuning ({method.tuning_type.__module__}.{method.tuning_type.__name__}):")
+            for field, value, why, owner in method.tuning_type.rows():
+                print(f"    {field} = {value!r}  {why}  [{owner.__module__}.{owner.__name__}]")
     for where, error in registry.failures.items():
         print(f"failed to load {where}: {error}", file=sys.stderr)
     return 0

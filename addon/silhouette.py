@@ -115,6 +115,8 @@ class Silhouette:
         another direction, has found (finding them now if it has not): the parts belong to the mesh, not the view
         (welded where ``other`` sees vertices at exactly one place), so the views of one mesh weld and join it
         once. ValueError if ``other`` traced other triangles or another number of vertices."""
+        if not isinstance(other, Silhouette):
+            raise TypeError(f"share_parts needs another Silhouette of the same mesh, got {type(other).__name__}")
         self._trace.share_components(other._trace)
 
     def lift(self, points, depth):

@@ -109,9 +109,9 @@ def segment_distances(point, starts, ends):
 
 
 def rigger_silhouette(vertices, triangles, **params):
-    """Rigger's own method; its per-stage timings come from ``stages["timings"]``."""
+    """Rigger's own method; its per-step timings come from ``Skeleton.timings``."""
     skeleton = rigger.rig_mesh(vertices, triangles.astype(np.int32), method="silhouette", **params)
-    return rigdata.Bones.of(skeleton), dict(skeleton.stages.get("timings", {}))
+    return rigdata.Bones.of(skeleton), dict(skeleton.timings)
 
 
 METHODS = {"stick": principal_stick, "skeletor": skeletor_wavefront, "rigger": rigger_silhouette}

@@ -10,7 +10,7 @@ neighbouring rungs of each character. Every real model in ../shared/models/gt an
 with a note, when absent).
 
 Each mesh is rigged several times (fewer when large); the median wall-clock and CPU time of the whole call and the
-median of every stage in ``skeleton.stages["timings"]`` are reported. The character meshes nearest 1e6 and 1e4
+median of every step in ``skeleton.timings`` are reported. The character meshes nearest 1e6 and 1e4
 vertices are profiled with cProfile (one call; ten calls). Writes ``bench/results/rig_time.md`` and ``bench/results/rig_time.png``.
 
     .venv/bin/python bench/rig_time.py                       # full run, a few minutes
@@ -174,7 +174,7 @@ def measure(mesh, runs):
             skeleton = rigger.rig_mesh(mesh.vertices, mesh.triangles)
             walls.append(time.perf_counter() - wall)
             cpus.append(time.thread_time() - cpu)
-            timings = dict(skeleton.stages["timings"])
+            timings = dict(skeleton.timings)
             total = timings.pop("total")
             timings["other"] = total - sum(timings.values())
             stage_runs.append(timings)
@@ -331,7 +331,7 @@ def markdown(measurements, summary, profiles, notes, run):
         "- The call: `rigger.rig_mesh(vertices, triangles)` with the silhouette method's defaults, input checks "
         "included, no skinning; vertices float64, triangles int32 (as Blender hands them over). Each time is the "
         "median over the runs shown (after one untimed call for meshes up to 20k vertices); stage columns are the "
-        "medians of `stages[\"timings\"]`, and `other` is the rest of the call (input checks, method lookup).",
+        "medians of `Skeleton.timings`, and `other` is the rest of the call (input checks, method lookup).",
         "- Meshes: the sample characters at Skin-modifier subdivision levels 0, 1, 2 (Blender, so coarser meshes "
         "are genuinely coarser, not decimated), then level 2 refined by midpoint subdivision (each triangle into "
         "four: same surface, four times the vertices) up to the cap. Times at exactly 10^3..10^6 vertices are "

@@ -26,7 +26,7 @@ import rigdata  # noqa: E402  (bench/ is not a package)
 from benchkit import (RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit, format_seconds,  # noqa: E402
                       markdown_table, table_cell)
 from rigger.blender.headless import empty_scene, temporary_user_folder  # noqa: E402  (bpy-free)
-from rigger.skeletonize.polyline import segment_distances  # noqa: E402  (bpy-free)
+from rigger.core.polyline import segment_distances  # noqa: E402  (bpy-free)
 
 MODELS_DIR = SHARED_MODELS / "gt"
 REPAIR_STAGES = ("welded bone heat", "island bone heat", "nearest bones")

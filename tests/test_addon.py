@@ -240,26 +240,34 @@ def test_several_selected_meshes_are_rigged_together_and_all_skinned(scene):
 
 
 def test_rig_builds_the_overlays_the_panel_toggles_and_clear_removes(scene):
-    from rigger.blender.overlays import COLLECTION_NAME, KIND_KEY, OVERLAY_KINDS
+    from rigger.blender.overlays import COLLECTION_NAME, KIND_KEY
     obj = build_character("humanoid", subdivisions=0)
     activate(obj)
-    scene.rigger.show_triangulation = False
+    toggle = scene.rigger.overlays.add()  # a script may set a stage's toggle before its first rig
+    toggle.name, toggle.shown = "cdt", False
     assert bpy.ops.rigger.rig() == {'FINISHED'}
     made = {o[KIND_KEY]: o for o in bpy.data.collections[COLLECTION_NAME].objects}
-    assert set(made) == {kind for kind, _, _ in OVERLAY_KINDS}
-    assert made["triangulation"].hide_get() and not made["joints"].hide_get()
+    assert set(made) == {"silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints"}
+    toggles = scene.rigger.overlays
+    assert set(toggles.keys()) == set(made)  # one toggle per stage drawn, labelled after its stage type
+    assert (toggles["axis"].label, toggles["merged"].label) == ("Chordal Axis", "Merged Axis")
+    assert made["cdt"].hide_get() and made["merged"].hide_get() and not made["joints"].hide_get()
+    assert not toggles["merged"].shown and toggles["joints"].shown
     depsgraph = bpy.context.evaluated_depsgraph_get()
     joints = made["joints"].evaluated_get(depsgraph).to_mesh()
     assert len(joints.polygons) > 0  # the node group drew spheres
     made["joints"].evaluated_get(depsgraph).to_mesh_clear()
 
-    scene.rigger.show_joints = False
+    toggles["joints"].shown = False
     assert made["joints"].hide_get()
-    scene.rigger.show_triangulation = True
-    assert not made["triangulation"].hide_get()
+    toggles["cdt"].shown = True
+    assert not made["cdt"].hide_get()
+    assert bpy.ops.rigger.rig() == {'FINISHED'}  # rigging again keeps the toggles as they are
+    made = {o[KIND_KEY]: o for o in bpy.data.collections[COLLECTION_NAME].objects}
+    assert made["joints"].hide_get() and not made["cdt"].hide_get() and len(toggles) == 7
     assert bpy.ops.rigger.clear_overlays() == {'FINISHED'}
     assert COLLECTION_NAME not in bpy.data.collections
-    assert not [o for o in bpy.data.objects if KIND_KEY in o]
+    assert not [o for o in bpy.data.objects if KIND_KEY in o] and len(toggles) == 0
     assert not bpy.ops.rigger.clear_overlays.poll()
 
 
@@ -378,9 +386,7 @@ def test_the_report_is_plain_json_whatever_numbers_a_method_records(scene):
 
         def rig(self, mesh):
             low, high = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
-            skeleton = Skeleton(["spine"], [low], [high], [-1])
-            skeleton.stages["timings"] = {"think": np.float32(0.5), "count": np.int64(3)}
-            return skeleton
+            return Skeleton(["spine"], [low], [high], [-1], timings={"think": np.float32(0.5), "count": np.int64(3)})
 
     result = rig_object(build_character("snake", subdivisions=0), NumpyTimed)
     report = json.loads(json.dumps(rig_report(result, None)))
@@ -427,7 +433,6 @@ def drawn_panel():
 
 
 def test_the_panel_shows_method_parameters_actions_and_overlay_toggles(scene):
-    from rigger.blender.overlays import OVERLAY_KINDS
     from rigger.blender.panel import RIGGER_PT_main
     assert (RIGGER_PT_main.bl_space_type, RIGGER_PT_main.bl_region_type) == ('VIEW_3D', 'UI')
     assert RIGGER_PT_main.bl_category == "Rigger"
@@ -435,9 +440,12 @@ def test_the_panel_shows_method_parameters_actions_and_overlay_toggles(scene):
     props = [name for kind, name in log if kind == "prop"]
     assert props[0] == "method"
     assert {"resolution", "bone_length", "view"} <= set(props)
-    assert {f"show_{kind}" for kind, _, _ in OVERLAY_KINDS} <= set(props)
+    assert "shown" not in props and ("label", "Rig a mesh to see its stages") in log  # no stages drawn yet
     assert [name for kind, name in log if kind == "operator"] == [
         "rigger.rig", "rigger.skin", "rigger.rig_skin", "rigger.clear_overlays"]
+    activate(build_character("snake", subdivisions=0))
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    assert [name for kind, name in drawn_panel().log if kind == "prop"].count("shown") == len(scene.rigger.overlays) > 0
 
 
 def test_the_direction_view_offers_to_look_along_the_3d_view(scene):

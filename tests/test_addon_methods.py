@@ -74,10 +74,44 @@ def test_a_method_file_dropped_into_the_folder_appears_after_re_enabling(addon_c
     assert [bone.name for bone in obj.rigger_armature.data.bones] == ["spine"]
 
 
+PACKAGE_METHOD = """
+from .._template import TemplateMethod
+from .reach import REACH
+
+
+class Reaching(TemplateMethod):
+    name = "reaching"
+    label = "Reaching"
+
+    def rig(self, mesh, *, bones, axis):
+        skeleton = super().rig(mesh, bones=bones, axis=axis)
+        skeleton.timings["reach"] = REACH  # where the test can see it
+        return skeleton
+"""
+
+
+def test_an_edit_to_any_module_of_a_method_package_is_seen_after_re_enabling(addon_copy):
+    package = addon_copy / "methods" / "reaching"
+    package.mkdir()
+    (package / "__init__.py").write_text(PACKAGE_METHOD)
+    (package / "reach.py").write_text("REACH = 1\n")
+    assert addon_utils.enable("rigger_copy", default_set=False, handle_error=None)
+    assert methods_in_dropdown() == ["reaching", "silhouette"]
+    api = sys.modules["rigger_copy.api"]
+    box = [(x, y, z) for x in (0, 1) for y in (0, 4) for z in (0, 1)], [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5)]
+    assert api.rig_mesh(*box, method="reaching").timings["reach"] == 1
+    (package / "reach.py").write_text("REACH = 2\n")  # same size, same second
+    addon_utils.disable("rigger_copy")
+    assert addon_utils.enable("rigger_copy", default_set=False, handle_error=None)
+    assert sys.modules["rigger_copy.api"].rig_mesh(*box, method="reaching").timings["reach"] == 2
+
+
 def test_every_method_failing_to_load_leaves_a_working_panel_and_rig_disabled(addon_copy):
-    (addon_copy / "methods" / "silhouette.py").write_text("syntax error here\n")
+    (addon_copy / "methods" / "silhouette" / "tuning.py").write_text("syntax error here\n")
     assert addon_utils.enable("rigger_copy", default_set=False, handle_error=None)
     assert methods_in_dropdown() == ["NONE"]
+    failure = sys.modules["rigger_copy.api"].method_registry().failures["silhouette/"]
+    assert failure.startswith("SyntaxError:") and "tuning.py" in failure
     obj = build_character("snake", subdivisions=0)
     activate(obj)
     assert not bpy.ops.rigger.rig.poll()

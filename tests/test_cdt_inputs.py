@@ -6,7 +6,7 @@ import re
 import numpy as np
 import pytest
 
-from cdt_checks import check_even_odd, check_triangulation, triangle_areas
+from cdt_checks import assert_same_up_to_cocircular, check_even_odd, check_triangulation, triangle_areas
 from rigger.cdt import triangulate
 
 SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
@@ -186,17 +186,24 @@ def test_negative_zero_is_the_same_point():
     assert tri.vertex_map.tolist() == [0, 1, 2, 0, 0]
 
 
-@pytest.mark.parametrize("renumber_from", [0, 10**9])
-def test_renumbering_in_insertion_order_changes_nothing(monkeypatch, renumber_from):
-    """Large inputs are renumbered in insertion order for memory locality (small ones are not): force either path
-    on messy input (duplicates, collinear runs, crossing and overlapping segments) and check the full contract."""
-    from rigger import _rigger_cdt
-    monkeypatch.setattr(_rigger_cdt, "RENUMBER_MIN", renumber_from)
+def corner_keys(tri):
+    """Each triangle as the sorted coordinates of its corners (indices of Steiner vertices differ with the input)."""
+    return [tuple(sorted(map(tuple, corners))) for corners in tri.vertices[tri.triangles].tolist()]
+
+
+def test_a_large_input_triangulates_as_its_distinct_points_do():
+    """Large inputs are renumbered in insertion order for memory locality (the compiled module does so from 16384
+    points), small ones are not: messy input (duplicates, collinear runs, crossing and overlapping segments) and the
+    same points repeated until it is large meet the full contract, and the repeats change nothing."""
     rng = np.random.default_rng(11)
     points = rng.integers(0, 12, (300, 2)).astype(float) * 0.1 + 5.0
     segments = rng.integers(0, 300, (40, 2))
+    repeated = np.tile(points, (100, 1))  # 30,000 points, every one a duplicate of the first 300
     for mode in ("all", "inside"):
-        tri = triangulate(points, segments, mode=mode)
-        check_triangulation(tri, points, segments, mode=mode)
+        small, large = (triangulate(given, segments, mode=mode) for given in (points, repeated))
+        check_triangulation(small, points, segments, mode=mode)
+        check_triangulation(large, repeated, segments, mode=mode)
+        np.testing.assert_array_equal(large.vertex_map, np.tile(small.vertex_map, 100))
+        assert_same_up_to_cocircular(small, large, *(corner_keys(tri) for tri in (small, large)))
     reference = triangulate(points, segments, mode="all")
     assert reference.vertex_map.tolist() == [int(np.flatnonzero((points == p).all(axis=1))[0]) for p in points]

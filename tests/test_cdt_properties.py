@@ -15,8 +15,7 @@ from hypothesis import strategies as st
 from cdt_checks import (assert_same_up_to_cocircular, check_convex_hull, check_delaunay, check_even_odd,
                         check_neighbors, check_orientation, check_triangulation, check_vertex_map, coordinate_triples,
                         has_closed_curves, incircle_signs, orient_signs, triangle_areas)
-from rigger import _rigger_cdt
-from rigger.cdt import triangulate
+from rigger.cdt import incircle, orient2d, triangulate
 
 
 def budget(examples):
@@ -231,10 +230,10 @@ def _nudged(values, ulps):
 @budget(400)
 @given(st.tuples(FINITE, FINITE), st.tuples(FINITE, FINITE), st.floats(-2, 2, allow_nan=False),
        st.lists(st.integers(-1, 1), min_size=2, max_size=2))
-def test_exposed_orient2d_is_exact(a, b, t, ulps):
+def test_orient2d_is_exact(a, b, t, ulps):
     c = _nudged([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])], ulps)
-    assert _rigger_cdt.orient2d(*a, *b, *c) == orient_signs(a, b, c)
-    assert _rigger_cdt.orient2d(*b, *a, *c) == -orient_signs(a, b, c)
+    assert orient2d(a, b, c) == orient_signs(a, b, c)
+    assert orient2d(b, a, c) == -orient_signs(a, b, c)
 
 
 PYTHAGOREAN = [(5, 0), (4, 3), (3, 4), (0, 5), (-3, 4), (-4, 3), (-5, 0), (-4, -3), (-3, -4), (0, -5), (3, -4), (4, -3)]
@@ -243,14 +242,14 @@ PYTHAGOREAN = [(5, 0), (4, 3), (3, 4), (0, 5), (-3, 4), (-4, 3), (-5, 0), (-4, -
 @budget(400)
 @given(st.permutations(PYTHAGOREAN), st.tuples(FINITE, FINITE), st.integers(-30, 30),
        st.lists(st.integers(-1, 1), min_size=2, max_size=2))
-def test_exposed_incircle_is_exact(circle, center, exponent, ulps):
+def test_incircle_is_exact(circle, center, exponent, ulps):
     """Four points of one integer circle, scaled by a power of two (exactly cocircular) and moved to ``center``
     (cocircular up to rounding), the last nudged by an ulp: the hardest in-circle signs."""
     a, b, c, d = (np.ldexp(np.array(p, np.float64), exponent) + center for p in circle[:4])
     if orient_signs(a, b, c) < 0:
         a, b = b, a
     d = _nudged(d, ulps)
-    assert _rigger_cdt.incircle(*a, *b, *c, *d) == incircle_signs(a, b, c, d)
+    assert incircle(a, b, c, d) == incircle_signs(a, b, c, d)
 
 
 def _flip_first_interior_edge(tri):

@@ -7,6 +7,7 @@ import pytest
 from rigger.core.mesh import Mesh, triangulate_polygons
 from rigger.core.params import Param, resolve
 from rigger.core.skeleton import Skeleton
+from rigger.core.stages import Joints
 
 TETRA_VERTICES = [(0, 0, 0), (2, 0, 0), (0, 1, 0), (0, 0, 1)]
 TETRA_TRIANGLES = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
@@ -124,7 +125,8 @@ def arm():
     names = ["root", "upper", "lower", "side"]
     heads = [(0, 0, 0), (0, 0, 1), (0, 0, 2), (1, 0, 0)]
     tails = [(0, 0, 1), (0, 0, 2), (0, 0, 3), (2, 0, 0)]
-    return Skeleton(names, heads, tails, [-1, 0, 1, 0], stages={"note": "kept"})
+    return Skeleton(names, heads, tails, [-1, 0, 1, 0], stages={"note": Joints(np.zeros((1, 3)))},
+                    timings={"cut": 0.25}, params={"bones": 4})
 
 
 def test_skeleton_tree_queries():
@@ -133,7 +135,7 @@ def test_skeleton_tree_queries():
     assert skeleton.roots == (0,)
     assert skeleton.children(0) == (1, 3) and skeleton.children(2) == ()
     assert skeleton.parents.dtype == np.int32
-    assert skeleton.stages == {"note": "kept"}
+    assert list(skeleton.stages) == ["note"] and skeleton.timings == {"cut": 0.25} and skeleton.params == {"bones": 4}
     # heads of all bones plus tails of the leaves 'lower' and 'side'
     np.testing.assert_array_equal(skeleton.joints(), [(0, 0, 0), (0, 0, 1), (0, 0, 2), (1, 0, 0), (0, 0, 3), (2, 0, 0)])
 
@@ -206,6 +208,7 @@ def test_transformed_applies_an_affine_matrix_and_keeps_the_tree():
     np.testing.assert_allclose(moved.tails[2], [10, 0, 5])
     np.testing.assert_array_equal(moved.parents, skeleton.parents)
     assert moved.names == skeleton.names and moved.stages is skeleton.stages
+    assert (moved.timings, moved.params) == (skeleton.timings, skeleton.params)
     back = moved.transformed(np.linalg.inv(matrix))
     np.testing.assert_allclose(back.heads, skeleton.heads, atol=1e-12)
 

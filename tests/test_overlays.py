@@ -1,10 +1,11 @@
 """Stage overlays (rigger.blender.overlays): the evaluated geometry-node output sits where each stage says, in the
-right materials, and building, rebuilding, hiding and clearing leave exactly the data they should."""
+right materials, for any stage type (a test-only method's own included), and building, rebuilding, hiding and
+clearing leave exactly the data they should."""
+import pathlib
+
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
-
-from stages import lift
 
 bpy = pytest.importorskip("bpy")
 
@@ -12,12 +13,14 @@ import rigger  # noqa: E402
 from rigger.blender import overlays, samples  # noqa: E402
 from rigger.blender.headless import empty_scene  # noqa: E402
 from rigger.blender.meshdata import mesh_vertices  # noqa: E402
-from rigger.methods._template import TemplateMethod  # noqa: E402
-from rigger.skeletonize.chordal import ISOLATED, JUNCTION, SLEEVE, TERMINAL  # noqa: E402
-from rigger.skeletonize.polyline import segment_distances  # noqa: E402
+from rigger.core.polyline import segment_distances  # noqa: E402
+from rigger.core.registry import discover  # noqa: E402
+from rigger.core.stages import (ISOLATED, JUNCTION, SLEEVE, TERMINAL, AxisGraph, Frame, MirrorPlane,  # noqa: E402
+                                Stage, Triangulation)
 
-KINDS = [key for key, _, _ in overlays.OVERLAY_KINDS]
-LINE_KINDS = ("silhouette", "axis", "pruned", "chains")
+KINDS = ["silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints"]  # the silhouette method's drawn stages
+LINE_KINDS = ("silhouette", "axis", "merged", "pruned", "chains")
+TEST_METHODS = pathlib.Path(__file__).parent / "methods"
 ICO_VERTICES = 42  # an ico sphere of SPHERE_SUBDIVISIONS = 2
 pytestmark = pytest.mark.usefixtures("scene")  # every test starts from an empty scene
 
@@ -30,19 +33,23 @@ def humanoid():
     return vertices, triangles, rigger.rig_mesh(vertices, triangles).stages
 
 
+def lift(frame, points):
+    """Points (P, 2) of a view's plane in 3D, from the frame's fields."""
+    return frame.origin + frame.depth * frame.direction + points[:, :1] * frame.u + points[:, 1:] * frame.v
+
+
 def stage_segments(stages, kind):
     """(starts, ends) of the segments a line-like stage draws, in 3D."""
+    stage = stages[kind]
     if kind == "silhouette":
-        loops = stages["silhouette"]["loops"]
-        starts = np.concatenate([lift(stages, loop) for loop in loops])
-        ends = np.concatenate([lift(stages, np.roll(loop, -1, axis=0)) for loop in loops])
+        starts = np.concatenate([lift(stage.frame, loop) for loop in stage.loops])
+        ends = np.concatenate([lift(stage.frame, np.roll(loop, -1, axis=0)) for loop in stage.loops])
         return starts, ends
     if kind == "chains":
-        return (np.concatenate([chain[:-1] for chain in stages["chains"]]),
-                np.concatenate([chain[1:] for chain in stages["chains"]]))
-    points = lift(stages, stages["axis"]["points"])
-    links = stages[kind]["links"]
-    return points[links[:, 0]], points[links[:, 1]]
+        return (np.concatenate([chain[:-1] for chain in stage.lines]),
+                np.concatenate([chain[1:] for chain in stage.lines]))
+    points = lift(stage.frame, stage.points)
+    return points[stage.links[:, 0]], points[stage.links[:, 1]]
 
 
 def distance_to_segments(points, starts, ends):
@@ -64,14 +71,14 @@ def evaluated(obj):
 
 def default_radius(stages):
     """LINE_SCALE times the largest extent of everything drawn."""
-    cdt = stages["cdt"]
-    axis_used = np.unique(np.concatenate([stages["axis"]["links"].ravel(), stages["pruned"]["links"].ravel()]))
+    cdt, axis = stages["cdt"], stages["axis"]
+    axis_used = np.unique(np.concatenate([stages[kind].links.ravel() for kind in ("axis", "merged", "pruned")]))
     points = np.concatenate([
-        *(lift(stages, loop) for loop in stages["silhouette"]["loops"]),
-        lift(stages, cdt["vertices"][np.unique(cdt["triangles"])]),
-        lift(stages, stages["axis"]["points"][axis_used]),
-        *stages["chains"],
-        stages["joints"],
+        *(lift(axis.frame, loop) for loop in stages["silhouette"].loops),
+        lift(cdt.frame, cdt.vertices[np.unique(cdt.triangles)]),
+        lift(axis.frame, axis.points[axis_used]),
+        *stages["chains"].lines,
+        stages["joints"].points,
     ])
     return overlays.LINE_SCALE * float(np.max(points.max(axis=0) - points.min(axis=0)))
 
@@ -92,8 +99,9 @@ def test_every_stage_of_the_silhouette_method_gets_its_object(humanoid):
         assert obj.data.name == obj.name
         assert list(obj.users_collection) == [collection]
         assert obj.hide_select and obj.show_in_front and obj.hide_render
-        assert obj.visible_get()
-        assert len(obj.data.polygons) == (len(stages["cdt"]["triangles"]) if kind == "triangulation" else 0)
+        assert obj.visible_get() == stages[kind].shown  # the merged axis starts hidden
+        assert len(obj.data.polygons) == (len(stages["cdt"].triangles) if kind == "cdt" else 0)
+        overlays.set_overlay_visible(kind, True)
         assert len(evaluated(obj)[1]) > 0, f"{kind}: the geometry nodes drew no faces"
 
 
@@ -101,7 +109,7 @@ def test_every_stage_of_the_silhouette_method_gets_its_object(humanoid):
 def test_tubes_follow_the_stage_at_the_line_radius(humanoid, kind):
     stages = humanoid[2]
     radius = default_radius(stages)
-    obj = overlays.build_overlays(stages, "Body")[kind]
+    obj = overlays.build_overlays(stages, "Body", visible={kind: True})[kind]
     vertices, materials = evaluated(obj)
     starts, ends = stage_segments(stages, kind)
     distance = distance_to_segments(vertices, starts, ends)
@@ -116,21 +124,21 @@ def test_tubes_follow_the_stage_at_the_line_radius(humanoid, kind):
 
 def test_plane_stages_lie_on_the_silhouette_plane_at_its_depth(humanoid):
     stages = humanoid[2]
-    frame = stages["silhouette"]
+    frame = stages["frame"]
     radius = default_radius(stages)
     objects = overlays.build_overlays(stages, "Body")
-    for kind in ("silhouette", "triangulation", "axis", "pruned"):
+    for kind in ("silhouette", "cdt", "axis", "merged", "pruned"):
         vertices = evaluated(objects[kind])[0]
-        depth = (vertices - frame["origin"]) @ frame["direction"]
-        assert np.abs(depth - frame["depth"]).max() <= radius * 1.001 + 1e-6, kind
+        depth = (vertices - frame.origin) @ frame.direction
+        assert np.abs(depth - frame.depth).max() <= radius * 1.001 + 1e-6, kind
     # The chains leave the plane: they are placed in depth inside the mesh.
-    chains = np.concatenate(stages["chains"])
-    assert np.ptp((chains - frame["origin"]) @ frame["direction"]) > 10 * radius
+    chains = np.concatenate(stages["chains"].lines)
+    assert np.ptp((chains - frame.origin) @ frame.direction) > 10 * radius
 
 
 def test_joint_spheres_are_centred_on_the_joints(humanoid):
     stages = humanoid[2]
-    joints = stages["joints"]
+    joints = stages["joints"].points
     obj = overlays.build_overlays(stages, "Body", scale=0.01)["joints"]
     vertices, materials = evaluated(obj)
     assert vertices.shape == (len(joints) * ICO_VERTICES, 3)
@@ -150,12 +158,13 @@ def test_scale_sets_the_line_radius(humanoid):
 
 def test_triangulation_materials_match_the_classes_present(humanoid):
     stages = humanoid[2]
-    classes = stages["cdt"]["classes"]
-    present = {overlays.CLASS_NAMES[code] for code in np.unique(classes)}
-    obj = overlays.build_overlays(stages, "Body")["triangulation"]
+    classes = stages["cdt"].classes
+    names = {code: name for code, name, _ in Triangulation.palette}
+    present = {names[code] for code in np.unique(classes)}
+    obj = overlays.build_overlays(stages, "Body")["cdt"]
     _, materials = evaluated(obj)
     assert set(materials) == {f"Rigger {name}" for name in present} | {f"Rigger {name} faces" for name in present}
-    for code, name in overlays.CLASS_NAMES.items():
+    for code, name in names.items():
         assert np.count_nonzero(materials == f"Rigger {name} faces") == np.count_nonzero(classes == code)
     faces = bpy.data.materials["Rigger junction faces"]
     edges = bpy.data.materials["Rigger junction"]
@@ -167,32 +176,30 @@ def test_triangulation_materials_match_the_classes_present(humanoid):
 def test_each_edge_is_drawn_once_in_the_colour_of_its_highest_class():
     """A junction and a sleeve share an edge (the junction draws it); a terminal and an isolated triangle stand
     alone. Every edge is a tube of TUBE_SIDES faces per segment."""
-    stages = {
-        "silhouette": {"loops": [], "origin": np.zeros(3), "u": np.array([1.0, 0, 0]), "v": np.array([0, 1.0, 0]),
-                       "direction": np.array([0, 0, 1.0]), "depth": 0.5},
-        "cdt": {"vertices": np.array([[0, 0], [1, 0], [0, 1], [1, 1], [3, 0], [4, 0], [3, 1], [6, 0], [7, 0],
-                                      [6, 1]], dtype=float),
-                "triangles": np.array([[0, 1, 2], [1, 3, 2], [4, 5, 6], [7, 8, 9]]),
-                "classes": np.array([JUNCTION, SLEEVE, TERMINAL, ISOLATED])},
-    }
-    objects = overlays.build_overlays(stages, "Patch", scale=0.05)
-    assert list(objects) == ["triangulation"]
-    vertices, materials = evaluated(objects["triangulation"])
+    vertices = np.array([[0, 0], [1, 0], [0, 1], [1, 1], [3, 0], [4, 0], [3, 1], [6, 0], [7, 0], [6, 1]], dtype=float)
+    cdt = Triangulation(plane_at(0.5), vertices, np.array([[0, 1, 2], [1, 3, 2], [4, 5, 6], [7, 8, 9]]),
+                        np.array([JUNCTION, SLEEVE, TERMINAL, ISOLATED]))
+    objects = overlays.build_overlays({"cdt": cdt}, "Patch", scale=0.05)
+    assert list(objects) == ["cdt"]
+    vertices, materials = evaluated(objects["cdt"])
     sides = overlays.TUBE_SIDES
     expected = {"Rigger junction": 3 * sides, "Rigger sleeve": 2 * sides, "Rigger terminal": 3 * sides,
                 "Rigger isolated": 3 * sides, "Rigger junction faces": 1, "Rigger sleeve faces": 1,
                 "Rigger terminal faces": 1, "Rigger isolated faces": 1}
     names, counts = np.unique(materials, return_counts=True)
     assert dict(zip(names.tolist(), counts.tolist())) == expected
-    assert np.abs(vertices[:, 2] - 0.5).max() <= overlays.CDT_EDGE_SCALE * 0.05 * 1.001
+    assert np.abs(vertices[:, 2] - 0.5).max() <= overlays.FACE_EDGE_SCALE * 0.05 * 1.001
+
+
+def plane_at(depth):
+    """The frame of a view along z whose plane lies at z = ``depth``."""
+    return Frame(np.zeros(3), np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, 1.0]), depth, np.eye(3))
 
 
 def test_graph_links_are_drawn_once_and_self_links_dropped():
-    frame = {"loops": [], "origin": np.zeros(3), "u": np.array([1.0, 0, 0]), "v": np.array([0, 1.0, 0]),
-             "direction": np.array([0, 0, 1.0]), "depth": 0.0}
-    axis = {"points": np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [9.0, 9.0]]),
-            "links": np.array([[0, 1], [1, 0], [1, 1], [1, 2]])}
-    obj = overlays.build_overlays({"silhouette": frame, "axis": axis}, "Graph", scale=0.1)["axis"]
+    axis = AxisGraph(plane_at(0.0), np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [9.0, 9.0]]), np.ones(4),
+                     np.array([[0, 1], [1, 0], [1, 1], [1, 2]]))
+    obj = overlays.build_overlays({"frame": plane_at(0.0), "axis": axis}, "Graph", scale=0.1)["axis"]
     assert len(obj.data.vertices) == 3  # the unused point is left out
     assert sorted(tuple(edge.vertices) for edge in obj.data.edges) == [(0, 1), (1, 2)]
     vertices, _ = evaluated(obj)
@@ -221,19 +228,21 @@ def test_rebuilding_replaces_the_owners_objects_and_shares_groups_and_materials(
     assert "Rigger joints: Body" not in bpy.data.objects and "Rigger joints: Other" in bpy.data.objects
 
 
-def test_visibility_at_build_and_toggled_per_kind(humanoid):
+def test_visibility_at_build_and_toggled_per_stage(humanoid):
     stages = humanoid[2]
-    body = overlays.build_overlays(stages, "Body", visible={"axis": False})
+    body = overlays.build_overlays(stages, "Body", visible={"axis": False, "merged": True})
     other = overlays.build_overlays(stages, "Other")
     assert not body["axis"].visible_get() and body["axis"].hide_viewport and body["axis"].hide_get()
     assert all(obj.visible_get() for kind, obj in body.items() if kind != "axis")
+    assert not other["merged"].visible_get()  # as its stage type says when not asked
 
-    overlays.set_overlay_visible("chains", False)
+    assert overlays.set_overlay_visible("chains", False) == 2
     assert not body["chains"].visible_get() and not other["chains"].visible_get()
     assert body["chains"].hide_viewport and other["chains"].hide_get()
-    overlays.set_overlay_visible("axis", True)
-    overlays.set_overlay_visible("chains", True)
+    for kind in ("axis", "chains", "merged"):
+        overlays.set_overlay_visible(kind, True)
     assert all(obj.visible_get() and not obj.hide_viewport for obj in [*body.values(), *other.values()])
+    assert overlays.set_overlay_visible("bones", True) == 0  # no such overlay: nothing to do
     # Shown again, the object evaluates as before.
     assert len(evaluated(body["axis"])[1]) > 0
 
@@ -252,50 +261,55 @@ def test_clear_leaves_nothing_behind(humanoid):
     assert data_counts() == before
 
 
-def test_stages_without_overlay_data_draw_nothing(humanoid):
-    vertices, triangles, stages = humanoid
-    template = rigger.rig_mesh(vertices, triangles, method=TemplateMethod).stages
+def test_stages_without_drawings_draw_nothing_and_a_rebuild_still_replaces(humanoid):
+    stages = humanoid[2]
+    undrawn = {"frame": stages["frame"], "plane": MirrorPlane(0, 0.0, np.array([1.0, 0, 0]))}
     before = data_counts()
-    assert overlays.build_overlays(template, "Body") == {}
+    assert overlays.build_overlays(undrawn, "Body") == {}
     assert data_counts() == before
     # A rebuild from such stages still removes the owner's earlier overlays.
     overlays.build_overlays(stages, "Body")
-    assert overlays.build_overlays(template, "Body") == {}
+    assert overlays.build_overlays(undrawn, "Body") == {}
     assert not [obj for obj in bpy.data.objects if obj.name.startswith("Rigger")]
 
 
-def _with(stages, key, value):
-    changed = dict(stages)
-    changed[key] = value
-    return changed
+class Broken(Stage):
+    """A stage whose drawing fails."""
+
+    def drawing(self):
+        raise ValueError("no points to draw")
 
 
-MALFORMED = {
-    "loop with NaN": (lambda s: _with(s, "silhouette", {**s["silhouette"], "loops": [np.full((4, 2), np.nan)]}),
-                      {"silhouette"}),
-    "frame without u": (lambda s: _with(s, "silhouette", {k: v for k, v in s["silhouette"].items() if k != "u"}),
-                        {"silhouette", "triangulation", "axis", "pruned"}),
-    "triangle index out of range": (lambda s: _with(s, "cdt", {**s["cdt"], "triangles": s["cdt"]["triangles"] + 10**6}),
-                                    {"triangulation"}),
-    "a class per vertex": (lambda s: _with(s, "cdt", {**s["cdt"], "classes": np.zeros(len(s["cdt"]["vertices"]))}),
-                           {"triangulation"}),
-    "float axis links": (lambda s: _with(s, "axis", {**s["axis"], "links": s["axis"]["links"] + 0.5}), {"axis"}),
-    "pruned past the axis": (lambda s: _with(s, "pruned", {"links": np.array([[0, len(s["axis"]["points"])]])}),
-                             {"pruned"}),
-    "chains not a list": (lambda s: _with(s, "chains", {"a": s["chains"][0]}), {"chains"}),
-    "2D chain": (lambda s: _with(s, "chains", [chain[:, :2] for chain in s["chains"]]), {"chains"}),
-    "2D joints": (lambda s: _with(s, "joints", s["joints"][:, :2]), {"joints"}),
-    "ragged joints": (lambda s: _with(s, "joints", [[0.0, 1.0, 2.0], [1.0]]), {"joints"}),
-}
-
-
-@pytest.mark.parametrize("case", MALFORMED)
-def test_malformed_stages_are_skipped_with_a_warning(humanoid, case):
-    corrupt, skipped = MALFORMED[case]
+def test_what_is_not_a_stage_or_fails_to_draw_is_skipped_with_a_warning(humanoid):
+    stages = {**humanoid[2], "raw": np.zeros(3), "broken": Broken()}
     with pytest.warns(RuntimeWarning) as record:
-        objects = overlays.build_overlays(corrupt(humanoid[2]), "Body")
-    assert list(objects) == [kind for kind in KINDS if kind not in skipped]
-    assert {str(warning.message).split("'")[1] for warning in record} == skipped
+        objects = overlays.build_overlays(stages, "Body")
+    assert list(objects) == KINDS
+    assert sorted(str(warning.message) for warning in record) == [
+        "Rigger overlay 'broken' skipped: drawing its Broken failed: no points to draw",
+        "Rigger overlay 'raw' skipped: a ndarray, not a rigger.core.stages.Stage"]
+
+
+def test_a_test_only_package_method_s_own_stage_type_gets_its_overlay():
+    """The test method ``slices`` (a package under tests/methods) returns a stage type of its own, ``Rings``, and
+    ``Joints``: both are drawn, the rings as tubes around each slab in the stage's colour, with nothing in the
+    Blender layer knowing the type."""
+    empty_scene()
+    method = discover(TEST_METHODS).methods["slices"]
+    vertices, triangles = samples.character_arrays("snake", subdivisions=0)
+    skeleton = rigger.rig_mesh(vertices, triangles, method=method, slabs=5)
+    objects = overlays.build_overlays(skeleton.stages, "Snake", scale=0.01)
+    assert list(objects) == ["rings", "centres"]
+    rings = skeleton.stages["rings"]
+    drawn, materials = evaluated(objects["rings"])
+    assert set(materials) == {"Rigger rings"}
+    assert tuple(bpy.data.materials["Rigger rings"].diffuse_color)[:3] == pytest.approx(rings.colour)
+    across = [axis for axis in range(3) if axis != rings.axis]
+    nearest = np.argmin(np.abs(drawn[:, rings.axis][:, None] - rings.centres[:, rings.axis][None]), axis=1)
+    distance = np.linalg.norm((drawn - rings.centres[nearest])[:, across], axis=1)
+    assert np.abs(distance - rings.radii[nearest]).max() <= 0.02  # on the rings, within the tube's radius
+    np.testing.assert_allclose(evaluated(objects["centres"])[0].reshape(5, -1, 3).mean(axis=1),
+                               skeleton.stages["centres"].points, atol=1e-5)
 
 
 @pytest.mark.parametrize("arguments", [
@@ -305,15 +319,9 @@ def test_malformed_stages_are_skipped_with_a_warning(humanoid, case):
     {"scale": 0.0},
     {"scale": float("nan")},
     {"scale": True},
-    {"visible": {"bones": True}},
 ])
 def test_bad_arguments_raise(humanoid, arguments):
     call = {"stages": humanoid[2], "owner": "Body", **arguments}
     with pytest.raises(ValueError):
         overlays.build_overlays(call.pop("stages"), call.pop("owner"), **call)
     assert not [obj for obj in bpy.data.objects if obj.name.startswith("Rigger")]
-
-
-def test_unknown_kind_cannot_be_toggled():
-    with pytest.raises(ValueError, match="unknown overlay kind"):
-        overlays.set_overlay_visible("bones", True)

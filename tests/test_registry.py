@@ -31,7 +31,7 @@ def stick_method(name, class_name="Stick"):
 
             def rig(self, mesh, length):
                 head = mesh.centroid
-                return Skeleton(["stick"], [head], [head + (0, 0, length)], [-1], stages={{"timings": {{"up": 0.5}}}})
+                return Skeleton(["stick"], [head], [head + (0, 0, length)], [-1], timings={{"up": 0.5}})
         """
 
 
@@ -173,8 +173,8 @@ def test_rig_mesh_runs_a_method_discovered_from_a_folder(tmp_path, scratch_regis
     assert isinstance(skeleton, rigger.Skeleton)
     np.testing.assert_allclose(skeleton.heads, [(0.5, 2, 0.5)])
     np.testing.assert_allclose(skeleton.tails, [(0.5, 2, 1.0)])
-    assert skeleton.stages["params"] == {"length": 0.5}
-    timings = skeleton.stages["timings"]
+    assert skeleton.params == {"length": 0.5}
+    timings = skeleton.timings
     assert timings["up"] == 0.5 and 0 < timings["total"] < 10
 
 
@@ -190,7 +190,7 @@ def test_rig_mesh_errors_name_what_is_wrong(tmp_path, scratch_registry):
         rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method="stick", length=0)
     with pytest.raises(ValueError, match=r"reference vertex 8 but the mesh has only 8 vertices"):
         rigger.rig_mesh(BOX_VERTICES, [(0, 1, 8)], method="stick")
-    with pytest.raises(ValueError, match=r"method must be a method name or a RigMethod subclass"):
+    with pytest.raises(ValueError, match=r"method must be a method name, a RigMethod subclass or an instance"):
         rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=None)
 
 
@@ -216,11 +216,13 @@ def test_the_template_method_rigs_a_chain_along_the_main_axis():
     assert skeleton.names == ("chain.000", "chain.001", "chain.002", "chain.003")
     assert list(skeleton.parents) == [-1, 0, 1, 2]
     np.testing.assert_allclose(skeleton.heads[1:], skeleton.tails[:-1])
-    np.testing.assert_allclose(abs(skeleton.stages["principal_axis"]), [0, 1, 0], atol=1e-12)
+    (axis_line,) = skeleton.stages["principal_axis"].lines
+    np.testing.assert_allclose(np.sort(axis_line[:, 1]), [0, 4], atol=1e-12)
+    np.testing.assert_allclose(axis_line[:, [0, 2]], 0.5, atol=1e-12)
     ends = sorted([skeleton.heads[0][1], skeleton.tails[-1][1]])
     np.testing.assert_allclose(ends, [0, 4])
     np.testing.assert_allclose(skeleton.heads[:, [0, 2]], 0.5)
-    assert set(skeleton.stages["timings"]) == {"axis", "chain", "total"}
+    assert set(skeleton.timings) == {"axis", "chain", "total"}
     along_z = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=TemplateMethod, axis="z")
     np.testing.assert_allclose(along_z.heads[0], [0.5, 2, 0])
     assert len(along_z) == 3
@@ -248,3 +250,98 @@ def test_import_rigger_is_cheap_and_exports_lazily():
     assert rigger.Skeleton is Skeleton
     with pytest.raises(AttributeError, match="has no attribute 'rig_meshes'"):
         rigger.rig_meshes
+
+
+# --- methods as packages, tuning tables, typed stages ---------------------------------------------------------------
+
+def write_package(folder, name, modules):
+    """A method package ``folder/name`` with the given {module file: source}."""
+    (folder / name).mkdir(exist_ok=True)
+    for filename, source in modules.items():
+        write(folder / name, filename, source)
+
+
+def package_method(method_name, height_source):
+    """A package method whose bone height comes from its ``height`` module."""
+    return {"__init__.py": f"""
+                from rigger.core.registry import RigMethod
+                from rigger.core.skeleton import Skeleton
+
+                from .height import HEIGHT
+
+                class Up(RigMethod):
+                    name = "{method_name}"
+
+                    def rig(self, mesh):
+                        head = mesh.centroid
+                        return Skeleton(["up"], [head], [head + (0, 0, HEIGHT)], [-1])
+                """,
+            "height.py": height_source}
+
+
+def test_a_method_can_be_a_package_and_its_modules_reload_with_it(tmp_path, monkeypatch):
+    monkeypatch.setattr(sys, "dont_write_bytecode", False)  # as inside Blender, where .pyc files get written
+    write_package(tmp_path, "up", package_method("up", "HEIGHT = 1.0\n"))
+    write(tmp_path, "stick.py", stick_method("stick"))
+    registry = discover(tmp_path)
+    assert list(registry.methods) == ["stick", "up"] and dict(registry.failures) == {}
+    assert rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=registry.methods["up"]).tails[0, 2] == 1.5
+
+    # An edit to a module of the package, same size, same second: seen on the next discovery.
+    write(tmp_path / "up", "height.py", "HEIGHT = 2.0\n")
+    registry = discover(tmp_path)
+    assert rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=registry.methods["up"]).tails[0, 2] == 2.5
+
+
+def test_a_broken_module_of_a_package_fails_that_method_naming_the_file_and_line(tmp_path):
+    write_package(tmp_path, "up", package_method("up", "HEIGHT = 1.0\nraise RuntimeError('no height')\n"))
+    write_package(tmp_path, "typo", package_method("typo", "HEIGHT = (\n"))
+    write(tmp_path, "stick.py", stick_method("stick"))
+    (tmp_path / "notes").mkdir()  # a folder without __init__.py is no method
+    registry = discover(tmp_path)
+    assert list(registry.methods) == ["stick"]
+    assert registry.failures["up/"] == "RuntimeError: no height (height.py, line 2)"
+    assert registry.failures["typo/"].startswith("SyntaxError:") and "height.py" in registry.failures["typo/"]
+    assert set(registry.failures) == {"up/", "typo/"}
+
+
+def test_the_shipped_silhouette_method_is_a_package_with_a_tuning_table():
+    method = discover().methods["silhouette"]
+    assert method.__module__.endswith("methods.silhouette")
+    rows = method.tuning_type.rows()
+    assert len(rows) >= 40 and all(why for _, _, why, _ in rows)  # every tuned number says why
+    owners = {owner.__module__.rsplit(".", 1)[-1] for _, _, _, owner in rows}
+    assert owners == {"tuning", "joints", "mirror"}
+
+
+def test_tuning_is_changed_by_name_and_checked():
+    silhouette = discover().methods["silhouette"]
+    default = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES)
+    same = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=silhouette(tuning={"speck": 0.25}))
+    np.testing.assert_array_equal(same.heads, default.heads)
+    table = silhouette.tuning_type().changed(longest_bone=1, pair_prune=0.6)
+    assert (table.longest_bone, table.pair_prune) == (1, 0.6)
+    with pytest.raises(ValueError, match="unknown tuning value pair_prun of Tuning; valid: "):
+        silhouette(tuning={"pair_prun": 0.6})
+    with pytest.raises(ValueError, match="tuning value path_candidates must be a int like its default 32"):
+        silhouette.tuning_type().changed(path_candidates=2.5)
+    with pytest.raises(ValueError, match="must be a Tuning or a dict of its values"):
+        silhouette(tuning=[("speck", 1.0)])
+    with pytest.raises(ValueError, match="has no tuning to change"):
+        RigMethod(tuning={"speck": 1.0})
+
+
+def test_a_method_instance_is_run_as_it_is_and_checked():
+    class Nameless(RigMethod):
+        def rig(self, mesh):
+            pass
+
+    with pytest.raises(ValueError, match="method name must be a Python identifier"):
+        rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=Nameless())
+    skeleton = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=TemplateMethod(tuning={"margin": 0.25}), bones=2)
+    np.testing.assert_allclose(sorted([skeleton.heads[0, 1], skeleton.tails[-1, 1]]), [1.0, 3.0])
+
+
+def test_stages_must_be_typed():
+    with pytest.raises(ValueError, match="stage 'axis' is a ndarray, not a rigger.core.stages.Stage"):
+        Skeleton(["a"], [(0, 0, 0)], [(0, 0, 1)], [-1], stages={"axis": np.zeros(3)})

@@ -515,8 +515,8 @@ def test_layers_with_parts_shared_from_another_view_match_their_own():
     turned = silhouette.trace(v, t[:, ::-1], "Y")  # the same vertices, other triangles
     with pytest.raises(ValueError, match="different meshes"):
         turned.share_parts(other)
-    with pytest.raises(TypeError):
-        shared._trace.share_components(None)
+    with pytest.raises(TypeError, match="another Silhouette"):
+        shared.share_parts(None)
 
 
 def test_layers_of_open_surfaces():

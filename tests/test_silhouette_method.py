@@ -9,11 +9,13 @@ from cdt_checks import polygon_area
 from characters import strictly_inside_fraction, load_character
 from meshes import box, combine, ellipsoids, far_apart_cubes, grid_surface, uv_sphere
 from rigger import samples
-from rigger.skeletonize.bones import mirrored
+from rigger.core.joints import Cutting
+from rigger.core.mirror import Symmetry
+from rigger.methods.silhouette.bones import BoneBuilder
+from rigger.methods.silhouette.tuning import Tuning
 
 from conftest import shared_path
 from rigdata import chamfer_distance, load_obj
-from stages import lift
 
 CHARACTERS = ("humanoid", "humanoid_hips", "quadruped", "octopus", "tree", "snake")
 
@@ -68,12 +70,12 @@ def test_joints_near_the_true_skeleton(rigged):
 def test_stages_hold_every_intermediate_result(rigged):
     _, _, _, skeleton = rigged
     stages = skeleton.stages
-    for key in ("silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints", "timings", "params"):
-        assert key in stages
+    assert {"frame", "silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints"} <= set(stages)
     cdt = stages["cdt"]
-    assert len(cdt["classes"]) == len(cdt["triangles"])
-    assert set(np.unique(cdt["classes"])) <= {0, 1, 2, 3}
-    assert all(loop.shape[1] == 2 for loop in stages["silhouette"]["loops"])
+    assert len(cdt.classes) == len(cdt.triangles)
+    assert set(np.unique(cdt.classes)) <= {0, 1, 2, 3}
+    assert all(loop.shape[1] == 2 for loop in stages["silhouette"].loops)
+    assert set(skeleton.params) == {param.name for param in rigger.api.method_registry().lookup("silhouette").params}
 
 
 def test_quadruped_side_view_gets_four_legs():
@@ -103,7 +105,8 @@ def test_a_stray_loose_vertex_changes_nothing(default_rig):
     vertices, triangles, skeleton = default_rig("humanoid")
     stray = np.vstack([vertices, [vertices[:, 0].max() + 1000 * np.ptp(vertices), 0.0, 0.0]])
     with_stray = rigger.rig_mesh(stray, triangles)
-    assert with_stray.stages["mirror_plane"] == skeleton.stages["mirror_plane"]
+    planes = with_stray.stages["mirror_plane"], skeleton.stages["mirror_plane"]
+    assert (planes[0].axis, planes[0].offset) == (planes[1].axis, planes[1].offset)
     for side in (".L", ".R"):
         assert sum(n.endswith(side) for n in with_stray.names) == sum(n.endswith(side) for n in skeleton.names) > 0
     assert_same_bones(np.hstack([with_stray.heads, with_stray.tails]), skeleton, 1e-6 * np.ptp(vertices))
@@ -146,15 +149,16 @@ def assert_side_bones_paired(skeleton, min_pairs, complete=True):
     return pairs
 
 
-def assert_mirror_image_pairs(skeleton, min_pairs, atol, heads, complete=True, plane=(0, 0.0)):
-    """``assert_side_bones_paired``, and the twins' tails mirror each other across ``plane`` (axis, offset; x = 0
-    unless given) within ``atol``, and their heads too: all (``heads="all"``), or those of twins that do not hang
-    from one bone (``"off_trunk"``), or none. Returns the pairs."""
+def assert_mirror_image_pairs(skeleton, min_pairs, atol, heads, complete=True, plane=None):
+    """``assert_side_bones_paired``, and the twins' tails mirror each other across ``plane`` (a ``MirrorPlane``
+    stage; x = 0 unless given) within ``atol``, and their heads too: all (``heads="all"``), or those of twins that
+    do not hang from one bone (``"off_trunk"``), or none. Returns the pairs."""
     pairs = assert_side_bones_paired(skeleton, min_pairs, complete)
+    reflect = (lambda points: points * [-1, 1, 1]) if plane is None else plane.reflect
     for left, right in pairs:
-        np.testing.assert_allclose(mirrored(skeleton.tails[left], plane), skeleton.tails[right], atol=atol)
+        np.testing.assert_allclose(reflect(skeleton.tails[left]), skeleton.tails[right], atol=atol)
         if heads == "all" or (heads == "off_trunk" and skeleton.parents[left] != skeleton.parents[right]):
-            np.testing.assert_allclose(mirrored(skeleton.heads[left], plane), skeleton.heads[right], atol=atol)
+            np.testing.assert_allclose(reflect(skeleton.heads[left]), skeleton.heads[right], atol=atol)
     return pairs
 
 
@@ -202,7 +206,7 @@ def test_min_branch_leaves_short_spikes_without_bones():
 def test_the_hole_between_arm_and_body_is_cut():
     vertices, triangles = load_character("humanoid_hips")
     skeleton = rigger.rig_mesh(vertices, triangles, view="Y")
-    loops = skeleton.stages["silhouette"]["loops"]
+    loops = skeleton.stages["silhouette"].loops
     assert sum(1 for loop in loops if polygon_area(loop) < 0) == 2  # both holes were seen …
     assert list(skeleton.roots) == [0]  # … and the result is still a tree
 
@@ -230,15 +234,14 @@ def test_same_skeleton_at_the_ends_of_floating_point_range(default_rig, scale):
     size = np.ptp(vertices, axis=0).max()
     assert chamfer_distance(skeleton.joints() / scale, reference.joints()) / size < 0.01
     stages = skeleton.stages
-    for kind, points in (("loops", np.concatenate(stages["silhouette"]["loops"])), ("cdt", stages["cdt"]["vertices"]),
-                         ("axis", stages["axis"]["points"])):  # on the plane through the mesh, at its size
-        lifted = lift(stages, points) / scale
+    for kind, points in (("loops", np.concatenate(stages["silhouette"].loops)), ("cdt", stages["cdt"].vertices),
+                         ("axis", stages["axis"].points)):  # on the plane through the mesh, at its size
+        lifted = stages[kind if kind != "loops" else "silhouette"].frame.lift(points) / scale
         assert (lifted >= vertices.min(axis=0) - 0.01 * size).all(), kind
         assert (lifted <= vertices.max(axis=0) + 0.01 * size).all(), kind
-    np.testing.assert_allclose(stages["axis"]["radius"].max() / scale, reference.stages["axis"]["radius"].max(),
-                               rtol=0.02)
-    (axis, offset), (reference_axis, reference_offset) = stages["mirror_plane"], reference.stages["mirror_plane"]
-    assert axis == reference_axis and abs(offset / scale - reference_offset) < 0.01 * size
+    np.testing.assert_allclose(stages["axis"].radius.max() / scale, reference.stages["axis"].radius.max(), rtol=0.02)
+    plane, reference_plane = stages["mirror_plane"], reference.stages["mirror_plane"]
+    assert plane.axis == reference_plane.axis and abs(plane.offset / scale - reference_plane.offset) < 0.01 * size
 
 
 def _turned(angle, axis):
@@ -253,17 +256,18 @@ def test_a_tilted_model_seen_along_its_own_front_rigs_as_when_upright(default_ri
     """Tilted 25 degrees about the axis across its view, looked at along its own (tilted) front: the rig is the
     upright one tilted, and its stages are in world space."""
     vertices, triangles, upright = default_rig(name)
-    front = np.abs(upright.stages["view"])
+    front = np.abs(upright.stages["frame"].direction)
     across = np.roll(front, 1)  # another axis: tilting about it turns the front
     rotation = _turned(np.radians(25.0), across)
     skeleton = rigger.rig_mesh(vertices @ rotation.T, triangles, view="DIRECTION", view_direction=rotation @ front)
     assert len(skeleton) == len(upright)
     back = np.hstack([skeleton.heads, skeleton.tails]) @ np.kron(np.eye(2), rotation)
     assert_same_bones(back, upright, 1e-6 * np.ptp(vertices))
-    np.testing.assert_allclose(np.abs(skeleton.stages["view"]), np.abs(rotation @ front), atol=1e-12)
-    np.testing.assert_allclose(skeleton.stages["chains"][0] @ rotation, upright.stages["chains"][0],
+    np.testing.assert_allclose(np.abs(skeleton.stages["frame"].direction), np.abs(rotation @ front), atol=1e-12)
+    np.testing.assert_allclose(skeleton.stages["chains"].lines[0] @ rotation, upright.stages["chains"].lines[0],
                                atol=1e-6 * np.ptp(vertices))  # the trunk
-    assert np.allclose(skeleton.stages["frame"] @ skeleton.stages["frame"].T, np.eye(3))
+    axes = skeleton.stages["frame"].axes
+    assert np.allclose(axes @ axes.T, np.eye(3))
 
 
 @pytest.fixture(scope="module")
@@ -279,7 +283,7 @@ def test_a_direction_along_an_axis_is_that_axis_view(default_rig, snake_along_y,
     vertices, triangles, _ = default_rig("snake")
     skeleton = rigger.rig_mesh(vertices, triangles, view="DIRECTION", view_direction=direction)
     np.testing.assert_array_equal(skeleton.heads, snake_along_y.heads)
-    np.testing.assert_array_equal(skeleton.stages["frame"], np.eye(3))
+    np.testing.assert_array_equal(skeleton.stages["frame"].axes, np.eye(3))
 
 
 def test_a_zero_view_direction_is_refused():
@@ -332,7 +336,7 @@ def bird():
 def test_legs_hidden_under_the_body_come_from_the_perpendicular_view():
     vertices, triangles = bird()
     skeleton = rigger.rig_mesh(vertices, triangles)
-    np.testing.assert_allclose(np.abs(skeleton.stages["view"]), [0, 1, 0])  # seen from above: legs hidden
+    np.testing.assert_allclose(np.abs(skeleton.stages["frame"].direction), [0, 1, 0])  # seen from above: legs hidden
     joints = skeleton.joints()
     for foot in ((0.08, -0.55, 0.0), (-0.08, -0.55, 0.0)):
         assert np.linalg.norm(joints - foot, axis=1).min() < 0.1, f"no joint near the foot at {foot}"
@@ -353,7 +357,7 @@ def test_ears_hidden_in_the_primary_view_come_from_the_end_on_view():
     """From the side both ears are one stubby bump, pruned; the end-on view (along the body) shows two."""
     vertices, triangles = fox()
     skeleton = rigger.rig_mesh(vertices, triangles)
-    np.testing.assert_allclose(np.abs(skeleton.stages["view"]), [1, 0, 0])
+    np.testing.assert_allclose(np.abs(skeleton.stages["frame"].direction), [1, 0, 0])
     joints = skeleton.joints()
     for tip in ((0.06, 0.32, 0.5), (-0.06, 0.32, 0.5)):
         assert np.linalg.norm(joints - tip, axis=1).min() < 0.02, f"no joint near the ear tip at {tip}"
@@ -405,7 +409,7 @@ def test_stubby_arms_of_a_figure_without_a_mirror_plane_get_bones(model, hands):
     A leaf bone ends at each hand (``hands``: where, as fractions of the bounding box in x and y)."""
     vertices, triangles = load_obj(shared_path("models", "nogt", f"{model}.obj"))
     skeleton = rigger.rig_mesh(vertices, triangles)
-    assert skeleton.stages["mirror_plane"] is None
+    assert "mirror_plane" not in skeleton.stages
     low, extent = vertices.min(axis=0), np.ptp(vertices, axis=0)
     leaf_tails = skeleton.tails[[i for i in range(len(skeleton)) if not skeleton.children(i)]]
     tips = (leaf_tails[:, :2] - low[:2]) / extent[:2]
@@ -413,16 +417,24 @@ def test_stubby_arms_of_a_figure_without_a_mirror_plane_get_bones(model, hands):
         assert np.linalg.norm(tips - hand, axis=1).min() < 0.05, f"no bone ends at the hand at {hand}"
 
 
+TUNING = Tuning()
+
+
+def bone_builder(bone_length, plane=None):
+    """A ``BoneBuilder`` cutting at 40 degrees into bones ``bone_length`` long, mirroring across ``plane`` (axis,
+    offset) within 0.05."""
+    symmetry = None if plane is None else Symmetry(plane, 0.05, TUNING)
+    return BoneBuilder(Cutting(np.radians(40), bone_length, 0, TUNING), symmetry, TUNING)
+
+
 def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):
     """A box body (x in -0.5..0.5) with one bone down its middle, optionally a box hand hanging beside it across a
     gap, and ``feet`` (polylines) added as hidden limbs seen from the front; returns the builder and how many bones
     the body (and hand) got."""
-    from rigger.methods.silhouette import _BoneBuilder
-
     parts = [box((-0.5, 0, 0), (0.5, 3, 1))] + ([box((0.8, 0, 0), (1.1, 2, 1))] if hand else [])
     vertices, triangles = combine(*parts)
     sil = rigger.silhouette.trace(vertices, triangles, "Z")
-    builder = _BoneBuilder(np.radians(40), bone_length, 0, plane, 0.05)
+    builder = bone_builder(bone_length, plane)
     body = np.array([[0.0, 2.8, 0.5], [0.0, 1.5, 0.5]])
     chains = [(body, -1, np.full(2, 0.4))]
     if hand:
@@ -438,9 +450,7 @@ def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):
 def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh(foot_depth, bone_length):
     """A foot at the bottom of a body whose nearest bone is in a hand hanging beside it, across a gap: the foot
     hangs from the body's bone, farther but reached without leaving the mesh (a path that only grazes the surface
-    near the foot still counts), its chain extended back to that bone with bones no longer than ``LONGEST``."""
-    from rigger.skeletonize.bones import LONGEST
-
+    near the foot still counts), its chain extended back to that bone with bones no longer than ``longest_bone``."""
     foot = np.array([[0.3, 0.3, foot_depth], [0.3, 0.1, 0.9]])
     builder, first = _body_with_feet([foot], hand=True, bone_length=bone_length)
     heads, tails, parents = builder.arrays()
@@ -448,7 +458,7 @@ def test_a_hidden_limb_hangs_from_the_nearest_bone_it_reaches_through_the_mesh(f
     np.testing.assert_allclose(heads[first], [0.0, 1.5, 0.5])  # where the body's bone is nearest the foot
     np.testing.assert_array_equal(parents[first + 1:], np.arange(first, len(heads) - 1))  # one chain
     np.testing.assert_allclose(tails[-1], foot[-1])
-    assert np.linalg.norm(tails - heads, axis=1).max() <= LONGEST * bone_length + 1e-9
+    assert np.linalg.norm(tails - heads, axis=1).max() <= TUNING.longest_bone * bone_length + 1e-9
 
 
 def test_a_hidden_limb_near_its_bone_or_reaching_none_is_not_extended():
@@ -476,17 +486,15 @@ class EnclosesNothing:
 
 def test_a_hidden_limb_tries_paths_to_the_nearest_bones_only():
     """Among many bones none reachable within the mesh (a soup of random triangles at a small bone length has a
-    thousand): paths to the ``PATH_CANDIDATES`` nearest are tried, then the limb hangs from the nearest, met nowhere
+    thousand): paths to the ``path_candidates`` nearest are tried, then the limb hangs from the nearest, met nowhere
     in particular."""
-    from rigger.methods.silhouette import PATH_CANDIDATES, _BoneBuilder
-
-    builder = _BoneBuilder(np.radians(40), 0.1, 0, None, 0.05)
-    for k in range(PATH_CANDIDATES + 10):
+    builder = bone_builder(3.0)  # a chain 1 long gets one bone
+    for k in range(TUNING.path_candidates + 10):
         bone = np.array([[k, 1.0, 0.0], [k, 2.0, 0.0]])
-        builder._add_chain(bone, bone, -1)
+        builder.add_island(bone[0], [(bone, -1, np.zeros(2))])
     view = EnclosesNothing()
-    assert builder._attachment(np.array([20.2, 0.0, 0.0]), (view,)) == (20, None)
-    assert view.tests == PATH_CANDIDATES
+    assert builder.attachment(np.array([20.2, 0.0, 0.0]), (view,)) == (20, None)
+    assert view.tests == TUNING.path_candidates
 
 
 def test_mirror_image_hidden_limbs_get_mirror_image_bones():
@@ -546,7 +554,7 @@ def test_a_round_blob_gets_one_root_bone_through_its_middle(shape):
 
 
 def test_rig_time_is_recorded_per_stage(default_rig):
-    timings = default_rig("snake")[2].stages["timings"]
+    timings = default_rig("snake")[2].timings
     assert {"silhouette_cdt_axis", "merge_prune", "other_views", "depth_bones", "total"} <= set(timings)
     assert all(t >= 0 for t in timings.values())
 
@@ -575,7 +583,7 @@ def test_auto_view_skips_an_axis_the_mesh_shows_nothing_along():
     with pytest.raises(ValueError, match="zero area"):
         rigger.rig_mesh(vertices, triangles, view="X")
     skeleton = rigger.rig_mesh(vertices, triangles)
-    assert len(skeleton) >= 1 and skeleton.stages["view"][0] == 0
+    assert len(skeleton) >= 1 and skeleton.stages["frame"].direction[0] == 0
 
 
 def test_unknown_parameter_is_rejected():

@@ -21,7 +21,7 @@ from rigger.blender import skinning  # noqa: E402
 from rigger.blender.armature import build_armature  # noqa: E402
 from rigger.blender.meshdata import mesh_vertices, world_points  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
-from rigger.skeletonize.polyline import segment_distances  # noqa: E402
+from rigger.core.polyline import segment_distances  # noqa: E402
 
 import rigdata  # noqa: E402
 

@@ -20,7 +20,7 @@ OUT = pathlib.Path(__file__).resolve().parents[1] / "out"
 RENDER_SIZE = (960, 1080)
 BONE_WIDTH = 0.06  # octahedral bone display: the widest section's half width, in bone lengths
 BONE_COLOUR = (0.05, 0.05, 0.05, 1.0)
-HIDDEN_IN_PICTURE = {"triangulation"}
+HIDDEN_IN_PICTURE = {"cdt", "merged"}  # stages whose overlays would hide the others from the front
 SKIN_COLOUR = (0.8, 0.8, 0.8, 0.2)  # Workbench draws material alpha as transparency: the skeleton shows through
 
 

@@ -1,9 +1,10 @@
 """Regression fingerprints: does a change move any skeleton or stage by a single bit?
 
 Rigs every ``../shared`` model (``models/gt`` and ``models/nogt``) and every generated sample character under
-``SETTINGS`` and hashes each output array (dtype, shape and bytes): the bones, and every stage field except
-timings. ``--baseline`` writes the fingerprints; without it they are compared with the baseline and every differing
-field is listed (exit status 1). Run it before a change that should move nothing, then after::
+``SETTINGS`` and hashes each output array (dtype, shape and bytes): the bones, every stage field and the parameters
+(not the timings: seconds differ between runs). ``--baseline`` writes the fingerprints; without it they are compared
+with the baseline and every differing field is listed (exit status 1). Run it before a change that should move
+nothing, then after::
 
     make regress-baseline     # on the commit before the change
     make regress              # after it: "identical" or the runs and fields that differ
@@ -37,7 +38,6 @@ SETTINGS = {
     "direction": {"view": "DIRECTION", "view_direction": (0.3, 1.0, 0.2)},
     "detail": {"prune": 1.0, "min_branch": 1.0, "bone_length": 0.07, "max_chain_bones": 0, "resolution": 256},
 }
-UNTRACKED_STAGES = ("timings",)  # seconds differ between runs
 
 
 def main(argv=None):
@@ -140,20 +140,48 @@ def _fingerprint_run(run):
 
 
 def stage_fields(skeleton):
-    """(key, value) of every tracked stage field: nested dicts and lists flattened into dotted keys."""
-    def walk(prefix, value):
-        if isinstance(value, dict):
-            for key in sorted(value):
-                yield from walk(f"{prefix}.{key}", value[key])
-        elif isinstance(value, (list, tuple)) and any(isinstance(item, np.ndarray) for item in value):
-            for index, item in enumerate(value):
-                yield from walk(f"{prefix}.{index}", item)
-        else:
-            yield prefix, value
+    """(key, value) of every tracked field: each stage's ``to_dict`` and the parameters, nested dicts and lists
+    flattened into dotted keys."""
+    stages = skeleton.stages
+    if any(isinstance(stage, dict) for stage in stages.values()):
+        stages, params = _typed_shape(stages), stages.get("params", {})
+    else:
+        stages, params = {name: stage.to_dict() for name, stage in stages.items()}, skeleton.params
+    for name in sorted(stages):
+        yield from _flattened(f"stages.{name}", stages[name])
+    yield from _flattened("params", params)
 
-    for name in sorted(skeleton.stages):
-        if name not in UNTRACKED_STAGES:
-            yield from walk(f"stages.{name}", skeleton.stages[name])
+
+def _flattened(prefix, value):
+    if isinstance(value, dict):
+        for key in sorted(value):
+            yield from _flattened(f"{prefix}.{key}", value[key])
+    elif isinstance(value, (list, tuple)) and any(isinstance(item, np.ndarray) for item in value):
+        for index, item in enumerate(value):
+            yield from _flattened(f"{prefix}.{index}", item)
+    else:
+        yield prefix, value
+
+
+def _typed_shape(stages):
+    """The silhouette method's stages of the dict format before typed stages (b77701f) in the typed stages'
+    ``to_dict`` shape, so that a baseline taken before them compares with a run after."""
+    outline, axis = stages["silhouette"], stages["axis"]
+    frame = {**{key: outline[key] for key in ("origin", "u", "v", "direction", "depth")}, "axes": stages["frame"]}
+    shaped = {
+        "frame": frame,
+        "silhouette": {"frame": frame, "loops": outline["loops"]},
+        "cdt": {"frame": frame, **stages["cdt"]},
+        "axis": {"frame": frame, **axis},
+        "chains": {"lines": stages["chains"]},
+        "joints": {"points": stages["joints"]},
+        **{name: {"frame": frame, "points": axis["points"], "radius": axis["radius"], "links": stages[name]["links"]}
+           for name in ("merged", "pruned")},
+    }
+    if stages["mirror_plane"] is not None:
+        plane_axis, offset = stages["mirror_plane"]
+        shaped["mirror_plane"] = {"axis": plane_axis, "offset": offset, "normal": stages["frame"][plane_axis]}
+    return shaped
 
 
 def _digest(value):

@@ -12,7 +12,8 @@ from mathutils import Vector
 from ..api import method_registry
 from . import overlays
 from .pipeline import rig_object, skin_meshes, skin_summary
-from .properties import ARMATURE_POINTER, NO_METHOD, SETTINGS_ATTRIBUTE, overlay_visibility, param_values
+from .properties import (ARMATURE_POINTER, NO_METHOD, SETTINGS_ATTRIBUTE, note_overlays, overlay_visibility,
+                         param_values)
 
 
 def rig_targets(context):
@@ -82,6 +83,7 @@ class _RiggerOperator:
         meshes, _ = rig_targets(context)
         result = rig_object(meshes[0], method.name, params, parts=meshes[1:],
                             show_overlays=overlay_visibility(settings), progress=progress)
+        note_overlays(settings, result.skeleton.stages, result.overlays)
         seconds = sum(result.timings.values())
         names = ", ".join(mesh.name for mesh in meshes)
         replaced = " (replaced the previous rig)" if result.replaced else ""
@@ -159,6 +161,7 @@ class RIGGER_OT_clear_overlays(bpy.types.Operator):
 
     def execute(self, context):
         overlays.clear_overlays()
+        getattr(context.scene, SETTINGS_ATTRIBUTE).overlays.clear()
         self.report({'INFO'}, "Cleared the Rigger overlays")
         return {'FINISHED'}
 

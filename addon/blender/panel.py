@@ -2,7 +2,6 @@
 import bpy
 
 from ..api import method_registry
-from . import overlays
 from .operators import RIGGER_OT_clear_overlays, RIGGER_OT_rig, RIGGER_OT_rig_skin, RIGGER_OT_skin
 from .problem import SidebarPanel
 from .properties import NO_METHOD, SETTINGS_ATTRIBUTE
@@ -28,9 +27,12 @@ class RIGGER_PT_main(SidebarPanel, bpy.types.Panel):
 
         box = layout.box()
         box.label(text="Overlays", icon='OVERLAY')
-        grid = box.grid_flow(columns=2, align=True)
-        for kind, _, _ in overlays.OVERLAY_KINDS:
-            grid.prop(settings, f"show_{kind}", toggle=True)
+        if settings.overlays:
+            grid = box.grid_flow(columns=2, align=True)
+            for item in settings.overlays:
+                grid.prop(item, "shown", text=item.label, toggle=True)
+        else:
+            box.label(text="Rig a mesh to see its stages")
         box.operator(RIGGER_OT_clear_overlays.bl_idname, icon='TRASH')
 
 

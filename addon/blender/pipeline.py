@@ -19,13 +19,15 @@ METHOD_PROPERTY = "rigger_method"  # custom property on the armature: the method
 @dataclass
 class RigResult:
     """What :func:`rig_object` made: the armature object, the meshes it was made for, the skeleton (with its
-    stages), whether a previous Rigger armature was replaced, and seconds per step."""
+    stages), whether a previous Rigger armature was replaced, seconds per step, and the overlay objects by stage
+    name (none unless asked for)."""
 
     armature: bpy.types.Object
     meshes: list
     skeleton: object
     replaced: bool
     timings: dict
+    overlays: dict
 
 
 def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays=None, progress=None):
@@ -35,9 +37,10 @@ def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays
     The meshes are read as evaluated (modifiers applied, Rigger's previous armatures at rest) in world space. The new
     armature ("<mesh>_rig", identity world matrix, parented to ``obj``'s parent if it has one) goes into the first of
     the mesh's collections shown in the view layer and becomes ``rigger_armature`` of every mesh, replacing
-    (deleting) the armatures Rigger made for them before. ``show_overlays`` maps overlay kinds to visibility (None:
-    build none); ``progress(fraction)`` is called between steps. ValueError for bad meshes, methods or parameters;
-    nothing is created when rigging fails.
+    (deleting) the armatures Rigger made for them before. ``show_overlays`` maps stage names to whether their
+    overlays start shown (None: build none; a stage it does not name starts as its type says);
+    ``progress(fraction)`` is called between steps. ValueError for bad meshes, methods or parameters; nothing is
+    created when rigging fails.
     """
     report = progress or (lambda fraction: None)
     clock = StageClock()
@@ -62,11 +65,12 @@ def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays
         setattr(mesh, ARMATURE_POINTER, armature)
     clock.lap("armature")
     report(0.8)
+    drawn = {}
     if show_overlays is not None:
-        overlays.build_overlays(skeleton.stages, obj.name, visible=show_overlays)
+        drawn = overlays.build_overlays(skeleton.stages, obj.name, visible=show_overlays)
         clock.lap("overlays")
     report(1.0)
-    return RigResult(armature, meshes, skeleton, replaced, clock.laps)
+    return RigResult(armature, meshes, skeleton, replaced, clock.laps, drawn)
 
 
 @contextlib.contextmanager

@@ -2,9 +2,10 @@
 ``scene.rigger``.
 
 Every discovered method gets a PropertyGroup with one property per :class:`~rigger.core.params.Param`, reachable as
-``scene.rigger.methods.<method name>.<param name>``; ``scene.rigger.method`` picks the method, ``show_<overlay>``
-toggle the overlays. The classes are built at register time from the registry discovered then, so a method file
-added to ``methods/`` appears after the add-on is enabled again.
+``scene.rigger.methods.<method name>.<param name>``; ``scene.rigger.method`` picks the method, and
+``scene.rigger.overlays`` holds a toggle per stage the rigs drew (``scene.rigger.overlays["cdt"].shown``), added
+as overlays of new stages are built. The classes are built at register time from the registry discovered then, so
+a method added to ``methods/`` appears after the add-on is enabled again.
 """
 import bpy
 import numpy as np
@@ -58,10 +59,16 @@ def _property(param):
     return bpy.props.FloatVectorProperty(size=3, default=param.default, **bounds, **common)
 
 
-def _overlay_toggle(kind, label, description):
-    def update(settings, context):
-        overlays.set_overlay_visible(kind, getattr(settings, f"show_{kind}"))
-    return bpy.props.BoolProperty(name=label, description=description, default=True, update=update)
+def _show_overlay(item, context):
+    overlays.set_overlay_visible(item.name, item.shown)
+
+
+class RIGGER_PG_overlay(bpy.types.PropertyGroup):
+    """One overlay toggle: the stage it shows (``name``), its label, and whether it is shown"""
+
+    label: bpy.props.StringProperty(name="Label")
+    shown: bpy.props.BoolProperty(name="Shown", description="Show this stage's overlay", default=True,
+                                  update=_show_overlay)
 
 
 def make_classes(registry):
@@ -79,12 +86,11 @@ def make_classes(registry):
     settings_annotations = {
         "method": bpy.props.EnumProperty(name="Method", description="Rigging method", items=items),
         "methods": bpy.props.PointerProperty(type=methods_group),
+        "overlays": bpy.props.CollectionProperty(type=RIGGER_PG_overlay, name="Overlays"),
     }
-    for kind, label, description in overlays.OVERLAY_KINDS:
-        settings_annotations[f"show_{kind}"] = _overlay_toggle(kind, label, description)
     settings = type("RIGGER_PG_settings", (bpy.types.PropertyGroup,), {
         "__annotations__": settings_annotations, "__doc__": "Rigger settings of a scene"})
-    return [*method_groups.values(), methods_group, settings]
+    return [*method_groups.values(), methods_group, RIGGER_PG_overlay, settings]
 
 
 def attach(settings_class):
@@ -102,5 +108,15 @@ def detach():
 
 
 def overlay_visibility(settings):
-    """{overlay kind: shown?} from the scene settings."""
-    return {kind: getattr(settings, f"show_{kind}") for kind, _, _ in overlays.OVERLAY_KINDS}
+    """{stage name: shown?} from the scene settings' overlay toggles."""
+    return {item.name: item.shown for item in settings.overlays}
+
+
+def note_overlays(settings, stages, drawn):
+    """Add a toggle to the scene settings for each stage name in ``drawn`` that has none yet, labelled after its
+    stage (``stages[name]``) and shown as the overlay was built (existing toggles keep their state)."""
+    for name, obj in drawn.items():
+        if name not in settings.overlays:
+            item = settings.overlays.add()
+            item.name, item.label = name, stages[name].label or name
+            item["shown"] = not obj.hide_viewport  # set without the update: the overlay is already so

@@ -104,13 +104,13 @@ def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warn
         skinning_outcome = {"summary": skin_summary(outcomes),
                             "meshes": {name: report.as_dict() for name, report in outcomes.items()}}
         warnings += [warning for report in outcomes.values() for warning in report.warnings]
-    stages = result.skeleton.stages
-    timings = {**result.timings, **{f"method.{k}": v for k, v in stages.get("timings", {}).items()}}
+    skeleton = result.skeleton
+    timings = {**result.timings, **{f"method.{k}": v for k, v in skeleton.timings.items()}}
     return {
         "frame": frame,
         "method": result.armature.get(METHOD_PROPERTY),
-        "params": stages.get("params", {}),
-        "bones": result.skeleton.transformed(to_frame).to_dict()["bones"],
+        "params": skeleton.params,
+        "bones": skeleton.transformed(to_frame).to_dict()["bones"],
         "timings": {name: float(seconds) for name, seconds in timings.items()},
         "skinning": skinning_outcome,
         "warnings": warnings,

@@ -1,6 +1,8 @@
 """The skeleton a method returns: a validated tree of bones plus the intermediate results that produced it."""
 import numpy as np
 
+from .stages import Stage
+
 
 class Skeleton:
     """A tree of B bones, each running from a head point to a tail point.
@@ -10,14 +12,14 @@ class Skeleton:
         heads, tails: (B, 3) float64, read-only; every head differs from its tail.
         parents: (B,) int32, read-only; ``parents[i]`` is the index of bone i's parent (any other bone) or -1 for
             a root. The parent links form a forest: at least one root and no cycles.
-        stages: dict of the method's intermediate results keyed by stage name (silhouette loops, CDT triangles and
-            their classes, chordal axis, ...), free-form numpy arrays, lists and dicts in the frame the method worked
-            in. ``stages["timings"]`` maps stage names to seconds; :func:`rigger.rig_mesh` adds ``"total"`` there
-            and the resolved parameters as ``stages["params"]``. Overlays, reports and tests read stages; treat them
-            as read-only data.
+        stages: the method's intermediate results by name (``rigger.core.stages`` types: outline, triangulation,
+            chordal axis, chains, joints, ...), in world coordinates. Overlays, reports and tests read them; treat
+            them as read-only.
+        timings: seconds per step of the method; :func:`rigger.rig_mesh` adds ``"total"``.
+        params: the parameter values the method ran with (:func:`rigger.rig_mesh` fills them in).
     """
 
-    def __init__(self, names, heads, tails, parents, stages=None):
+    def __init__(self, names, heads, tails, parents, stages=None, timings=None, params=None):
         self.names = _validated_names(names)
         count = len(self.names)
         self.heads = _validated_points(heads, count, "heads")
@@ -26,7 +28,9 @@ class Skeleton:
         if zero_length.size:
             raise ValueError(f"bone {self.names[zero_length[0]]!r} has zero length (its head equals its tail)")
         self.parents = _validated_parents(parents, self.names)
-        self.stages = {} if stages is None else stages
+        self.stages = _validated_stages({} if stages is None else stages)
+        self.timings = {} if timings is None else dict(timings)
+        self.params = {} if params is None else dict(params)
 
     def __len__(self):
         return len(self.names)
@@ -55,7 +59,7 @@ class Skeleton:
     def transformed(self, matrix):
         """A copy with heads and tails mapped by the affine 4x4 ``matrix`` (e.g. world to armature-local frame).
 
-        ``stages`` is shared by reference: intermediate results stay in the frame the method worked in.
+        ``stages``, ``timings`` and ``params`` are shared by reference: the stages stay in the world's frame.
         """
         matrix = np.asarray(matrix, dtype=np.float64)
         if matrix.shape != (4, 4) or not np.isfinite(matrix).all():
@@ -65,8 +69,10 @@ class Skeleton:
         if np.linalg.det(matrix[:3, :3]) == 0:
             raise ValueError("transform is singular")
         linear, offset = matrix[:3, :3], matrix[:3, 3]
-        return Skeleton(self.names, self.heads @ linear.T + offset, self.tails @ linear.T + offset, self.parents,
-                        self.stages)
+        moved = Skeleton(self.names, self.heads @ linear.T + offset, self.tails @ linear.T + offset, self.parents,
+                         self.stages)
+        moved.timings, moved.params = self.timings, self.params
+        return moved
 
     def to_dict(self):
         """``{"bones": [{"name", "head", "tail", "parent"}, ...]}`` with plain floats and the parent's name (None
@@ -101,6 +107,17 @@ class Skeleton:
             raise ValueError(f"parent {unknown[0]!r} is not a bone of this skeleton")
         parents = [-1 if name is None else index[name] for name in parent_names]
         return cls(names, heads, tails, parents, stages)
+
+
+def _validated_stages(stages):
+    if not isinstance(stages, dict):
+        raise ValueError(f"stages must be a dict of stage name to stage, got {type(stages).__name__}")
+    for name, stage in stages.items():
+        if not isinstance(name, str) or not name:
+            raise ValueError(f"stage names must be non-empty strings, got {name!r}")
+        if not isinstance(stage, Stage):
+            raise ValueError(f"stage {name!r} is a {type(stage).__name__}, not a rigger.core.stages.Stage")
+    return stages
 
 
 def _validated_names(names):

@@ -1,4 +1,4 @@
-"""Per-stage timings, as methods report them in ``stages["timings"]`` and the Blender pipeline in its result."""
+"""Per-step timings, as methods report them in ``Skeleton.timings`` and the Blender pipeline in its result."""
 import time
 
 

@@ -5,20 +5,19 @@ two make a *terminal* triangle (a branch ends), one a *sleeve* (a branch runs th
 meet) and three an *isolated* triangle (a whole island). The axis joins the midpoints of the internal edges: a sleeve
 links its two, a junction links its three to its centre, a terminal links its one to its tip.
 
-The result is a :class:`AxisGraph`: points in the silhouette plane with the radius of the part there (half the
+The result is a :class:`ChordalAxis`: points in the silhouette plane with the radius of the part there (half the
 chord, or the junction's circumradius) and undirected links.
 """
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..core.graphs import components
+from ...core.graphs import components
+from ...core.stages import SLEEVE, TERMINAL
 
-TERMINAL, SLEEVE, JUNCTION, ISOLATED = 2, 1, 0, 3
 
-
-@dataclass
-class AxisGraph:
+@dataclass(frozen=True)
+class ChordalAxis:
     """A planar graph along the middle of a shape.
 
     Attributes:
@@ -48,13 +47,14 @@ class AxisGraph:
 
 
 def triangle_classes(tri):
-    """Class of every triangle of a ``rigger.cdt`` triangulation (TERMINAL, SLEEVE, JUNCTION or ISOLATED)."""
+    """Class of every triangle of a ``rigger.cdt`` triangulation (``core.stages``' TERMINAL, SLEEVE, JUNCTION or
+    ISOLATED): 3 minus its internal edges."""
     internal = (tri.neighbors >= 0) & ~tri.constrained
     return 3 - internal.sum(axis=1)
 
 
 def chordal_axis(tri):
-    """The chordal axis of a ``rigger.cdt.Triangulation`` made in mode ``"inside"``, as an :class:`AxisGraph`."""
+    """The chordal axis of a ``rigger.cdt.Triangulation`` made in mode ``"inside"``, as a :class:`ChordalAxis`."""
     corners = tri.vertices[tri.triangles]                       # (T, 3, 2)
     internal = (tri.neighbors >= 0) & ~tri.constrained          # (T, 3): edge opposite corner k is internal
     classes = 3 - internal.sum(axis=1)
@@ -90,7 +90,7 @@ def chordal_axis(tri):
     points = np.concatenate([edge_points, centre_points])
     radius = np.concatenate([edge_radius, centre_radius])
     junction = np.concatenate([np.zeros(len(edge_points), bool), classes[centre_tris] != TERMINAL])
-    return AxisGraph(points, radius, junction, links, components(len(points), links))
+    return ChordalAxis(points, radius, junction, links, components(len(points), links))
 
 
 def _triangle_centres(corners, classes):

@@ -10,8 +10,32 @@ edge-on) are never doubled.
 """
 import numpy as np
 
-from .depth import OCCLUSION_RATIO
-from .polyline import length, segment_distances
+from ...core.polyline import length, segment_distances
+from .depth import PlacedIsland, placed_islands
+from .tree import pruned_tree
+
+
+def hidden_limbs(sil, view, lines, rules):
+    """Limbs the primary view (``sil``) hides behind the body, from the perpendicular ``View`` ``view``'s pruned tree,
+    compared with the primary skeleton's chains ``lines``; the view's chains are placed in depth only when a leaf tip
+    lies off the primary skeleton. Its tree is pruned at ``hidden_prune`` of ``prune``, with the mirror plane when the
+    view looks across it (a wolf's ears, seen end-on, are kept as a pair)."""
+    params, tuning = rules.params, rules.tuning
+    pruning = rules.pruning(view.sil, tuning.hidden_prune * params.prune)
+    view_graph, alive, _, kept = pruned_tree(view.axis_graph, params.merge, pruning)
+    ends, count = np.unique(kept, return_counts=True)
+    tips = view_graph.points[ends[count == 1]]
+    cover = Cover(lines, view.sil.direction, tuning.hidden_reach * rules.unit)
+    if cover.covered(view.sil.lift(tips, 0.0)).all():
+        return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
+    view.sil.share_parts(sil)  # the mesh's welded parts, found once for the primary view, give the view's layers
+    limbs = []
+    # placed without the plane: only the limbs off the skeleton are kept, and add_limbs completes their mirror pairs
+    for placed in placed_islands(view.sil, view_graph, alive, kept, tuning.speck * rules.unit, tuning, None,
+                                 params.split_layers, None):
+        if isinstance(placed, PlacedIsland):
+            limbs += uncovered_limbs(placed.chains, cover, sil, pruning.min_reach, tuning)
+    return limbs
 
 
 class Cover:
@@ -34,7 +58,7 @@ class Cover:
         return _distance_to_segments(flat, self.starts[near], self.ends[near]) <= self.reach
 
 
-def uncovered_limbs(placed, cover, primary_sil, min_length):
+def uncovered_limbs(placed, cover, primary_sil, min_length, tuning):
     """The outer parts of the leaf chains in ``placed`` that the primary skeleton does not cover.
 
     Args:
@@ -45,6 +69,7 @@ def uncovered_limbs(placed, cover, primary_sil, min_length):
             through the mesh for much longer than the limb is wide (a foot under a body); a tip the primary view
             shows plainly (the edge of a thin sheet) was seen there and judged no limb.
         min_length: shorter uncovered parts are dropped.
+        tuning: the method's (``occlusion_ratio``).
 
     Returns a list of (polyline, half-widths), each starting at the node past the last one the primary skeleton
     covers.
@@ -55,7 +80,8 @@ def uncovered_limbs(placed, cover, primary_sil, min_length):
         if index in parents or len(line) < 2:
             continue
         tip = line[-1:]  # the cheap tests first: most leaf chains end on the primary skeleton
-        if cover.covered(tip)[0] or not hidden(primary_sil, tip, 2 * OCCLUSION_RATIO * float(np.median(widths)))[0]:
+        width = 2 * tuning.occlusion_ratio * float(np.median(widths))
+        if cover.covered(tip)[0] or not hidden(primary_sil, tip, width)[0]:
             continue
         covered = np.flatnonzero(cover.covered(line))
         first = int(covered[-1]) + 1 if len(covered) else 0  # not the covered node: its depth is the body's

@@ -1,17 +1,30 @@
-"""The skeleton-building steps on hand-made inputs: spur pruning, rooting a path, counting stacked parts, joints
-along a chain, the mirror plane, mirror pairs of chains and their names."""
+"""The silhouette method's steps and the core pieces it builds on, on hand-made inputs: spur pruning, rooting a path,
+counting stacked parts (``methods.silhouette``); joints along a chain, the mirror plane, mirror twins and their
+names (``core.joints``, ``core.mirror``, ``core.naming``)."""
 import numpy as np
 import pytest
 
 from meshes import box, combine
 from rigger import silhouette
 from rigger.core.arrays import column_bounds
-from rigger.skeletonize import depth
-from rigger.skeletonize.chordal import AxisGraph
-from rigger.skeletonize.bones import (bone_names, chain_joints, mirror_chain_pairs, mirror_completed, mirror_plane,
-                                     reflection_in_view, symmetric_joints)
-from rigger.skeletonize.polyline import arc_lengths, segment_distances
-from rigger.skeletonize.tree import Chain, chains_of, prune_spurs, rooted_chains
+from rigger.core.graphs import chains_of
+from rigger.core.joints import Cutting, chain_joints, symmetric_joints
+from rigger.core.mirror import Symmetry, mirror_chain_pairs, mirror_completed, mirror_plane
+from rigger.core.naming import bone_names
+from rigger.core.polyline import arc_lengths, segment_distances
+from rigger.methods.silhouette import depth
+from rigger.methods.silhouette.chordal import ChordalAxis
+from rigger.methods.silhouette.tree import Chain, Pruning, prune_spurs, rooted_chains
+from rigger.methods.silhouette.tuning import Tuning
+from rigger.methods.silhouette.views import reflection_in_view
+
+TUNING = Tuning()
+ACROSS_X = Symmetry((0, 0.0), 0.05, TUNING)  # chains mirror across x = 0 within 0.05
+
+
+def cutting(max_bones=0):
+    """Chains cut at 40 degree corners into bones 0.1 long, at most ``max_bones`` per chain (0: no limit)."""
+    return Cutting(np.radians(40), 0.1, max_bones, TUNING)
 
 
 def rooted_path(radius):
@@ -20,7 +33,7 @@ def rooted_path(radius):
     points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
     links = np.stack([np.arange(count - 1), np.arange(1, count)], axis=1)
     keys, chains = chains_of(list(range(count)), links)
-    return rooted_chains(points, keys, chains, np.asarray(radius, dtype=float))
+    return rooted_chains(points, keys, chains, np.asarray(radius, dtype=float), TUNING)
 
 
 def test_a_column_is_one_chain_from_its_thicker_end():
@@ -47,9 +60,9 @@ def test_a_wide_branch_reaching_far_is_a_limb_not_a_bump():
     nodes = np.array([(0.0, 0.0, 1.2)] + neck + legs[0] + legs[1])
     points, radius = nodes[:, :2], nodes[:, 2]
     chains = [[0] + list(range(1, 10)), [0] + list(range(10, 16)), [0] + list(range(16, 22))]
-    kept = {tuple(link) for link in prune_spurs(points, radius, chains, 1.35, 0.5, max_reach=2.5)}
+    kept = {tuple(link) for link in prune_spurs(points, radius, chains, Pruning(1.35, 0.5, max_reach=2.5))}
     assert (8, 9) in kept and len(kept) == 21
-    bumped = {tuple(link) for link in prune_spurs(points, radius, chains, 1.35, 0.5)}
+    bumped = {tuple(link) for link in prune_spurs(points, radius, chains, Pruning(1.35, 0.5))}
     assert (8, 9) not in bumped and len(bumped) == 12
 
 
@@ -72,7 +85,7 @@ def chest_with_legs(*branches, legs=(-0.5, 0.5)):
 def tips_kept(*branches, prune=1.35, legs=(-0.5, 0.5), **rules):
     """Whether each of the ``branches`` off ``chest_with_legs``' chest keeps its tip after ``prune_spurs``."""
     points, radius, chains = chest_with_legs(*branches, legs=legs)
-    links = prune_spurs(points, radius, chains, prune, **rules)
+    links = prune_spurs(points, radius, chains, Pruning(prune, **rules))
     return [chain[-1] in links for chain in chains[-len(branches):]]
 
 
@@ -145,7 +158,7 @@ def test_without_a_mirror_plane_the_two_corner_branches_at_a_limb_s_end_still_go
     corners = np.array([(3.2, 0.2, 0.12), (3.4, 0.35, 0.2), (3.2, -0.2, 0.12), (3.4, -0.35, 0.2)])
     points, radius = np.vstack([points, corners[:, :2]]), np.r_[radius, corners[:, 2]]
     chains += [[hand, len(points) - 4, len(points) - 3], [hand, len(points) - 2, len(points) - 1]]
-    links = prune_spurs(points, radius, chains, 1.35, pair_prune=0.74, local_pairs=True)
+    links = prune_spurs(points, radius, chains, Pruning(1.35, pair_prune=0.74, local_pairs=True))
     assert hand in links and len(points) - 3 not in links and len(points) - 1 not in links
 
 
@@ -154,7 +167,7 @@ def test_outline_noise_is_not_kept_for_lying_on_the_body_it_mirrors_onto():
     speck's image lies on the chest, not on a kept branch, so both go."""
     specks = [(0.5, 0.85, 0.01)], [(-0.5, 0.85, 0.01)]  # 0.99 from the chest's centre, 1.0 its radius
     points, radius, chains = chest_with_legs(*specks)
-    kept = prune_spurs(points, radius, chains, 1.35, mirror=reflect)
+    kept = prune_spurs(points, radius, chains, Pruning(1.35, mirror=reflect))
     leg, *speck_tips = (chain[-1] for chain in chains[1:])
     assert all(tip not in kept for tip in speck_tips) and leg in kept
 
@@ -169,7 +182,7 @@ def test_a_round_part_without_a_neck_is_kept():
         leg, tip = chains[1][-1], chains[2][-1]
         blobs = np.zeros(len(points), bool)
         blobs[[0, tip]] = True, is_blob
-        kept = prune_spurs(points, radius, chains, 1.35, min_reach, blobs=blobs)
+        kept = prune_spurs(points, radius, chains, Pruning(1.35, min_reach), blobs=blobs)
         assert leg in kept  # the legs are limbs whatever happens to the head
         return tip in kept
 
@@ -185,7 +198,7 @@ def test_blobs_near_the_mirror_line_are_centred_on_it():
     and every other node, stay; the graph itself is left as it was."""
     points = np.array([(0.2, 0.0), (0.6, 1.0), (0.3, 2.0), (-0.05, 3.0)])
     radius = np.array([0.5, 1.0, 0.5, 0.1])
-    graph = AxisGraph(points, radius, np.ones(4, bool), np.array([(0, 1), (1, 2), (2, 3)]), np.zeros(4, int))
+    graph = ChordalAxis(points, radius, np.ones(4, bool), np.array([(0, 1), (1, 2), (2, 3)]), np.zeros(4, int))
     centred = graph.centred_on_mirror(np.array([0, 1, 2]), reflect)
     np.testing.assert_array_equal(centred.points, [(0.0, 0.0), (0.6, 1.0), (0.3, 2.0), (-0.05, 3.0)])
     assert graph.points[0, 0] == 0.2
@@ -199,35 +212,35 @@ def layers(*intervals):
 def test_sheets_are_not_parts():
     """An open sheet hit once is a zero-thickness interval: no part for a chain to split into, unless nothing else
     is there."""
-    np.testing.assert_array_equal(depth._solid(layers((0.0, 1.0), (2.0, 2.0)), radius=0.5), layers((0.0, 1.0)))
-    np.testing.assert_array_equal(depth._solid(layers((2.0, 2.0)), radius=0.5), layers((2.0, 2.0)))
+    np.testing.assert_array_equal(depth.solid_layers(layers((0.0, 1.0), (2.0, 2.0)), 0.5, TUNING), layers((0.0, 1.0)))
+    np.testing.assert_array_equal(depth.solid_layers(layers((2.0, 2.0)), 0.5, TUNING), layers((2.0, 2.0)))
 
 
 def test_a_chain_splits_into_its_limbs_not_into_their_toes():
     """Seen from the side: the body (one part), then both legs (two), then each foot's two toes (four)."""
     node_layers = ([layers((0, 4))] * 6 + [layers((0, 1), (3, 4))] * 6
                    + [layers((0, 0.4), (0.6, 1), (3, 3.4), (3.6, 4))] * 8)
-    assert depth._layer_count(node_layers) == 2
-    assert depth._layer_count([layers((0, 1))] * 10) == 1
-    assert depth._layer_count([layers((0, 1), (3, 4))] * 10) == 2
+    assert depth.layer_count(node_layers, TUNING) == 2
+    assert depth.layer_count([layers((0, 1))] * 10, TUNING) == 1
+    assert depth.layer_count([layers((0, 1), (3, 4))] * 10, TUNING) == 2
 
 
 def test_plates_of_one_limb_are_one_part():
     """A robot's forearm seen along the view: shells and plates thinner than the arm is wide, a little apart."""
     plates = layers((0.0, 0.3), (0.35, 0.6), (0.9, 1.1))
-    np.testing.assert_array_equal(depth._parts(plates, radius=1.0), layers((0.0, 1.1)))
+    np.testing.assert_array_equal(depth.separate_parts(plates, 1.0, TUNING), layers((0.0, 1.1)))
     legs = layers((0.0, 1.0), (3.0, 4.2))
-    np.testing.assert_array_equal(depth._parts(legs, radius=1.0), legs)
-    assert depth._layer_count([depth._parts(plates, 1.0)] * 10) == 1
+    np.testing.assert_array_equal(depth.separate_parts(legs, 1.0, TUNING), legs)
+    assert depth.layer_count([depth.separate_parts(plates, 1.0, TUNING)] * 10, TUNING) == 1
 
 
 def test_a_nose_beside_a_head_is_not_a_second_head():
     """Two intervals each thicker than the part is wide, but one a fifth of the other's thickness (a nose, a brim):
     one part. Two alike (legs, fingers) stay two."""
     head = layers((0.0, 0.4), (0.6, 2.6))
-    np.testing.assert_array_equal(depth._parts(head, radius=0.4), layers((0.6, 2.6)))
+    np.testing.assert_array_equal(depth.separate_parts(head, 0.4, TUNING), layers((0.6, 2.6)))
     legs = layers((0.0, 0.8), (1.2, 2.4))
-    np.testing.assert_array_equal(depth._parts(legs, radius=0.4), legs)
+    np.testing.assert_array_equal(depth.separate_parts(legs, 0.4, TUNING), legs)
 
 
 def test_fingers_fork_off_their_arm_but_legs_split_from_the_body():
@@ -237,9 +250,9 @@ def test_fingers_fork_off_their_arm_but_legs_split_from_the_body():
     radius = np.full(20, 0.5)
     fingers = [layers((0, 0.8), (1, 1.8), (2, 2.8), (3, 3.8))] * 8
     arm = [layers((1.4, 2.4))] * 12 + fingers
-    assert depth._fork(arm, radius, 4) == 11
+    assert depth.fork_point(arm, radius, 4, TUNING) == 11
     body = [layers((0, 4))] * 6 + [layers((0, 1), (3, 4))] * 14
-    assert depth._fork(body, radius, 2) == 0
+    assert depth.fork_point(body, radius, 2, TUNING) == 0
 
 
 class FlatSilhouette:
@@ -263,7 +276,7 @@ def placed_along_x(node_layers, chains=None, side_axis=None, **options):
     count = len(node_layers)
     points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
     return depth.place_chains(FlatSilhouette(node_layers), points, np.full(count, 0.5), 0,
-                              chains or [Chain(list(range(count)), -1)], side_axis, **options)
+                              chains or [Chain(list(range(count)), -1)], TUNING, side_axis, **options)
 
 
 def test_a_forked_chain_is_one_stem_then_a_chain_per_part():
@@ -313,7 +326,7 @@ def straight(length, points=101):
 
 @pytest.mark.parametrize("length, bones", [(0.05, 1), (0.1, 1), (0.15, 2), (0.25, 3), (0.4, 4), (0.9, 4)])
 def test_a_straight_chain_gets_one_bone_per_bone_length_begun_up_to_the_limit(length, bones):
-    joints = chain_joints(straight(length), np.radians(40), bone_length=0.1, max_bones=4)
+    joints = chain_joints(straight(length), cutting(max_bones=4))
     assert len(joints) == bones + 1
     np.testing.assert_allclose(np.diff(joints[:, 0]), length / bones)  # evenly cut
 
@@ -321,14 +334,14 @@ def test_a_straight_chain_gets_one_bone_per_bone_length_begun_up_to_the_limit(le
 def test_a_finger_gets_two_bones_a_short_link_one():
     """A leaf chain (a finger) half a bone long or more gets two bones, as artists give it; a link between two
     branch points that short gets one, and a stub of a leaf one."""
-    assert len(chain_joints(straight(0.07), np.radians(40), bone_length=0.1, max_bones=4, leaf=True)) == 3
-    assert len(chain_joints(straight(0.07), np.radians(40), bone_length=0.1, max_bones=4)) == 2
-    assert len(chain_joints(straight(0.04), np.radians(40), bone_length=0.1, max_bones=4, leaf=True)) == 2
+    assert len(chain_joints(straight(0.07), cutting(max_bones=4), leaf=True)) == 3
+    assert len(chain_joints(straight(0.07), cutting(max_bones=4))) == 2
+    assert len(chain_joints(straight(0.04), cutting(max_bones=4), leaf=True)) == 2
 
 
 def test_corners_get_joints_even_beyond_the_limit():
     zigzag = np.array([[0, 0, 0], [0.2, 0, 0], [0.2, 0.2, 0], [0.4, 0.2, 0], [0.4, 0.4, 0]], dtype=float)
-    joints = chain_joints(zigzag, np.radians(40), bone_length=0.1, max_bones=2)
+    joints = chain_joints(zigzag, cutting(max_bones=2))
     for corner in zigzag[1:-1]:
         assert np.linalg.norm(joints - corner, axis=1).min() < 1e-9
     assert np.linalg.norm(np.diff(joints, axis=0), axis=1).min() >= 0.035 - 1e-9  # no stub bones
@@ -344,10 +357,10 @@ def test_wiggles_within_the_part_place_joints_but_add_no_bones():
     """A wing whose axis wiggles by less than its half-width (feathers): one bone per bone length begun, not one
     per wiggle; a snake bending farther than its half-width gets a joint at every bend, beyond the limit."""
     wing = wave(0.4, 0.008, 6)
-    joints = chain_joints(wing, np.radians(40), bone_length=0.1, widths=np.full(401, 0.012))
+    joints = chain_joints(wing, cutting(), widths=np.full(401, 0.012))
     assert len(joints) - 1 == np.ceil(arc_lengths(wing)[-1] / 0.1) == 5
     snake = wave(0.4, 0.03, 6)
-    joints = chain_joints(snake, np.radians(40), bone_length=0.1, max_bones=4, widths=np.full(401, 0.01))
+    joints = chain_joints(snake, cutting(max_bones=4), widths=np.full(401, 0.01))
     assert len(joints) - 1 > 4
     for crest in np.flatnonzero(np.abs(snake[:, 1]) >= 0.03 - 1e-12)[1:-1]:
         assert np.linalg.norm(joints - snake[crest], axis=1).min() <= 0.35 * 0.1
@@ -358,14 +371,14 @@ def test_a_line_jittering_in_depth_gets_no_stub_bones():
     shrink to stubs there."""
     line = straight(0.4)
     line[45:55:2, 2] = 0.03  # every other point 0.03 off: many short corners within a tenth of a bone
-    joints = chain_joints(line, np.radians(40), bone_length=0.1, max_bones=4, widths=np.full(len(line), 0.01))
+    joints = chain_joints(line, cutting(max_bones=4), widths=np.full(len(line), 0.01))
     assert np.linalg.norm(np.diff(joints, axis=0), axis=1).min() >= 0.035 - 1e-9
 
 
 class FixedSide:
     """A stand-in for ``SideAxis`` that puts every occluded node at depth 0 (the body's middle)."""
 
-    def depth_at(self, point, radius, interval, previous):
+    def depth_at(self, point, radius, interval, previous, width_cost):
         return 0.0
 
 
@@ -376,10 +389,10 @@ def test_one_node_seeing_two_legs_as_one_part_is_a_slip_not_an_occlusion():
     leg, merged = layers((2.5, 3.5)), layers((-3.5, 3.5))
     points, radius = np.zeros((9, 2)), np.full(9, 0.5)
     slip = [leg] * 4 + [merged] + [leg] * 4
-    depths = depth._resolve_occlusion(sil, points, radius, slip, np.full(9, 3.0), FixedSide())
+    depths = depth.resolve_occlusion(sil, points, radius, slip, np.full(9, 3.0), FixedSide(), TUNING)
     np.testing.assert_array_equal(depths, 3.0)
     occluded = [leg] * 3 + [merged] * 3 + [leg] * 3
-    depths = depth._resolve_occlusion(sil, points, radius, occluded, np.full(9, 3.0), FixedSide())
+    depths = depth.resolve_occlusion(sil, points, radius, occluded, np.full(9, 3.0), FixedSide(), TUNING)
     np.testing.assert_array_equal(depths, [3, 3, 3, 0, 0, 0, 3, 3, 3])
 
 
@@ -403,7 +416,7 @@ def test_mirror_pair_chains_get_mirror_image_joints():
     spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     lines = [spine, left, right, leg, stepping]
     joints = [spine, left + [0, 0.02, 0], right + [0.01, -0.02, 0], leg, stepping]
-    result = symmetric_joints(joints, lines, (0, 0.0), 0.05, None, leaves=[True] * 5)  # equal counts: no recount
+    result = symmetric_joints(joints, lines, ACROSS_X, None, leaves=[True] * 5, tuning=TUNING)  # no recount needed
     np.testing.assert_allclose(result[1][0], joints[1][0])  # first joints stay where the chains attach
     np.testing.assert_allclose(result[2][0], joints[2][0])
     np.testing.assert_allclose(result[1][1:], (left + [-0.005, 0, 0])[1:], atol=1e-12)
@@ -414,8 +427,7 @@ def test_mirror_pair_chains_get_mirror_image_joints():
 
 def recounter(lines):
     """``symmetric_joints``' recount for chains ``lines`` at a bone length of 0.1."""
-    return lambda chain, max_bones, min_bones: chain_joints(lines[chain], np.radians(40), 0.1, max_bones,
-                                                            min_bones=min_bones)
+    return lambda chain, max_bones, min_bones: chain_joints(lines[chain], cutting(max_bones), min_bones=min_bones)
 
 
 def twins(lines, max_bones, leaves=(True, True)):
@@ -423,7 +435,7 @@ def twins(lines, max_bones, leaves=(True, True)):
     of chains ``lines`` across x = 0, tolerance 0.05, bone length 0.1."""
     recount = recounter(lines)
     joints = [recount(chain, bones, 0) for chain, bones in enumerate(max_bones)]
-    return joints, symmetric_joints(joints, lines, (0, 0.0), 0.05, recount, leaves=list(leaves))
+    return joints, symmetric_joints(joints, lines, ACROSS_X, recount, leaves=list(leaves), tuning=TUNING)
 
 
 def test_a_mirror_pair_gets_one_bone_count_so_every_bone_has_a_twin():
@@ -470,8 +482,8 @@ def test_twins_whose_recount_overshoots_still_get_one_count():
         return straight(0.1 * bones, bones + 1) * [1 - 2 * chain, 1, 1]
 
     lines = [straight(0.5), straight(-0.5)]
-    result = symmetric_joints([recount(0, 4, 0), recount(1, 2, 0)], lines, (0, 0.0), 0.05, recount,
-                              leaves=[True, True])
+    result = symmetric_joints([recount(0, 4, 0), recount(1, 2, 0)], lines, ACROSS_X, recount, leaves=[True, True],
+                              tuning=TUNING)
     assert len(result[0]) == len(result[1]) == 6
     assert asked[2:] == [(0, 3, 0), (1, 4, 4), (0, 5, 5)]
 
@@ -482,13 +494,13 @@ def test_whole_twins_pair_before_partial_ones():
     arm = np.array([[0.1, 1.0, 0.0], [0.5, 1.0, 0.0], [0.9, 1.0, 0.0]])
     stub = np.array([[0.1, 1.0, 0.0], [0.12, 1.0, 0.0]])
     spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
-    assert mirror_chain_pairs([spine, stub, arm * [-1, 1, 1], arm], (0, 0.0), 0.05) == [(2, 3)]
-    assert mirror_chain_pairs([spine, arm, stub, arm * [-1, 1, 1]], (0, 0.0), 0.05) == [(1, 3)]
+    assert mirror_chain_pairs([spine, stub, arm * [-1, 1, 1], arm], ACROSS_X) == [(2, 3)]
+    assert mirror_chain_pairs([spine, arm, stub, arm * [-1, 1, 1]], ACROSS_X) == [(1, 3)]
 
 
 def test_min_bones_overrides_the_limit():
     """A mirror twin's count wins over ``max_bones``."""
-    assert len(chain_joints(straight(0.07), np.radians(40), bone_length=0.1, max_bones=1, min_bones=3)) == 4
+    assert len(chain_joints(straight(0.07), cutting(max_bones=1), min_bones=3)) == 4
 
 
 def test_an_arm_whose_twin_reaches_into_the_hand_is_still_its_twin():
@@ -501,8 +513,8 @@ def test_an_arm_whose_twin_reaches_into_the_hand_is_still_its_twin():
     spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     paired = ["trunk.00", "limb01.00.L", "limb01.01.L", "limb01.00.R", "limb01.01.R"]
     for left, right in ((arm, into_hand), (into_hand * [-1, 1, 1], arm * [-1, 1, 1])):
-        assert bone_names([0, 1, 1, 2, 2], [0, 0, 1, 0, 1], [spine, left, right], (0, 0.0), 0.05) == paired
-    names = bone_names([0, 1, 1, 2, 2], [0, 0, 1, 0, 1], [spine, arm, raised], (0, 0.0), 0.05)
+        assert bone_names([0, 1, 1, 2, 2], [0, 0, 1, 0, 1], [spine, left, right], ACROSS_X) == paired
+    names = bone_names([0, 1, 1, 2, 2], [0, 0, 1, 0, 1], [spine, arm, raised], ACROSS_X)
     assert names == ["trunk.00", "limb01.00.L", "limb01.01.L", "limb02.00.R", "limb02.01.R"]
 
 
@@ -511,7 +523,7 @@ def test_legs_from_the_middle_of_the_hips_are_named_for_the_side_their_feet_are_
     leg; a trunk that leans off the plane at its tip, with no twin, stays unsided."""
     spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.08, 2.0, 0.0]])  # leaning: its tip is off the plane
     leg = np.array([[0.0, 0.0, 0.0], [0.02, -0.5, 0.0], [0.12, -1.0, 0.0]])  # on the plane on average, tip off it
-    names = bone_names([0, 0, 1, 1, 2, 2], [0, 1, 0, 1, 0, 1], [spine, leg, leg * [-1, 1, 1]], (0, 0.0), 0.05)
+    names = bone_names([0, 0, 1, 1, 2, 2], [0, 1, 0, 1, 0, 1], [spine, leg, leg * [-1, 1, 1]], ACROSS_X)
     assert names == ["trunk.00", "trunk.01", "limb01.00.L", "limb01.01.L", "limb01.00.R", "limb01.01.R"]
 
 
@@ -525,19 +537,19 @@ def test_a_limb_that_its_longer_twins_image_covers_becomes_that_image():
     stub = np.array([[-0.1, 1.0, 0.08], [-0.28, 1.09, 0.0]])
     bent = np.array([[-0.1, 1.0, 0.0], [-0.25, 1.16, 0.0], [-0.48, 1.28, 0.0]])
     for short in (stub, bent):
-        limbs = mirror_completed([(ear, widths), (short, widths[:len(short)])], (0, 0.0), 0.05)
+        limbs = mirror_completed([(ear, widths), (short, widths[:len(short)])], ACROSS_X)
         assert limbs[0][0] is ear
         np.testing.assert_array_equal(limbs[1][0], ear * [-1, 1, 1])
         np.testing.assert_array_equal(limbs[1][1], widths)
     twin = ear * [-1, 1, 1] + [0, 0, 0.02]
     elsewhere = np.array([[-0.1, 1.0, 0.0], [-0.3, 0.7, 0.0]])
     for other in (twin, elsewhere):
-        assert mirror_completed([(ear, widths), (other, widths)], (0, 0.0), 0.05)[1][0] is other
-    one_twin = mirror_completed([(ear, widths), (stub, widths[:2]), (bent, widths)], (0, 0.0), 0.05)
+        assert mirror_completed([(ear, widths), (other, widths)], ACROSS_X)[1][0] is other
+    one_twin = mirror_completed([(ear, widths), (stub, widths[:2]), (bent, widths)], ACROSS_X)
     assert one_twin[1][0] is stub and one_twin[2][0] is not bent  # the ear's image replaces the limb it fits best
     leg = np.array([[0.12, 0.95, 0.0], [0.2, 1.03, 0.0]])  # short, beside the ear: its own twin fits it better
     pair = [(leg, widths[:2]), (leg * [-1, 1, 1], widths[:2])]
-    limbs = mirror_completed([(ear, widths), (twin, widths)] + pair, (0, 0.0), 0.05)
+    limbs = mirror_completed([(ear, widths), (twin, widths)] + pair, ACROSS_X)
     assert all(got is kept for (got, _), (kept, _) in zip(limbs[2:], pair))
 
 
@@ -547,7 +559,7 @@ def test_a_flat_mesh_is_not_mirrored_across_its_own_plane():
     def plane(outline):
         points = np.array([(x, y, 0.0) for x, y in outline], dtype=float)
         points = np.concatenate([points + [dx, dy, 0.0] for dx in (0, 0.01) for dy in (0, 0.01)])
-        return mirror_plane(points, column_bounds(points), 0.02)
+        return mirror_plane(points, column_bounds(points), 0.02, TUNING)
 
     t_shape = [(x, 1.0) for x in np.linspace(-1, 1, 21)] + [(0.0, y) for y in np.linspace(-1, 1, 21)]
     l_shape = [(x, -1.0) for x in np.linspace(0, 1, 21)] + [(0.0, y) for y in np.linspace(-1, 1, 21)]
@@ -566,8 +578,8 @@ def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_
         sil = traces[view]
         outline = np.concatenate(sil.loops)
         starts, ends = outline, np.concatenate([np.roll(loop, -1, axis=0) for loop in sil.loops])
-        image = reflection_in_view(sil, (0, 2.0))(outline)
+        image = reflection_in_view(sil, (0, 2.0), TUNING)(outline)
         assert segment_distances(image, starts, ends).min(axis=1).max() < sil.cell  # onto the outline
         assert np.abs(image - outline).max() > 1  # and moved
-    assert reflection_in_view(traces["X"], (0, 2.0)) is None
-    assert reflection_in_view(traces["Y"], None) is None
+    assert reflection_in_view(traces["X"], (0, 2.0), TUNING) is None
+    assert reflection_in_view(traces["Y"], None, TUNING) is None

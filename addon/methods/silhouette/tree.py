@@ -3,27 +3,19 @@
 A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch points). The steps:
 
 1. Blob merging (Pan's "merge the triangles that lie within one maximal inscribed disc"): every junction, largest
-   first, swallows the axis nodes it reaches without leaving its disc. A round head or belly thus becomes one node
-   instead of a tree of spurious little branches.
-2. Spur pruning: a branch that pokes out of the disc it hangs on by less than ``prune`` times its own width is a
-   bump or outline noise, not a limb; it is removed, repeatedly, since removing one can expose another. A branch
-   reaching far enough is kept however wide, and so is one ending in a round part of its own (a head without a
-   neck), one whose mirror image is kept, or a mirror pair of stubbier ones (two ears); on a mesh without a mirror
-   plane, a pair of stubbier ones alike in size (a hand-made figure's arms).
-3. Rooting at the most central branch point (smallest largest distance to any end), then cutting every cycle (holes
-   in the silhouette) where the two ways around it from the root meet. A path without branch points is rooted at
-   its widest node, or at its thicker end when it is about equally wide throughout.
+   first, swallows the axis nodes it reaches without leaving its disc, so a round head becomes one node.
+2. Spur pruning (``prune_spurs``): branches that are bumps or outline noise go, repeatedly, since removing one can
+   expose another.
+3. Rooting at the most central branch point, then cutting every cycle (holes in the silhouette) where the two ways
+   around it from the root meet.
 """
-import heapq
 from dataclasses import dataclass
 
 import numpy as np
 
-from .polyline import arc_lengths, length
-
-UNIFORM = 1.25  # a path whose widest node is at most this many times its median width is a column, not a body
-LOCAL_PAIR = 1.5  # spurs off one base are a pair when (ratio of their reaches) x (ratio of their widths) <= this
-ROUND_TIP = 0.7  # a spur ending in a blob at least this share of its base's width, outside the base's disc, is a part
+from ...core.graphs import chains_of, links_of, neighbour_lists, shortest_paths
+from ...core.polyline import arc_lengths, length
+from .tuning import Tuning
 
 
 @dataclass
@@ -42,7 +34,7 @@ def merge_discs(points, radius, junction, links, scale=1.0):
     between representatives (no self-links, no duplicates).
     """
     count = len(points)
-    neighbours = _adjacency(count, links)
+    neighbours = neighbour_lists(count, links)
     owner = np.full(count, -1, dtype=np.int64)
     for centre in np.flatnonzero(junction)[np.argsort(-radius[junction], kind="stable")]:
         if owner[centre] >= 0:
@@ -63,62 +55,83 @@ def merge_discs(points, radius, junction, links, scale=1.0):
     return representative, merged
 
 
-def chains_of(nodes, links):
-    """Split the graph on ``nodes`` into chains between key nodes (degree other than 2). Returns (keys, chains)
-    with chains as node lists; a cycle without key node is opened at its lowest node."""
-    neighbours = {n: [] for n in nodes}
-    for a, b in links.tolist():
-        neighbours[a].append(b)
-        neighbours[b].append(a)
-    keys = {n for n, adj in neighbours.items() if len(adj) != 2}
-    arrived = set()  # (key, node before it) of every chain walked: its far end, not to be walked back
-    chains = []
-    for start in sorted(keys):
-        for first in neighbours[start]:
-            if (start, first) not in arrived:
-                chains.append(_walk(start, first, neighbours, keys, arrived))
-    walked = {n for chain in chains for n in chain}
-    for start in sorted(neighbours):  # pure cycles
-        if start not in keys and start not in walked:
-            keys.add(start)
-            chain = _walk(start, neighbours[start][0], neighbours, keys, arrived)
-            walked.update(chain)
-            chains.append(chain)
-    return keys, chains
+@dataclass(frozen=True)
+class Pruning:
+    """What spur pruning keeps in one view (``prune_spurs``).
+
+    Attributes:
+        prune: a branch sticking out of its base's disc by at most this many times its width is a bump ...
+        min_reach: ... and so is one sticking out by at most this (mesh units), however thin ...
+        max_reach: ... but never one reaching this far (mesh units): a cow's short thick neck with its head.
+        pair_prune: two twin spurs sticking out more than this many times their width (and ``min_reach``) stay;
+            None: spurs never pair.
+        mirror: a function reflecting (P, 2) points of the view across the mesh's mirror plane, or None.
+        local_pairs: without a mirror plane, pair spurs alike in size (``_local_pairs``).
+        tuning: the method's tuning (``round_tip``, ``local_pair``, ``width_nodes``).
+    """
+
+    prune: float
+    min_reach: float = 0.0
+    max_reach: float = np.inf
+    pair_prune: float = None
+    mirror: object = None
+    local_pairs: bool = False
+    tuning: Tuning = Tuning()
 
 
-def _walk(start, first, neighbours, keys, arrived):
-    path = [start, first]
-    before, here = start, first
-    while here not in keys:
-        a, b = neighbours[here]
-        before, here = here, (a if a != before else b)
-        path.append(here)
-    arrived.add((here, before))
-    return path
+def pruned_tree(graph, merge, pruning):
+    """Blob merging (discs grown ``merge`` times) and spur pruning (``pruning``) of a ``ChordalAxis``, its junctions
+    being the blobs that keep a spur ending in one. Returns (graph, alive nodes, merged links, kept links): with a
+    mirror, the graph whose blobs near the mirror line are centred on it (``ChordalAxis.centred_on_mirror``), which
+    the stages show and the bones follow."""
+    representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
+    alive = np.unique(representative)
+    if pruning.mirror is not None:
+        graph = graph.centred_on_mirror(alive[graph.junction[alive]], pruning.mirror)
+    _, chains = chains_of(alive.tolist(), merged)
+    return graph, alive, merged, prune_spurs(graph.points, graph.radius, chains, pruning, blobs=graph.junction)
 
 
-def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, mirror=None, blobs=None,
-                pair_prune=None, local_pairs=False):
-    """Drop leaf chains that stick out of the disc of the node they hang on by less than ``prune`` times their own
-    width, or by less than ``min_reach``, but never by ``max_reach`` or more, until none does. ``chains`` are node
-    lists; returns the surviving links.
+def removed_links(before, after):
+    """The links of ``before`` that ``after`` lacks, each as sorted node pairs."""
+    kept = set(map(tuple, np.sort(after, axis=1).tolist())) if len(after) else set()
+    gone = [pair for pair in np.sort(before, axis=1).tolist() if tuple(pair) not in kept]
+    return np.array(gone, dtype=np.int64).reshape(-1, 2)
+
+
+def islands(graph, alive, links):
+    """(nodes, links, size) per island of the live nodes ``alive`` joined by ``links``, the largest (most axis
+    length) first."""
+    result = []
+    node_island = graph.island[alive]
+    link_island = graph.island[links[:, 0]] if len(links) else np.zeros(0, graph.island.dtype)  # links join live nodes
+    for island in np.unique(node_island):
+        nodes = alive[node_island == island]
+        sub = links[link_island == island]
+        size = float(np.linalg.norm(graph.points[sub[:, 0]] - graph.points[sub[:, 1]], axis=1).sum())
+        size += float(graph.radius[nodes].max())
+        result.append((size, nodes.tolist(), sub))
+    result.sort(key=lambda item: -item[0])
+    return [(nodes, sub, size) for size, nodes, sub in result]
+
+
+def prune_spurs(points, radius, chains, pruning, blobs=None):
+    """Drop leaf chains (``chains``: node lists) that are bumps by the rules of ``pruning``, until none is; returns
+    the surviving links.
 
     A limb is long for its width where it leaves the base (a leg, a finger, a tail, a neck with its head) while
-    outline noise and bumps (an ear on a round head, a belly) are not, whatever their size, up to ``max_reach``: a
-    part reaching that far needs bones of its own however wide it is (a cow's short thick neck with its head).
+    outline noise and bumps (an ear on a round head, a belly) are not, whatever their size, up to ``max_reach``.
     With ``blobs``, a (n,) mask of the nodes that stand for a round part (junctions, which swallow the axis within
-    their disc), a spur reaching ``min_reach`` and ending in one whose centre lies outside the base's disc and
-    whose width is at least ``ROUND_TIP`` times the base's is kept: a gingerbread man's head sits on its shoulders
-    without a neck, and a cartoon's round feet hang straight off its hips.
-    With ``mirror``, a function reflecting (P, 2) points across the mesh's mirror plane, a spur whose mirror image
-    is a branch kept off the same base stays too: a figure's two arms off its chest, each near the threshold, are
-    kept or dropped together. With ``pair_prune`` as well, two spurs off one base that mirror each other and stick
-    out by more than ``min_reach`` and ``pair_prune`` times their width both stay: a pair is a limb where a lone
-    bump of that size is not (a dog's two ears on its head; outline noise is not symmetric). With ``pair_prune`` and
-    ``local_pairs`` instead (a mesh without a mirror plane), two such spurs off one base that stick out about as far
-    and are about as wide both stay (``_local_pairs``).
+    their disc), a spur reaching ``min_reach`` and ending in one whose centre lies off the base's disc and whose
+    width is at least ``round_tip`` times the base's is kept: a gingerbread man's head sits on its shoulders without
+    a neck. With a ``mirror``, a spur whose mirror image is a branch kept off the same base stays too (a figure's two
+    arms, each near the threshold, are kept or dropped together), and with ``pair_prune`` two spurs off one base
+    that mirror each other stay: a pair is a limb where a lone bump of that size is not (a dog's ears; outline noise
+    is not symmetric). With ``pair_prune`` and ``local_pairs`` instead, two such spurs off one base that stick out
+    about as far and are about as wide stay (``_local_pairs``).
     """
+    prune, min_reach, max_reach, pair_prune = pruning.prune, pruning.min_reach, pruning.max_reach, pruning.pair_prune
+    tuning = pruning.tuning
     chains = [list(c) for c in chains]
     dropped = []  # with local_pairs, the pairable spurs removed so far (``pairable`` entries below)
     while True:
@@ -138,9 +151,10 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
                     # width where the branch leaves the base disc: a neck, not the head it carries
                     ordered = np.array(chain if chain[0] == base else chain[::-1])
                     outside = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]]
-                    width = 2 * float(radius[outside[:3]].mean()) if len(outside) else 2 * float(radius[tip])
+                    width = 2 * float(radius[outside[:tuning.width_nodes]].mean()) if len(outside) else (
+                        2 * float(radius[tip]))
                     bump = beyond <= prune * width and not (  # the round-part test only where it can matter
-                        blobs is not None and _round_part(apart, radius, blobs, base, tip))
+                        blobs is not None and _round_part(apart, radius, blobs, base, tip, tuning.round_tip))
                     spur = beyond < max_reach and (beyond <= min_reach or bump)
                     may_pair = spur and pair_prune is not None and beyond > max(min_reach, pair_prune * width)
                     if spur:
@@ -150,24 +164,26 @@ def prune_spurs(points, radius, chains, prune, min_reach=0.0, max_reach=np.inf, 
                     if may_pair or not spur:
                         leaves.append((i, base, outside))
                     break
-        if spurs and mirror is not None:
-            spurs = _unmirrored(spurs, pairable, leaves, points, radius, mirror)
+        if spurs and pruning.mirror is not None:
+            spurs = _unmirrored(spurs, pairable, leaves, points, radius, pruning.mirror)
         if not spurs:
-            links = _links_of(chains)
-            return np.vstack([links, _links_of(_local_pairs(dropped, links, points))]) if dropped else links
-        if local_pairs:
+            links = links_of(chains)
+            if not dropped:
+                return links
+            return np.vstack([links, links_of(_local_pairs(dropped, links, points, tuning.local_pair))])
+        if pruning.local_pairs:
             dropped += [pairable[i] for i in spurs if i in pairable]
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
         kept = [c for i, c in enumerate(chains) if i not in spurs]
         if not kept:
             return np.zeros((0, 2), dtype=np.int64)
-        _, chains = chains_of(sorted({n for c in kept for n in c}), _links_of(kept))
+        _, chains = chains_of(sorted({n for c in kept for n in c}), links_of(kept))
 
 
-def _round_part(apart, radius, blobs, base, tip):
-    """Whether leaf node ``tip``, ``apart`` from ``base``, is a blob as wide as a part of its own, lying off the disc
-    of ``base``."""
-    return bool(blobs[tip]) and radius[tip] >= ROUND_TIP * radius[base] and apart > radius[base]
+def _round_part(apart, radius, blobs, base, tip, round_tip):
+    """Whether leaf node ``tip``, ``apart`` from ``base``, is a blob at least ``round_tip`` as wide as the base (a
+    part of its own), lying off the disc of ``base``."""
+    return bool(blobs[tip]) and radius[tip] >= round_tip * radius[base] and apart > radius[base]
 
 
 def _unmirrored(spurs, pairable, leaves, points, radius, mirror):
@@ -192,11 +208,11 @@ def _unmirrored(spurs, pairable, leaves, points, radius, mirror):
         chain not in spurs or (i in pairable and i in lying_on[chain]) for chain in twins)}
 
 
-def _local_pairs(dropped, links, points):
+def _local_pairs(dropped, links, points, most_unlike):
     """Node lists of the spurs among ``dropped`` ((base, nodes from base to tip, reach, width) each, pruned although
     they stick out enough to be limbs in a pair) that pair up off a base the kept tree (``links``) still runs through
     (two links at least: not the end a limb's two corner branches forked from): the ratio of their reaches times the
-    ratio of their widths at most ``LOCAL_PAIR``, their tips farther apart than either is wide, the most alike paired
+    ratio of their widths at most ``most_unlike``, their tips farther apart than either is wide, the most alike paired
     first. A hand-made figure's two stubby arms or ears are never exact mirror images, while outline noise does not
     come in such pairs."""
     degree = np.bincount(links.ravel(), minlength=len(points))
@@ -212,7 +228,7 @@ def _local_pairs(dropped, links, points):
                 (_, nodes_a, reach_a, width_a), (_, nodes_b, reach_b, width_b) = spurs[a], spurs[b]
                 unlike = max(reach_a / reach_b, reach_b / reach_a) * max(width_a / width_b, width_b / width_a)
                 apart = np.linalg.norm(points[nodes_a[-1]] - points[nodes_b[-1]])
-                if unlike <= LOCAL_PAIR and apart > max(width_a, width_b):
+                if unlike <= most_unlike and apart > max(width_a, width_b):
                     pairs.append((unlike, a, b))
         used = set()
         for _, a, b in sorted(pairs):
@@ -222,14 +238,9 @@ def _local_pairs(dropped, links, points):
     return restored
 
 
-def _links_of(chains):
-    pairs = [(c[i], c[i + 1]) for c in chains for i in range(len(c) - 1)]
-    return np.array(pairs, dtype=np.int64).reshape(-1, 2)
-
-
-def rooted_chains(points, keys, chains, radius):
-    """Root the chain graph at its most central branch point and cut its cycles; returns (root, [Chain])
-    ordered parents first."""
+def rooted_chains(points, keys, chains, radius, tuning):
+    """Root the chain graph at its most central branch point (smallest largest distance to any end) and cut its
+    cycles; returns (root, [Chain]) ordered parents first. A graph without branch points: ``_root_single_path``."""
     lengths = [length(points[c]) for c in chains]
     adjacency = {}
     for i, c in enumerate(chains):
@@ -237,10 +248,10 @@ def rooted_chains(points, keys, chains, radius):
         adjacency.setdefault(c[-1], []).append((c[0], i))
     branch_points = [k for k in keys if len(adjacency.get(k, ())) >= 3]
     if branch_points:
-        root = min(branch_points, key=lambda k: (max(_distances(k, adjacency, lengths).values()), -radius[k]))
+        root = min(branch_points, key=lambda k: (max(shortest_paths(k, adjacency, lengths)[0].values()), -radius[k]))
     else:
-        return _root_single_path(chains, keys, radius)
-    dist, via = _shortest_paths(root, adjacency, lengths)
+        return _root_single_path(chains, keys, radius, tuning)
+    dist, via = shortest_paths(root, adjacency, lengths)
     tree = set(via.values())
     ordered = []
     chain_of_end = {}
@@ -264,47 +275,17 @@ def rooted_chains(points, keys, chains, radius):
     return root, ordered
 
 
-def _root_single_path(chains, keys, radius):
+def _root_single_path(chains, keys, radius, tuning):
     """A graph without branch points is one path. Root it at its widest node, the body (a bird with spread wings,
     a fish), with a chain each way; a path about as wide everywhere (a column, a tentacle) is rooted at its thicker
     end instead, one chain from its base, as an artist would rig it."""
     nodes = chains[0] if chains else sorted(keys)
     width = radius[nodes]
-    quarter = max(1, len(nodes) // 4)  # the very ends taper to a point whatever the part's width
-    if width.max() <= UNIFORM * np.median(width):
+    quarter = max(1, len(nodes) // tuning.end_share)  # the very ends taper to a point whatever the part's width
+    if width.max() <= tuning.uniform * np.median(width):
         if width[-quarter:].mean() > width[:quarter].mean():
             nodes = nodes[::-1]
         return nodes[0], [Chain(list(nodes), -1)] if len(nodes) > 1 else []
     middle = int(np.argmax(width))
     halves = [nodes[middle:], nodes[:middle + 1][::-1]]
     return nodes[middle], [Chain(h, -1) for h in halves if len(h) > 1]
-
-
-def _distances(source, adjacency, lengths):
-    return _shortest_paths(source, adjacency, lengths)[0]
-
-
-def _shortest_paths(source, adjacency, lengths):
-    """Dijkstra over the chain graph: distance to every key node and the chain each was reached through."""
-    dist = {source: 0.0}
-    via = {}
-    heap = [(0.0, source)]
-    while heap:
-        d, node = heapq.heappop(heap)
-        if d > dist[node]:
-            continue
-        for other, chain in adjacency.get(node, ()):
-            nd = d + lengths[chain]
-            if nd < dist.get(other, np.inf):
-                dist[other] = nd
-                via[other] = chain
-                heapq.heappush(heap, (nd, other))
-    return dist, via
-
-
-def _adjacency(count, links):
-    neighbours = [[] for _ in range(count)]
-    for a, b in links.tolist():
-        neighbours[a].append(b)
-        neighbours[b].append(a)
-    return neighbours

@@ -1,5 +1,5 @@
-"""Measuring along and to polylines (axis-node chains, placed 3D chains, bones): shared by the tree, second-view and
-bone steps."""
+"""Measuring along and to polylines (axis chains, placed 3D chains, bones): lengths, points at arc lengths, nearest
+points and distances to segments."""
 import numpy as np
 
 

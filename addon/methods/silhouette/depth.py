@@ -6,27 +6,56 @@ the mesh in k > 1 separate parts over much of its length (a quadruped's left and
 the chain is split into k chains, one per part, from where the parts come apart (a hand's fingers seen edge-on fork
 off the one arm). Where the chosen interval is much thicker than the part is wide
 (an arm in front of the body merges with it along the ray), the perpendicular silhouette decides, as in Pan et al.:
-its own chordal axis, seen from the side, says at which depth a part of that width and height lies.
+its own chordal axis, seen from the side, says at which depth a part of that width and height lies. The thresholds
+are the tuning's depth section (``tuning.py``).
 """
+from typing import NamedTuple
+
 import numpy as np
 
-# an interval this many times thicker than the part is wide means the part is occluded by (merged with) another
-OCCLUSION_RATIO = 2.5
-THIN = 0.2  # intervals thinner than this many half-widths of the part are sheets, not parts
-SEVERAL = 0.3  # a chain is split when this share of its outer nodes cross the same number (> 1) of parts
-FORK = 0.8  # parts apart over this share of a chain's outer nodes fork where that stretch begins
-ROUND = 1.5  # a part at most this many times as thick along the view as it is wide is one limb, not two side by side
-PART = 0.8  # a separate part (a leg behind a leg) is at least this many of its half-widths thick along the view
-ALIKE = 0.45  # ... and at least this share of the thickest part's thickness (not a nose or a brim beside a head)
+from ...core.graphs import chains_of
+from .tree import islands, rooted_chains
 
 
-def place_chains(sil, points, radius, root, chains, side_axis=None, split=True, mirror=None):
+class Blob(NamedTuple):
+    """An island whose pruned axis is a single node (a round speck): that node's point (2D) and disc radius."""
+
+    point: np.ndarray
+    radius: float
+
+
+class PlacedIsland(NamedTuple):
+    """An island's chains placed in 3D (``place_chains``): the root's point and (polyline, parent, widths)s."""
+
+    root_point: np.ndarray
+    chains: list
+
+
+def placed_islands(sil, graph, alive, kept, speck, tuning, side=None, split=True, mirror=None):
+    """Per island of the pruned axis (``graph``'s nodes ``alive`` joined by the links ``kept``), largest first: a
+    ``PlacedIsland`` (its chains in 3D), or a ``Blob`` for an island that is a single node; islands other than the
+    largest and smaller than ``speck`` are skipped (skinning gives them to the nearest bone). ``side``, ``split`` and
+    ``mirror``: see ``place_chains``."""
+    for number, (nodes, links, size) in enumerate(islands(graph, alive, kept)):
+        if number and size < speck:
+            continue
+        keys, island_chains = chains_of(nodes, links)
+        if not island_chains:
+            widest = nodes[int(np.argmax(graph.radius[nodes]))]
+            yield Blob(graph.points[widest], graph.radius[widest])
+            continue
+        root, rooted = rooted_chains(graph.points, keys, island_chains, graph.radius, tuning)
+        yield PlacedIsland(*place_chains(sil, graph.points, graph.radius, root, rooted, tuning, side, split, mirror))
+
+
+def place_chains(sil, points, radius, root, chains, tuning, side_axis=None, split=True, mirror=None):
     """3D polylines for the rooted ``chains`` (see ``tree.rooted_chains``).
 
     Args:
         sil: the primary ``Silhouette``.
         points, radius: the axis nodes (n, 2) in ``sil``'s frame and their half-widths.
         root: the root node; chains: ``tree.Chain`` list, parents first.
+        tuning: the method's ``Tuning``.
         side_axis: optional ``SideAxis`` of the perpendicular view, used where the primary view is occluded.
         split: split chains that run through several separate parts along the view (else follow one).
         mirror: (depth, tolerance) of a mirror plane the view looks across, or None: with ``split``, a chain on
@@ -39,7 +68,7 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True, 
     """
     used = sorted({root} | {n for c in chains for n in c.nodes})
     slot = {n: i for i, n in enumerate(used)}
-    layers = [_solid(layer, radius[n]) for layer, n in zip(sil.layers(points[used]), used)]
+    layers = [solid_layers(layer, radius[n], tuning) for layer, n in zip(sil.layers(points[used]), used)]
     root_layers = layers[slot[root]]
     root_depth = _middle(root_layers[np.argmax(root_layers[:, 1] - root_layers[:, 0])]) if len(root_layers) else 0.0
     end_depth = {-1: root_depth}
@@ -52,8 +81,8 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True, 
         node_layers = [layers[slot[n]] for n in chain.nodes]
         copies, parts, plane = 1, node_layers, None  # plane: the mirror this chain keeps to, if any
         if split:
-            parts = [_parts(layer, r) for layer, r in zip(node_layers, radius[nodes])]
-            copies = _layer_count(parts)
+            parts = [separate_parts(layer, r, tuning) for layer, r in zip(node_layers, radius[nodes])]
+            copies = layer_count(parts, tuning)
             if copies == 1 and mirror is not None:
                 end, stays = _plane_course(node_layers, *mirror, leaf=ci not in has_children)
                 nodes, node_layers, parts = nodes[:end], node_layers[:end], parts[:end]
@@ -62,7 +91,7 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True, 
         widths = chain_radius
         if chain.parent < 0 and root_is_end:
             widths = np.r_[0.0, widths[1:]]  # no branch point here: no disc for the chain to leave (chain_joints)
-        fork = _fork(parts, chain_radius, copies) if copies > 1 else 0
+        fork = fork_point(parts, chain_radius, copies, tuning) if copies > 1 else 0
         pieces = [(slice(0, fork + 1), 1), (slice(fork, None), copies)] if fork else [(slice(None), copies)]
         parents = ends_of[chain.parent]
         for part, count in pieces:
@@ -70,8 +99,8 @@ def place_chains(sil, points, radius, root, chains, side_axis=None, split=True, 
             followed = [_follow((parts if count > 1 else node_layers)[part], copy, count, end_depth[chain.parent],
                                 plane) for copy in range(count)]
             for copy in range(count):
-                depths = _resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
-                                            followed[copy], side_axis, followed[:copy] + followed[copy + 1:])
+                depths = resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
+                                           followed[copy], side_axis, tuning, followed[:copy] + followed[copy + 1:])
                 line = sil.lift(chain_points[part], depths)
                 parent = -1
                 if parents:
@@ -90,44 +119,44 @@ def _middle(interval):
     return 0.5 * (interval[0] + interval[1])
 
 
-def _solid(layer, radius):
-    """One node's depth intervals without those thinner than ``THIN`` times its half-width when a thicker one
+def solid_layers(layer, radius, tuning):
+    """One node's depth intervals without those thinner than ``thin`` times its half-width when a thicker one
     exists: the zero-thickness intervals of open sheets (a cloak's hem) are not parts a chain should split into."""
     if len(layer) < 2:
         return layer  # the common case, kept free of numpy calls: nodes are many
-    thick = layer[:, 1] - layer[:, 0] >= THIN * radius
+    thick = layer[:, 1] - layer[:, 0] >= tuning.thin * radius
     return layer[thick] if thick.any() else layer
 
 
-def _parts(layer, radius):
-    """The intervals of one node that count as separate parts for splitting: those at least ``PART`` times its
+def separate_parts(layer, radius, tuning):
+    """The intervals of one node that count as separate parts for splitting: those at least ``part`` times its
     half-width thick, a limb's round cross-section, not the plates and shells of one limb (a robot's forearm, a
-    sheet), and ``ALIKE`` as thick as the thickest (legs and fingers side by side are alike; a nose or a hat's brim
+    sheet), and ``alike`` as thick as the thickest (legs and fingers side by side are alike; a nose or a hat's brim
     beside a head is not a second head); a single part spanning all the intervals when none is that thick."""
     if len(layer) < 2:
         return layer  # the common case, kept free of numpy calls: nodes are many
     size = layer[:, 1] - layer[:, 0]
-    thick = size >= max(PART * radius, ALIKE * size.max())
+    thick = size >= max(tuning.part * radius, tuning.alike * size.max())
     if thick.any():
         return layer[thick]
     return np.array([[layer[0, 0], layer[-1, 1]]])
 
 
-def _fork(parts, radius, copies):
+def fork_point(parts, radius, copies, tuning):
     """Where a chain that runs through ``copies`` parts forks into them: the last node before the outer stretch over
-    which (for ``FORK`` of its nodes) the parts are apart, when the chain runs through one round part of its own
+    which (for ``fork`` of its nodes) the parts are apart, when the chain runs through one round part of its own
     width before it (a hand's fingers off an arm: one arm, then a chain per finger); else 0, the parts apart from
     the start (a leg pair seen from the side merges with the body and each other towards its parent)."""
     apart = np.array([len(layer) >= 2 for layer in parts], dtype=float)
     share = np.cumsum(apart[::-1])[::-1] / np.arange(len(apart), 0, -1)
-    if not (share >= FORK).any():
+    if not (share >= tuning.fork).any():
         return 0
-    start = int(np.argmax(share >= FORK))
+    start = int(np.argmax(share >= tuning.fork))
     start += int(np.argmax(apart[start:]))  # the stretch begins where the parts are first apart
     if start < 2 or not any(len(layer) == copies for layer in parts[start:]):
         return 0
     thickness = [layer[:, 1].max() - layer[:, 0].min() if len(layer) else 0.0 for layer in parts[:start]]
-    own = np.median(np.array(thickness) / (2 * np.maximum(radius[:start], 1e-300))) <= ROUND
+    own = np.median(np.array(thickness) / (2 * np.maximum(radius[:start], 1e-300))) <= tuning.round_part
     return start - 1 if own else 0
 
 
@@ -161,18 +190,18 @@ def _holds(intervals, depth):
     return any(low <= depth <= high for low, high in intervals)
 
 
-def _layer_count(node_layers):
-    """How many separate parts a chain runs through, judged over its outer two thirds (the part near its parent
-    often runs into the body): the fewest parts (more than one) that 30% of those nodes cross, else the most
-    frequent count. Fewest, because parts split further towards the tip (a dinosaur's left and right feet, each
-    with its toes) are still one limb each."""
+def layer_count(node_layers, tuning):
+    """How many separate parts a chain runs through, judged over its outer nodes (all but the first
+    ``1 / outer_share``: near its parent it often runs into the body): the fewest parts (more than one) that a
+    ``several`` share of those nodes cross, else the most frequent count. Fewest, because parts split further towards
+    the tip (a dinosaur's feet, each with its toes) are still one limb each."""
     counts = np.array([len(layer) for layer in node_layers])
-    outer = counts[len(counts) // 3:]
+    outer = counts[len(counts) // tuning.outer_share:]
     outer = outer[outer > 0]
     if not len(outer):
         return 1
     frequency = np.bincount(outer)
-    several = np.flatnonzero(frequency[2:] >= SEVERAL * len(outer)) + 2
+    several = np.flatnonzero(frequency[2:] >= tuning.several * len(outer)) + 2
     return int(several[0]) if len(several) else int(np.argmax(frequency))
 
 
@@ -211,7 +240,7 @@ def _track(node_layers, order, previous, depths, stay=False, mirror=None):
         depths[i] = previous
 
 
-def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis, siblings=()):
+def resolve_occlusion(sil, points, radius, node_layers, depths, side_axis, tuning, siblings=()):
     """Where a node's interval is much thicker than its part is wide, take the depth from the side view instead,
     choosing among the side-view candidates the one closest to the previous node's depth (so a chain never
     hops between two legs that the side view shows at the same height). A thick interval at one node alone, between
@@ -224,7 +253,7 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis, sibl
     out = depths.copy()
     previous = depths[0]
     typical = max(float(np.median(radius)), sil.cell)  # not the tip's vanishing radius
-    limits = (OCCLUSION_RATIO * 2 * np.maximum(radius, typical)).tolist()
+    limits = (tuning.occlusion_ratio * 2 * np.maximum(radius, typical)).tolist()
     chosen = [min(layer.tolist(), key=lambda interval: abs(0.5 * (interval[0] + interval[1]) - depth))
               if len(layer) else None for layer, depth in zip(node_layers, depths.tolist())]
     thick = np.array([c is not None and c[1] - c[0] > limit for c, limit in zip(chosen, limits)])
@@ -234,7 +263,7 @@ def _resolve_occlusion(sil, points, radius, node_layers, depths, side_axis, sibl
     lifted = sil.lift(points, 0.0) if thick.any() else None
     for i, interval in enumerate(chosen):
         if thick[i]:
-            found = side_axis.depth_at(lifted[i], radius[i], interval, previous)
+            found = side_axis.depth_at(lifted[i], radius[i], interval, previous, tuning.side_width_cost)
             if found is not None:
                 out[i] = found
         previous = out[i]
@@ -258,15 +287,16 @@ class SideAxis:
         self.radius = radius
         self.cell = side_sil.cell
 
-    def depth_at(self, point, radius, interval, previous):
+    def depth_at(self, point, radius, interval, previous, width_cost):
         """Depth (in the primary view's frame) of the side-view part matching a primary node at ``point`` (3D, on
         the primary view's plane), inside ``interval``: of the side-view axis nodes at the node's height, the one
-        nearest ``previous`` (ties to the closest width); None if no side-view node fits."""
+        nearest ``previous``, a width difference costing ``width_cost`` per unit of depth; None if no side-view
+        node fits."""
         depth = self.depth
         near = np.abs(self.w - float(point @ self.w_axis)) <= max(radius, self.cell)
         near &= (depth >= interval[0]) & (depth <= interval[1])
         if not near.any():
             return None
         candidates = np.flatnonzero(near)
-        cost = np.abs(depth[candidates] - previous) + 0.1 * np.abs(self.radius[candidates] - radius)
+        cost = np.abs(depth[candidates] - previous) + width_cost * np.abs(self.radius[candidates] - radius)
         return float(depth[candidates[np.argmin(cost)]])

@@ -1,0 +1,200 @@
+"""Where joints go along a chain (a 3D polyline through a part), and mirror twins given mirror-image joints."""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .mirror import covering_fit, mirror_chain_pairs
+from .polyline import arc_lengths, point_at, resampled
+from .tuning import TuningTable, tuned
+
+
+@dataclass(frozen=True)
+class JointTuning(TuningTable):
+    """The tuned numbers of cutting chains into bones (in bone lengths unless said otherwise)."""
+
+    longest_bone: float = tuned(3.0, "no bone is longer, whatever max_bones says: a straight leg still gets a knee")
+    joint_spacing: float = tuned(0.35, "joint candidates closer than this to a joint already placed are dropped")
+    leaf_two_bones: float = tuned(0.5, "a leaf chain this long gets two bones, as the artists' leaf chains have")
+    disc_exit: float = tuned(0.3, "the joint where a chain leaves its branch point's disc is this far along at least")
+    disc_exit_rest: float = tuned(0.5, "... and this much of the chain lies beyond it")
+    corner_tolerance: float = tuned(0.25, "corners are measured on the chain simplified within this: no jitter stubs")
+    spare_bend: float = tuned(0.5, "spare bones go to bends a straight bone would leave the part's middle at, this "
+                                   "share of the half-width off")
+    same_shape: float = tuned(0.6, "twins whose shapes agree within this many mirror tolerances get the average of "
+                                   "their mirror-image joints")
+    shape_samples: int = tuned(9, "points along each twin compared for that")
+
+
+@dataclass(frozen=True)
+class Cutting:
+    """How chains are cut into bones: ``bone_angle`` (radians) a chain turns by for a corner joint, the
+    ``bone_length`` (mesh units), ``max_bones`` per chain (0: no limit) and the ``tuning``."""
+
+    bone_angle: float
+    bone_length: float
+    max_bones: int
+    tuning: JointTuning
+
+
+def chain_joints(line, cutting, widths=None, leaf=False, min_bones=0):
+    """Joint positions along a polyline.
+
+    ``widths`` are the half-widths of the part along the line. A chain leaving a branch point first gets a joint
+    where it leaves that point's disc (``widths[0]``): a hip, a shoulder. Every corner where the line turns by more
+    than the bone angle gets a joint (an elbow, a knee), and so does every bend that would take a straight bone out
+    of the part, the sharpest first where two are close. The chain has one bone per bone length begun (the artist
+    rigs give a chain about one bone more than length / bone length: a hand, a foot), at most ``max_bones`` unless
+    those joints need more, a bone would exceed ``longest_bone``, or ``min_bones`` (its twin's count) asks for more.
+    Spare bones go to the gentler bends, from the start: they place joints but add none (every wiggle of a feathered
+    wing would be a bone). The pieces between joints are cut evenly. A ``leaf`` chain (a finger, a toe) long enough
+    gets at least two bones.
+    """
+    tuning, bone_length = cutting.tuning, cutting.bone_length
+    widths = np.zeros(len(line)) if widths is None else widths
+    arc = arc_lengths(line)
+    wanted = max(1, int(np.ceil(arc[-1] / bone_length - 1e-9)))  # one bone per bone length begun
+    if leaf and arc[-1] >= tuning.leaf_two_bones * bone_length:
+        wanted = max(wanted, 2)
+    if cutting.max_bones > 0:
+        wanted = min(wanted, cutting.max_bones)
+    wanted = max(wanted, min_bones)
+    stops, places = [0.0, arc[-1]], [line[0], line[-1]]
+    candidates, needed = _candidate_stops(line, arc, widths, cutting)
+    for k, (at, place) in enumerate(zip(candidates, point_at(line, arc, np.array(candidates, dtype=float)))):
+        if k >= needed and len(stops) > wanted:
+            break  # no bone to spare for this bend (nor for the gentler ones after it)
+        if min(np.linalg.norm(place - other) for other in places) >= tuning.joint_spacing * bone_length:
+            stops.append(at)
+            places.append(place)
+    stops.sort()
+    lengths = np.diff(stops)
+    counts = _share(lengths, wanted)
+    counts = np.maximum(counts, np.ceil(lengths / (tuning.longest_bone * bone_length)).astype(int))
+    at = [0.0]
+    for start, length, count in zip(stops[:-1], lengths, counts):
+        at.extend(start + length * np.arange(1, count + 1) / count)
+    return point_at(line, arc, np.array(at))
+
+
+def _candidate_stops(line, arc, widths, cutting):
+    """Arc lengths where a joint belongs, most important first, and how many of them are needed: leaving the branch
+    point's disc, corners by how sharply they turn and the bends a straight bone would leave the part at (its axis
+    farther than a half-width away); then, for the bones to spare, the bends it would leave the part's middle at."""
+    tuning, bone_length = cutting.tuning, cutting.bone_length
+    found = []
+    reach = np.linalg.norm(line - line[0], axis=1)
+    outside = np.flatnonzero(reach > widths[0]) if widths[0] > 0 else []
+    if len(outside) and arc[outside[0]] >= tuning.disc_exit * bone_length and (
+            arc[-1] - arc[outside[0]] >= tuning.disc_exit_rest * bone_length):
+        found.append(arc[outside[0]])
+    turns = _turns(line, np.full(len(line), tuning.corner_tolerance * bone_length))
+    found += [arc[i] for i, angle in sorted(turns, key=lambda item: -item[1]) if angle > cutting.bone_angle]
+    if not widths.any():
+        return found, len(found)
+    found += [arc[i] for i in _simplified(line, np.maximum(widths, 1e-12 * bone_length))[1:-1]]
+    needed = len(found)
+    found += [arc[i] for i in _simplified(line, np.maximum(tuning.spare_bend * widths, 1e-12 * bone_length))[1:-1]]
+    return found, needed
+
+
+def _share(lengths, total):
+    """Split ``total`` bones over pieces of the given lengths, at least one each, the rest by largest remainder."""
+    counts = np.ones(len(lengths), dtype=int)
+    spare = total - len(lengths)
+    if spare > 0 and lengths.sum() > 0:
+        ideal = lengths / lengths.sum() * total - 1
+        extra = np.floor(np.clip(ideal, 0, None)).astype(int)
+        while extra.sum() > spare:
+            extra[np.argmax(extra)] -= 1
+        left = spare - extra.sum()
+        order = np.argsort(-(ideal - extra))
+        extra[order[:left]] += 1
+        counts += extra
+    return counts
+
+
+def _simplified(line, tolerance):
+    """Indices kept by Douglas-Peucker simplification (iterative) with a per-point tolerance."""
+    n = len(line)
+    if n <= 2:
+        return [0, n - 1]
+    keep = np.zeros(n, bool)
+    keep[[0, n - 1]] = True
+    stack = [(0, n - 1)]
+    while stack:
+        a, b = stack.pop()
+        if b - a < 2:
+            continue
+        seg = line[b] - line[a]
+        rel = line[a + 1:b] - line[a]
+        length = np.linalg.norm(seg)
+        if length > 0:
+            dist = np.linalg.norm(rel - np.outer(rel @ seg / length ** 2, seg), axis=1)
+        else:
+            dist = np.linalg.norm(rel, axis=1)
+        excess = dist - tolerance[a + 1:b]
+        far = int(np.argmax(excess))
+        if excess[far] > 0:
+            keep[a + 1 + far] = True
+            stack += [(a, a + 1 + far), (a + 1 + far, b)]
+    return list(np.flatnonzero(keep))
+
+
+def _turns(line, tolerance):
+    """(index, turning angle) at each inner vertex of the simplified ``line``."""
+    idx = _simplified(line, tolerance)
+    turns = []
+    for prev, here, nxt in zip(idx[:-2], idx[1:-1], idx[2:]):
+        u, w = line[here] - line[prev], line[nxt] - line[here]
+        cos = float(u @ w) / max(np.linalg.norm(u) * np.linalg.norm(w), 1e-300)
+        turns.append((here, float(np.arccos(np.clip(cos, -1.0, 1.0)))))
+    return turns
+
+
+def symmetric_joints(joints, lines, symmetry, recount, *, leaves, tuning):
+    """``joints`` per chain (3D polylines ``lines``, ``leaves`` telling which end in a tip) with each pair of mirror
+    twins (``mirror_chain_pairs``) made to match, so that every bone has a twin (``.L`` and ``.R``, X-mirror
+    posing).
+
+    A twin that is a leaf running on along the other's image past its tip (pruning kept a hand's branch on one side
+    only) takes the other's mirror image, bone count too: both arms end at the wrist. Otherwise the pair gets one
+    bone count: the one with more bones is recounted with at most as many as the other, and while the counts differ
+    (its corners need more, or a bone would be too long) the one with fewer gets as many as the other
+    (``recount(chain, max_bones, min_bones)`` gives a chain's joints anew). Twins whose shapes agree then get the
+    average of one's joints and the other's mirror image; twins whose shapes differ (a leg stepping forward) keep
+    their own. Each chain keeps its first joint, where it attaches to its parent.
+    """
+    joints = list(joints)
+    for i, j in mirror_chain_pairs(lines, symmetry):
+        runs_on = _runs_on(lines, i, j, symmetry, leaves)
+        if runs_on is not None:
+            longer, shorter = runs_on
+            joints[longer] = np.vstack([joints[longer][:1], symmetry.reflect(joints[shorter])[1:]])
+            continue
+        if len(joints[i]) != len(joints[j]):
+            more, fewer = (i, j) if len(joints[i]) > len(joints[j]) else (j, i)
+            joints[more] = recount(more, len(joints[fewer]) - 1, 0)
+            while len(joints[more]) != len(joints[fewer]):  # the count only grows, up to what both need
+                more, fewer = (more, fewer) if len(joints[more]) > len(joints[fewer]) else (fewer, more)
+                joints[fewer] = recount(fewer, len(joints[more]) - 1, len(joints[more]) - 1)
+        image_of_j = symmetry.reflect(resampled(lines[j], tuning.shape_samples))
+        same_shape = np.linalg.norm(resampled(lines[i], tuning.shape_samples) - image_of_j, axis=1).max() <= (
+            tuning.same_shape * symmetry.tolerance)
+        if same_shape:
+            a, b = joints[i], joints[j]
+            mean = (a + symmetry.reflect(b)) / 2
+            joints[i] = np.vstack([a[:1], mean[1:]])
+            joints[j] = np.vstack([b[:1], symmetry.reflect(mean)[1:]])
+    return joints
+
+
+def _runs_on(lines, i, j, symmetry, leaves):
+    """(longer, shorter) of mirror twins ``i`` and ``j`` when the longer is a leaf that covers the shorter's mirror
+    image (``Symmetry.covers``) and whose tip lies more than a tolerance from the image's tip; else None. A leg
+    stepping forward does not cover its twin's image."""
+    for longer, shorter in ((i, j), (j, i)):
+        image = symmetry.reflect(lines[shorter])
+        if leaves[longer] and symmetry.covers(covering_fit(lines[longer], image)) and (
+                np.linalg.norm(lines[longer][-1] - image[-1]) > symmetry.tolerance):
+            return longer, shorter
+    return None

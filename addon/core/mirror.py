@@ -1,0 +1,163 @@
+"""A mesh's mirror plane, and mirror twins among chains (3D polylines): which chain is which one's image, on which
+side of the plane a chain lies, and limbs completed from a longer twin's image."""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .polyline import length, segment_distances
+from .tuning import TuningTable, tuned
+
+
+@dataclass(frozen=True)
+class MirrorTuning(TuningTable):
+    """The tuned numbers of mirror symmetry (shares of the mesh size, or of the twin tolerance)."""
+
+    plane_match: float = tuned(0.01, "a vertex with a mirror image within this share of the size is symmetric")
+    plane_samples: int = tuned(600, "vertices tested for a mirror image (at most)")
+    plane_share: float = tuned(0.95, "a plane holds when this share of them has one (loose bits, seams aside)")
+    twin_tolerance: float = tuned(0.05, "chains whose ends mirror each other this close (share of size) are twins")
+    twin_ends: float = tuned(2.0, "... their two ends' gaps summed, in twin tolerances")
+    cover_start: float = tuned(2.0, "a chain covers another's image from starts this close (twin tolerances) ...")
+    cover_tip: float = tuned(1.0, "... to the other's tip this close to it")
+
+
+@dataclass(frozen=True)
+class Symmetry:
+    """A mirror ``plane`` (axis 0, 1 or 2, offset), the ``tolerance`` (mesh units) within which chains mirror each
+    other, and the ``tuning``."""
+
+    plane: tuple
+    tolerance: float
+    tuning: MirrorTuning
+
+    def reflect(self, points):
+        """``mirrored(points, plane)``."""
+        return mirrored(points, self.plane)
+
+    def covers(self, gaps):
+        """Whether a polyline covers another whose ``covering_fit`` against it is ``gaps``: their starts within
+        ``cover_start`` tolerances, the other's tip within ``cover_tip`` of the polyline."""
+        start_gap, tip_gap = gaps
+        return (start_gap <= self.tuning.cover_start * self.tolerance
+                and tip_gap <= self.tuning.cover_tip * self.tolerance)
+
+    def side(self, line, by_tip=False):
+        """+1 on the plane's positive side, -1 on its negative side, 0 for a chain on the plane (on average), or with
+        ``by_tip`` for one whose tip is on it too."""
+        axis, offset = self.plane
+        distance = float(np.mean(line[:, axis])) - offset
+        if by_tip and abs(distance) <= self.tolerance:
+            distance = float(line[-1, axis]) - offset
+        return 0 if abs(distance) <= self.tolerance else int(np.sign(distance))
+
+
+def mirrored(points, plane):
+    """A copy of ``points`` (..., 3) reflected across ``plane`` = (axis, offset)."""
+    axis, offset = plane
+    image = np.array(points, dtype=float)
+    image[..., axis] = 2 * offset - image[..., axis]
+    return image
+
+
+def mirror_plane(vertices, bounds, tolerance, tuning):
+    """The axis (0, 1, 2) and offset of a plane the ``vertices`` are mirror-symmetric about, or None.
+
+    Tries the planes through the centre of ``bounds`` (their (2, 3) bounding box) perpendicular to X, Y and Z where
+    the box is more than two ``tolerance`` deep (across a flat mesh's own plane nothing has a side); a plane fits
+    when ``plane_share`` of (up to ``plane_samples``) vertices have a mirror image among the vertices within
+    ``tolerance``: vertices are hashed to a grid of that size and the mirrored ones looked up in the sorted hashes,
+    with their 26 neighbour cells.
+    """
+    low, high = bounds
+    origin = low - 2 * tolerance
+    span = np.floor((high - low) / tolerance).astype(np.int64) + 5
+    table = np.unique(_cell_keys(np.floor((vertices - origin) / tolerance).astype(np.int64), span))
+    step = max(1, len(vertices) // tuning.plane_samples)
+    probe = vertices[::step]
+    offsets = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)])
+    best = None
+    for axis in np.flatnonzero(high - low > 2 * tolerance):
+        centre = 0.5 * (low[axis] + high[axis])
+        cells = np.floor((mirrored(probe, (axis, centre)) - origin) / tolerance).astype(np.int64)
+        around = np.clip(cells[:, None, :] + offsets[None], 0, span - 1).reshape(-1, 3)
+        keys = _cell_keys(around, span)
+        at = np.minimum(np.searchsorted(table, keys), len(table) - 1)
+        score = (table[at] == keys).reshape(len(probe), -1).any(axis=1).mean()
+        if score >= tuning.plane_share and (best is None or score > best[2]):
+            best = (int(axis), centre, score)
+    return None if best is None else best[:2]
+
+
+def _cell_keys(cells, span):
+    return (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]
+
+
+def mirror_chain_pairs(lines, symmetry):
+    """Pairs (i, j) of chains (3D polylines) that are mirror twins: their ends match the mirrored ends (within
+    ``twin_ends`` tolerances summed); then, among the chains left, those whose starts match and where one's tip lies
+    on the other's image (``Symmetry.covers``: a hand whose finger's branch was pruned on one side only, so one arm
+    runs on into the hand). Whole twins pair first, so a stub off a shoulder never takes an arm from its exact twin.
+    Chains on the plane are never paired; one that lies on it on average but whose tip is off it (legs from the
+    middle of the hips) is on its tip's side."""
+    ends = np.array([[line[0], line[-1]] for line in lines])  # (C, 2, 3)
+    images = symmetry.reflect(ends)
+    side = np.array([symmetry.side(line, by_tip=True) for line in lines])
+    pairs, taken = [], np.zeros(len(lines), bool)
+    for partial in (False, True):
+        for i in range(len(lines)):
+            if taken[i] or side[i] == 0:
+                continue
+            candidates = (side == -side[i]) & ~taken
+            if partial:
+                j = _partial_twin(lines, symmetry.reflect(lines[i]), candidates, symmetry)
+            else:
+                cost = np.where(candidates, np.linalg.norm(ends - images[i], axis=2).sum(axis=1), np.inf)
+                j = int(np.argmin(cost)) if cost.min() <= symmetry.tuning.twin_ends * symmetry.tolerance else None
+            if j is not None:
+                pairs.append((i, j))
+                taken[[i, j]] = True
+    return pairs
+
+
+def _partial_twin(lines, image, candidates, symmetry):
+    """The chain among ``candidates`` (a mask over ``lines``) that fits a chain's mirror ``image`` best, either one
+    running on past the other's tip, if the longer one covers the shorter; else None."""
+    fits = [(sum(gaps), gaps, int(k)) for k in np.flatnonzero(candidates)
+            for gaps in (covering_fit(image, lines[k]), covering_fit(lines[k], image))]
+    if not fits:
+        return None
+    _, gaps, best = min(fits, key=lambda fit: fit[0])
+    return best if symmetry.covers(gaps) else None
+
+
+def covering_fit(long, short):
+    """(start gap, tip gap) of polyline ``short`` against ``long``: how far apart their starts lie and how far the
+    tip of ``short`` lies off ``long`` (for ``Symmetry.covers``)."""
+    return (float(np.linalg.norm(short[0] - long[0])),
+            float(segment_distances(short[-1:], long[:-1], long[1:]).min()))
+
+
+def mirror_completed(limbs, symmetry):
+    """The (polyline, half-widths) ``limbs`` with each one that a longer mirror twin covers (``Symmetry.covers``)
+    replaced by the twin's mirror image: a view's triangulation is not symmetric, and may prune one ear's tip but not
+    the other's. A limb's twin is the one whose image fits it best, so a short limb beside a long one (a leg below an
+    antenna) keeps its own; each twin replaces one limb, the one it fits best."""
+    lines = [line for line, _ in limbs]
+    side = [symmetry.side(line, by_tip=True) for line in lines]
+    images = [symmetry.reflect(line) for line in lines]
+    fits = {}  # twin -> (misfit, limb it replaces)
+    for j, line in enumerate(lines):
+        twins = [i for i in range(len(lines)) if side[i] != 0 and side[i] == -side[j]]
+        if not twins:
+            continue
+        gaps = np.array([covering_fit(images[i], line) for i in twins])  # (start gap, tip gap) per twin
+        misfits = gaps.sum(axis=1)
+        best = int(np.argmin(misfits))
+        i = twins[best]
+        covered = symmetry.covers(gaps[best]) and length(line) < length(lines[i])
+        if covered and misfits[best] < fits.get(i, (np.inf,))[0]:
+            fits[i] = (misfits[best], j)
+    result = list(limbs)
+    for i, (_, j) in fits.items():
+        result[j] = (images[i], limbs[i][1])
+    return result

@@ -1,0 +1,141 @@
+"""The silhouette rigging method (Pan et al. 2009, "Automatic rigging for animation characters with 3D silhouette").
+
+Project the mesh along the axis that shows it widest (``views``), trace and triangulate its outline (``outline``),
+take the chordal axis (``chordal``), merge round blobs and prune spurs, root the tree (``tree``), put every axis
+point inside the mesh in depth (``depth``), cut the chains into bones (``bones``), and add the limbs the primary
+view hides from the perpendicular views (``second_view``). Every tuned number is in ``tuning``.
+"""
+from types import SimpleNamespace
+
+import numpy as np
+
+from ... import silhouette
+from ...core.params import Param
+from ...core.registry import RigMethod
+from ...core.skeleton import Skeleton
+from ...core.stages import (AxisGraph, Chains, Frame, Joints, MergedAxis, MirrorPlane, Outline, Placement,
+                            PrunedBranches, Triangulation)
+from ...core.timing import StageClock
+from .bones import BoneBuilder
+from .chordal import triangle_classes
+from .depth import Blob, SideAxis, placed_islands
+from .rules import Rules
+from .second_view import hidden_limbs
+from .tree import pruned_tree, removed_links
+from .tuning import Tuning
+from .views import AXIS_NAMES, mirror_in_depth, perpendicular_views, primary_view, view_frame
+
+TUNING = Tuning()
+
+
+class SilhouetteMethod(RigMethod):
+    """Skeleton from the chordal axis of the mesh's silhouette, centred in depth."""
+
+    name = "silhouette"
+    label = "Silhouette (Pan 2009)"
+    description = "Chordal axis of the 3D silhouette, centred inside the mesh in depth"
+    tuning_type = Tuning
+    params = (
+        Param("view", "enum", "AUTO", items=("AUTO", "X", "Y", "Z", "DIRECTION"),
+              description="Projection axis; AUTO picks the axis that shows the mesh widest, DIRECTION looks "
+                          "along the view direction (a model tilted off the axes, seen from its front)"),
+        Param("view_direction", "vector", (0.0, 1.0, 0.0),
+              description="The direction to look along when the view is DIRECTION (its length does not matter)"),
+        Param("resolution", "int", 384, min=TUNING.min_view_resolution, max=8192,
+              description="Silhouette grid cells along the longest side; higher keeps thinner gaps apart"),
+        Param("outline_spacing", "float", 0.01, min=0.001, max=0.1,
+              description="Longest outline edge fed to the triangulation, as a fraction of the silhouette size"),
+        Param("min_hole", "float", 0.01, min=0.0, max=0.5,
+              description="Holes in the silhouette smaller than this fraction of its area are filled "
+                          "(gaps between parts), larger ones (an arm on the hip) are kept"),
+        Param("merge", "float", 1.0, min=0.0, max=3.0,
+              description="Blob merging: nodes within this many disc radii of a branch point join it"),
+        Param("prune", "float", 1.35, min=0.0, max=5.0,
+              description="Branches sticking out of their base by less than this many times their width are "
+                          "bumps, not limbs; lower keeps stubbier branches"),
+        Param("min_branch", "float", 0.5, min=0.0, max=10.0,
+              description="Branches sticking out less than this many bone lengths get no bones, however thin; "
+                          "raise it to leave short spikes, claws and toes without bones"),
+        Param("bone_angle", "float", 40.0, min=1.0, max=180.0,
+              description="Start a new bone where a chain turns by more than this many degrees"),
+        Param("bone_length", "float", 0.1, min=0.01, max=1.0,
+              description="Typical bone length, as a fraction of the mesh's largest extent"),
+        Param("max_chain_bones", "int", 5, min=0, max=100,
+              description="Most bones per chain between branch points (0: no limit)"),
+        Param("split_layers", "bool", True,
+              description="Split chains whose view rays cross the mesh in separate parts (stacked legs)"),
+        Param("side_view", "bool", True,
+              description="Use the perpendicular silhouettes: for depth where the primary view is occluded, "
+                          "and for the limbs it hides"),
+    )
+
+    def draw(self, layout, props):
+        """Looking along a direction: a button takes it from the 3D view."""
+        if props.view == "DIRECTION":
+            layout.operator("rigger.direction_from_view", icon='VIEW_CAMERA').param = "view_direction"
+
+    def rig(self, mesh, **values):
+        params, tuning = SimpleNamespace(**values), self.tuning
+        clock = StageClock()
+        frame, view = None, params.view
+        if view == "DIRECTION":
+            frame, axis = view_frame(params.view_direction, tuning)
+            view = AXIS_NAMES[axis]
+        # rig at unit size (a power of two away: exact), in the frame where the view is an axis; then map back
+        placement = Placement(mesh.unit_factor, frame)
+        mesh = mesh.at_unit_size(frame)
+        try:
+            axis, primary = primary_view(mesh, view, params, tuning)
+        except silhouette.NoSilhouette as error:
+            if frame is None:
+                raise
+            raise type(error)(f"along view_direction {tuple(params.view_direction)}: {error}") from None
+        sil = primary.sil
+        clock.lap("silhouette_cdt_axis")
+
+        rules = Rules.of(mesh, params, tuning)
+        graph, alive, merged, kept = pruned_tree(primary.axis_graph, params.merge, rules.pruning(sil, params.prune))
+        clock.lap("merge_prune")
+
+        side, other_views = None, []  # side: the side view's axis, for depth where the primary view is occluded
+        if params.side_view and mesh.flat_normal is None:  # a flat mesh has nothing to hide in depth
+            side_of, end_on = perpendicular_views(mesh, axis, params, tuning)
+            if side_of is not None:
+                side = SideAxis(side_of.sil, side_of.axis_graph.points, side_of.axis_graph.radius, sil)
+            other_views = [found for found in (side_of, end_on) if found is not None]
+        clock.lap("other_views")
+
+        builder = BoneBuilder(rules.cutting, rules.symmetry, tuning)
+        mirror = None if rules.plane is None else mirror_in_depth(sil, rules.plane, rules.symmetry.tolerance, tuning)
+        for placed in placed_islands(sil, graph, alive, kept, tuning.speck * rules.unit, tuning, side,
+                                     params.split_layers, mirror):
+            if isinstance(placed, Blob):
+                builder.add_blob(sil, placed.point, placed.radius)
+            else:
+                builder.add_island(placed.root_point, placed.chains)
+        for view_of in other_views:
+            builder.add_limbs(hidden_limbs(sil, view_of, builder.lines, rules), (sil, view_of.sil))
+        clock.lap("depth_bones")
+
+        heads, tails, parents = builder.arrays()
+        names = builder.names()
+        clock.lap("names")
+
+        view_frame_stage = Frame(sil.origin, sil.u, sil.v, sil.direction,
+                                 float((mesh.centroid - sil.origin) @ sil.direction), np.eye(3))
+        stages = {
+            "frame": view_frame_stage,
+            "silhouette": Outline(view_frame_stage, sil.loops),
+            "cdt": Triangulation(view_frame_stage, primary.triangulation.vertices, primary.triangulation.triangles,
+                                 triangle_classes(primary.triangulation)),
+            "axis": AxisGraph(view_frame_stage, graph.points, graph.radius, graph.links),
+            "merged": MergedAxis(view_frame_stage, graph.points, graph.radius, merged),
+            "pruned": PrunedBranches(view_frame_stage, graph.points, graph.radius, removed_links(merged, kept)),
+            "chains": Chains(builder.lines),
+        }
+        if rules.plane is not None:
+            stages["mirror_plane"] = MirrorPlane(rules.plane[0], rules.plane[1], np.eye(3)[rules.plane[0]])
+        stages = {name: stage.mapped(placement) for name, stage in stages.items()}
+        heads, tails = placement.point(heads), placement.point(tails)
+        stages["joints"] = Joints(np.unique(np.concatenate([heads, tails]), axis=0))
+        return Skeleton(names, heads, tails, parents, stages=stages, timings=clock.laps)

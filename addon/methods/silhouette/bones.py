@@ -1,0 +1,179 @@
+"""Bone building: bones along the placed chains of each island, hidden limbs hung from the bones they reach, and
+their names."""
+from dataclasses import replace
+
+import numpy as np
+
+from ...core.graphs import components
+from ...core.joints import chain_joints, symmetric_joints
+from ...core.mirror import mirror_completed
+from ...core.naming import bone_names
+from ...core.polyline import nearest_on_segments
+
+
+class BoneBuilder:
+    """Accumulates bones island by island; the first island's trunk holds the single root bone. Chains are cut as
+    ``cutting`` says; with a ``symmetry`` (None without a mirror plane), mirror twins get mirror-image joints, so a
+    symmetric mesh gets a symmetric rig. ``tuning``: the method's (hanging hidden limbs)."""
+
+    def __init__(self, cutting, symmetry, tuning):
+        self.cutting, self.symmetry, self.tuning = cutting, symmetry, tuning
+        self.bone_length = cutting.bone_length
+        self.heads, self.tails, self.parents = [], [], []
+        self.chain_of_bone, self.index_in_chain = [], []
+        self.lines = []  # one polyline per chain, indexed by chain number
+
+    def add_island(self, root_point, placed):
+        """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk."""
+        roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
+        trunk = max(roots, key=lambda i: placed[i][2].mean())
+        order = [trunk] + [i for i in range(len(placed)) if i != trunk]
+        inner = {parent for _, parent, _ in placed}
+        joints = self._joints([(line, widths, i not in inner) for i, (line, _, widths) in enumerate(placed)])
+        attach, _ = self.attachment(root_point)
+        last_bone, first_bone = {}, {}
+        for i in order:
+            line, parent, _ = placed[i]
+            if parent >= 0:
+                up = last_bone[parent]
+            elif i == trunk:
+                up = attach
+            else:
+                up = first_bone[trunk]
+            added = self._add_chain(line, joints[i], up)
+            first_bone[i], last_bone[i] = (added[0], added[-1]) if added else (up, up)
+
+    def add_limbs(self, limbs, views):
+        """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone already there that their
+        start reaches within the mesh as all the silhouettes ``views`` see it (the primary one and the one the limbs
+        come from); a chain starting far from that bone (a foot below a leg too stubby to show) is extended back
+        along the path to it, so the leg between them gets bones of its own, and mirror pairs stay mirror pairs.
+        Limbs that far from one bone whose starts, and the points where they meet the bone, all lie within half a
+        bone length of each other (a pair of ears, horns on a neck) share that extension: one chain from the middle
+        of those points to the middle of their starts, from which each hangs (through a bone to its own start when
+        apart), instead of bones lying on each other. Which limbs share does not depend on their order, so mirror
+        pairs stay mirror pairs."""
+        if not limbs:
+            return
+        if self.symmetry is not None:
+            limbs = mirror_completed(limbs, self.symmetry)
+        chains, ups, meets_of = [], [], {}  # meets_of: limb number -> where it meets its bone, for the limbs to extend
+        for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
+            up, meets = self.attachment(line[0], views)  # from the left one's extension, which passes nearer it)
+            if meets is not None and np.linalg.norm(line[0] - meets) > self.tuning.bridge * self.bone_length:
+                meets_of[len(chains)] = meets
+            chains.append((line, widths, True))
+            ups.append(up)
+        ends = {}  # limb number -> the bridge chain it hangs from
+        for members in self._sharing(meets_of, ups, [line[0] for line, _, _ in chains]):
+            meets = np.mean([meets_of[k] for k in members], axis=0)
+            shared = len(members) > 1
+            start = np.mean([chains[k][0][0] for k in members], axis=0) if shared else meets
+            for k in members:
+                line, widths, _ = chains[k]
+                if np.linalg.norm(line[0] - start) > 1e-9 * self.bone_length:
+                    chains[k] = (np.vstack([start, line]), np.r_[0.0, widths], True)  # 0: no disc to leave
+            if shared:
+                ends.update(dict.fromkeys(members, len(chains)))
+                chains.append((np.vstack([meets, start]), np.zeros(2), False))
+                ups.append(ups[members[0]])
+        joints = self._joints(chains)
+        last_bone = {}
+        for c in sorted(range(len(chains)), key=lambda c: c in ends):  # bridge chains before the limbs they carry
+            line, along = chains[c][0], joints[c]
+            up = last_bone[ends[c]] if c in ends else ups[c]
+            added = self._add_chain(line, along, up)
+            last_bone[c] = added[-1] if added else up
+
+    def _sharing(self, meets, ups, starts):
+        """The limbs to extend (the keys of ``meets``, where each meets its bone) in groups that share one
+        extension: linked when they hang from the same bone and their starts and meeting points each lie within half
+        a bone length; a linked group is kept only when every two of its limbs are linked (else each goes alone), so
+        the groups do not depend on the limbs' order."""
+        reach = self.tuning.share_reach * self.bone_length
+        limbs = list(meets)
+
+        def linked(a, b):
+            return (ups[a] == ups[b] and np.linalg.norm(starts[a] - starts[b]) <= reach
+                    and np.linalg.norm(meets[a] - meets[b]) <= reach)
+
+        pairs = [(i, j) for i in range(len(limbs)) for j in range(i) if linked(limbs[i], limbs[j])]
+        labels = components(len(limbs), np.array(pairs, dtype=np.int64).reshape(-1, 2))
+        groups = []
+        for label in np.unique(labels):
+            members = [limbs[i] for i in np.flatnonzero(labels == label)]
+            whole = all(linked(a, b) for a in members for b in members)
+            groups += [members] if whole else [[k] for k in members]
+        return groups
+
+    def _joints(self, chains):
+        """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror pairs made symmetric."""
+        def joints_of(chain, max_bones, min_bones=0):
+            """Joints along chain number ``chain`` (``chain_joints``), at most and at least that many bones."""
+            line, widths, leaf = chains[chain]
+            return chain_joints(line, replace(self.cutting, max_bones=max_bones), widths, leaf, min_bones)
+
+        joints = [joints_of(chain, self.cutting.max_bones) for chain in range(len(chains))]
+        if self.symmetry is None:
+            return joints
+        return symmetric_joints(joints, [line for line, _, _ in chains], self.symmetry, joints_of,
+                                leaves=[leaf for _, _, leaf in chains], tuning=self.cutting.tuning)
+
+    def _add_chain(self, line, joints, up):
+        """Bones between consecutive ``joints`` of one chain, the first hanging from bone ``up``; returns the
+        indices of the bones added (none where the joints coincide)."""
+        chain = len(self.lines)
+        self.lines.append(line)
+        added = []
+        for k in range(len(joints) - 1):
+            if np.linalg.norm(joints[k + 1] - joints[k]) <= 1e-9 * self.bone_length:
+                continue
+            self.heads.append(joints[k])
+            self.tails.append(joints[k + 1])
+            self.parents.append(up)
+            self.chain_of_bone.append(chain)
+            self.index_in_chain.append(k)
+            up = len(self.heads) - 1
+            added.append(up)
+        return added
+
+    def add_blob(self, sil, point2d, radius):
+        """An island whose axis is a single node (a round speck): one short bone through it, pointing up."""
+        front, back = sil.depth(point2d[None])
+        depth = 0.5 * (front[0] + back[0]) if not np.isnan(front[0]) else 0.0
+        centre = sil.lift(point2d[None], [depth])[0]
+        half = max(radius, sil.cell) * sil.v
+        ends = np.array([centre - half, centre + half])
+        self._add_chain(ends, ends, self.attachment(centre)[0])
+
+    def attachment(self, point, views=()):
+        """(bone, where a path from ``point`` meets it): the bone nearest ``point``, or -1 before the first island,
+        met nowhere in particular (None). With silhouettes ``views``, the nearest bone that a straight path from
+        ``point`` reaches within the mesh as each of them sees it (``Silhouette.encloses``, sampled every grid cell,
+        up to ``path_slack`` outside: a path may graze the surface, but a foot beside a hanging hand belongs to the
+        body, not the hand), and the point the path meets it at; the nearest bone, met nowhere (None), when no path
+        to the ``path_candidates`` nearest stays in (a soup of triangles strewn at random has a
+        thousand bones at a small ``bone_length``, and paths through it rarely stay in)."""
+        if not self.heads:
+            return -1, None
+        targets = nearest_on_segments(point[None], np.array(self.heads), np.array(self.tails))[0]
+        distance = np.linalg.norm(targets - point, axis=1)
+        order = np.argsort(distance, kind="stable")
+        if views:
+            cell = min(view.cell for view in views)
+            for bone in order[:self.tuning.path_candidates]:
+                count = int(np.clip(np.ceil(distance[bone] / cell), 1, self.tuning.path_samples))
+                path = point + (np.arange(1, count + 1) / (count + 1))[:, None] * (targets[bone] - point)
+                outside = np.zeros(count, bool)
+                for view in views:
+                    outside |= ~view.encloses(path, view.cell)
+                if outside.sum() * distance[bone] / (count + 1) <= self.tuning.path_slack * self.bone_length:
+                    return int(bone), targets[bone]
+        return int(order[0]), None
+
+    def arrays(self):
+        return np.array(self.heads), np.array(self.tails), np.array(self.parents, dtype=np.int64)
+
+    def names(self):
+        """The bones' names (``bone_names``), mirror-suffixed across the builder's plane."""
+        return bone_names(self.chain_of_bone, self.index_in_chain, self.lines, self.symmetry)

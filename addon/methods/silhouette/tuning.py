@@ -1,0 +1,71 @@
+"""The silhouette method's tuning table: every tuned number, each with the reason for its value.
+
+Lengths are in bone lengths (the ``bone_length`` parameter times the mesh's size) unless the line says otherwise.
+The numbers that cutting chains into bones and mirror symmetry use come from ``core.joints.JointTuning`` and
+``core.mirror.MirrorTuning``, declared there. ``python -m rigger methods --tuning`` prints the whole table.
+"""
+from dataclasses import dataclass
+
+from ...core.joints import JointTuning
+from ...core.mirror import MirrorTuning
+from ...core.tuning import tuned
+
+
+@dataclass(frozen=True)
+class Tuning(JointTuning, MirrorTuning):
+    """Every tuned number of the silhouette method."""
+
+    # 1. the view
+    spread_samples: int = tuned(100_000, "triangles sampled to choose the view: a regular sample gives the variance")
+    axis_snap: float = tuned(1e-6, "view_direction components this small beside its largest are zero (a 3D view's "
+                                   "float32 noise)")
+    min_view_resolution: int = tuned(64, "the coarsest grid any view gets (also the resolution parameter's minimum)")
+    end_resolution: float = tuned(1 / 3, "the end-on view only looks for limbs, coarse features: this share of the "
+                                         "resolution")
+    along_plane: float = tuned(1e-6, "a view whose direction has no larger component along the mirror plane's axis "
+                                     "looks along the plane")
+    # 4. merging and pruning
+    keep_reach: float = tuned(0.25, "branches reaching this share of the mesh's size are kept however wide (a "
+                                    "cow's neck and head)")
+    pair_prune: float = tuned(0.55, "two twin branches sticking out more than this share of prune times their width "
+                                    "are limbs (a dog's ears)")
+    local_pair: float = tuned(1.5, "without a mirror plane, two branches off one base pair when their reach ratio "
+                                   "times width ratio is at most this")
+    round_tip: float = tuned(0.7, "a branch ending in a blob this share of its base's width, off the base's disc, is "
+                                  "a part (a head without a neck)")
+    width_nodes: int = tuned(3, "a branch's width is its mean over this many nodes past the base's disc (a neck, "
+                                "not the head it carries)")
+    # 5. rooting
+    uniform: float = tuned(1.25, "a path whose widest node is at most this many times its median width is a column "
+                                 "(rooted at its thicker end), not a body")
+    end_share: int = tuned(4, "a path's ends, this fraction of its nodes each (1/4), decide which end is thicker")
+    # 6. depth
+    occlusion_ratio: float = tuned(2.5, "an interval this many times thicker than the part is wide is another part "
+                                        "in front of it")
+    thin: float = tuned(0.2, "depth intervals thinner than this many half-widths are sheets, not parts")
+    several: float = tuned(0.3, "a chain splits when this share of its outer nodes cross the same number (> 1) of "
+                                "parts")
+    outer_share: int = tuned(3, "... its outer nodes being all but the first 1/3 (near its parent it runs into the "
+                                "body)")
+    fork: float = tuned(0.8, "parts apart over this share of a chain's outer nodes fork where that stretch begins")
+    round_part: float = tuned(1.5, "a part at most this many times as thick along the view as it is wide is one limb, "
+                                   "not two side by side")
+    part: float = tuned(0.8, "a separate part is at least this many of its half-widths thick along the view")
+    alike: float = tuned(0.45, "... and at least this share of the thickest part (not a nose beside a head)")
+    side_width_cost: float = tuned(0.1, "matching a side-view node, a width difference costs this much per unit of "
+                                        "depth difference")
+    # 8. islands
+    speck: float = tuned(0.25, "islands whose axis is shorter than this get no bones (skinning gives them to the "
+                               "nearest bone)")
+    # 9. hidden limbs
+    hidden_reach: float = tuned(0.6, "a perpendicular-view limb tip this far off the skeleton (seen that way) is "
+                                     "missing from it")
+    hidden_prune: float = tuned(2 / 3, "the perpendicular views prune at this share of prune: their limbs must also "
+                                       "be hidden and off the skeleton")
+    path_samples: int = tuned(256, "most points tested along a path from a hidden limb to a bone it may hang from")
+    path_candidates: int = tuned(32, "... to each of the nearest bones, nearest first, at most this many")
+    path_slack: float = tuned(0.15, "... and the path may leave the mesh for this long in all (grazing its "
+                                    "surface)")
+    bridge: float = tuned(1.0, "a hidden limb starting farther than this from its bone is extended back to it")
+    share_reach: float = tuned(0.5, "limbs extended from one bone share the extension when their starts and "
+                                    "meeting points lie this close")

@@ -1,1 +1,0 @@
-"""Skeleton extraction building blocks: chordal axis, tree surgery, depth placement, bones (bpy-free)."""
