@@ -34,16 +34,14 @@ reproduced exactly wherever it crosses a grid line; the outline departs from the
   antennae stay separate lobes even where the gap between them is narrower than a cell. When nothing but specks
   is left, ``trace`` raises ``PartsTooSmall``.
 
-Measured against the exact union on real models (``bench/results/silhouette.md``; front and side views): worst area
-IoU 0.9962 at resolution 128, 0.9988 at 256, 0.9996 at 512, 0.99986 at the default 1024 and 0.99995 at 2048. The
-default keeps the IoU above 0.999 on every model tried, matches every island and hole larger than a few cells, and
-traces a million triangles in about 0.2 s; a 5,000-triangle character takes about 4 ms. Lower resolutions are
-cheaper mainly for meshes of large triangles, whose cross-sections are computed on every line they cross.
+How close the outline comes to the exact union at each resolution, and what it costs, is measured in
+``bench/results/silhouette.md``. Lower resolutions are cheaper mainly for meshes of large triangles, whose
+cross-sections are computed on every line they cross.
 
 ``tolerance`` then removes outline points while a bound on the distance between the traced and the simplified
 outline stays within that fraction of a cell, never removing a point whose removal could make two loop segments
-cross; the default 0.05 keeps the IoU essentially unchanged while dropping the collinear runs that straight mesh
-edges produce (about 250 points for a whole character instead of several thousand).
+cross; the default 0.05 keeps the outline's area essentially unchanged while dropping the collinear runs that straight
+mesh edges produce.
 """
 from dataclasses import dataclass, field
 

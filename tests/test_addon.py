@@ -250,7 +250,8 @@ def test_rig_builds_the_overlays_the_panel_toggles_and_clear_removes(scene):
     assert set(made) == {"silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints"}
     toggles = scene.rigger.overlays
     assert set(toggles.keys()) == set(made)  # one toggle per stage drawn, labelled after its stage type
-    assert (toggles["axis"].label, toggles["merged"].label) == ("Chordal Axis", "Merged Axis")
+    labels = [toggles[name].label for name in ("axis", "merged", "cdt")]
+    assert labels == ["Chordal Axis", "Merged Axis", "Triangulation"]
     assert made["cdt"].hide_get() and made["merged"].hide_get() and not made["joints"].hide_get()
     assert not toggles["merged"].shown and toggles["joints"].shown
     depsgraph = bpy.context.evaluated_depsgraph_get()

@@ -277,17 +277,25 @@ class Broken(Stage):
     """A stage whose drawing fails."""
 
     def drawing(self):
-        raise ValueError("no points to draw")
+        return {}["points"]
+
+
+class Sketchy(Stage):
+    """A stage that draws something the overlays do not know."""
+
+    def drawing(self):
+        return np.zeros((2, 3))
 
 
 def test_what_is_not_a_stage_or_fails_to_draw_is_skipped_with_a_warning(humanoid):
-    stages = {**humanoid[2], "raw": np.zeros(3), "broken": Broken()}
+    stages = {**humanoid[2], "raw": np.zeros(3), "broken": Broken(), "sketchy": Sketchy()}
     with pytest.warns(RuntimeWarning) as record:
         objects = overlays.build_overlays(stages, "Body")
     assert list(objects) == KINDS
     assert sorted(str(warning.message) for warning in record) == [
-        "Rigger overlay 'broken' skipped: drawing its Broken failed: no points to draw",
-        "Rigger overlay 'raw' skipped: a ndarray, not a rigger.core.stages.Stage"]
+        "Rigger overlay 'broken' skipped: drawing its Broken failed: KeyError: 'points'",
+        "Rigger overlay 'raw' skipped: a ndarray, not a rigger.core.stages.Stage",
+        "Rigger overlay 'sketchy' skipped: its drawing is a ndarray, not Lines, Points or ClassedFaces"]
 
 
 def test_a_test_only_package_method_s_own_stage_type_gets_its_overlay():

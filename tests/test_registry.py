@@ -319,8 +319,9 @@ def test_tuning_is_changed_by_name_and_checked():
     default = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES)
     same = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=silhouette(tuning={"speck": 0.25}))
     np.testing.assert_array_equal(same.heads, default.heads)
-    table = silhouette.tuning_type().changed(longest_bone=1, pair_prune=0.6)
-    assert (table.longest_bone, table.pair_prune) == (1, 0.6)
+    table = silhouette.tuning_type().changed(longest_bone=1, pair_prune=np.float64(0.6), path_candidates=np.int64(8))
+    assert (table.longest_bone, table.pair_prune, table.path_candidates) == (1.0, 0.6, 8)
+    assert type(table.longest_bone) is float and type(table.path_candidates) is int
     with pytest.raises(ValueError, match="unknown tuning value pair_prun of Tuning; valid: "):
         silhouette(tuning={"pair_prun": 0.6})
     with pytest.raises(ValueError, match="tuning value path_candidates must be a int like its default 32"):
@@ -345,3 +346,32 @@ def test_a_method_instance_is_run_as_it_is_and_checked():
 def test_stages_must_be_typed():
     with pytest.raises(ValueError, match="stage 'axis' is a ndarray, not a rigger.core.stages.Stage"):
         Skeleton(["a"], [(0, 0, 0)], [(0, 0, 1)], [-1], stages={"axis": np.zeros(3)})
+
+
+def test_a_package_method_may_define_its_class_in_a_module_of_its_own(tmp_path):
+    write_package(tmp_path, "up", {"__init__.py": "from .method import Up\n",
+                                   "method.py": package_method("up", "")["__init__.py"].replace(
+                                       "from .height import HEIGHT", "HEIGHT = 3.0")})
+    assert list(discover(tmp_path).methods) == ["up"]
+
+
+def test_a_tuning_table_made_before_discovery_reloaded_the_method_is_taken():
+    from rigger.methods.silhouette.tuning import Tuning  # the class as imported now; discovery loads it afresh
+
+    silhouette = discover().methods["silhouette"]
+    assert silhouette.tuning_type is not Tuning
+    method = silhouette(tuning=Tuning(longest_bone=1.0))
+    assert isinstance(method.tuning, silhouette.tuning_type) and method.tuning.longest_bone == 1.0
+    import rigger.methods
+    assert rigger.methods.silhouette.SilhouetteMethod is silhouette  # the package attribute is the fresh module
+
+
+def test_a_changed_tuning_value_reaches_the_rig():
+    """No bone longer than ``longest_bone`` bone lengths: at 1.0 instead of 3.0 the long straight box (4 long,
+    bone length 0.1 x 4 = 0.4) gets at least ten bones, more than by default."""
+    silhouette = discover().methods["silhouette"]
+    default = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, max_chain_bones=1)
+    short = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=silhouette(tuning={"longest_bone": 1.0}),
+                            max_chain_bones=1)
+    assert len(short) > len(default)
+    assert np.linalg.norm(short.tails - short.heads, axis=1).max() <= 0.4 + 1e-9

@@ -276,7 +276,8 @@ def placed_along_x(node_layers, chains=None, side_axis=None, **options):
     count = len(node_layers)
     points = np.stack([np.arange(count, dtype=float), np.zeros(count)], axis=1)
     return depth.place_chains(FlatSilhouette(node_layers), points, np.full(count, 0.5), 0,
-                              chains or [Chain(list(range(count)), -1)], TUNING, side_axis, **options)
+                              chains or [Chain(list(range(count)), -1)],
+                              depth.Placing(TUNING, side_axis=side_axis, **options))
 
 
 def test_a_forked_chain_is_one_stem_then_a_chain_per_part():
@@ -389,10 +390,11 @@ def test_one_node_seeing_two_legs_as_one_part_is_a_slip_not_an_occlusion():
     leg, merged = layers((2.5, 3.5)), layers((-3.5, 3.5))
     points, radius = np.zeros((9, 2)), np.full(9, 0.5)
     slip = [leg] * 4 + [merged] + [leg] * 4
-    depths = depth.resolve_occlusion(sil, points, radius, slip, np.full(9, 3.0), FixedSide(), TUNING)
+    occluding = depth.Placing(TUNING, side_axis=FixedSide())
+    depths = depth.resolve_occlusion(sil, points, radius, slip, np.full(9, 3.0), occluding)
     np.testing.assert_array_equal(depths, 3.0)
     occluded = [leg] * 3 + [merged] * 3 + [leg] * 3
-    depths = depth.resolve_occlusion(sil, points, radius, occluded, np.full(9, 3.0), FixedSide(), TUNING)
+    depths = depth.resolve_occlusion(sil, points, radius, occluded, np.full(9, 3.0), occluding)
     np.testing.assert_array_equal(depths, [3, 3, 3, 0, 0, 0, 3, 3, 3])
 
 
@@ -406,86 +408,67 @@ def test_split_legs_keep_their_sides_where_they_merge_into_the_hips():
     np.testing.assert_array_equal(sorted(line[1, 2] for line, _, _ in placed), [-3.0, 3.0])
 
 
-def test_mirror_pair_chains_get_mirror_image_joints():
-    """Two arms mirrored across x = 0 whose joints came out slightly apart get the average, mirrored; each keeps its
-    own first joint; a chain on the plane and a pair whose shapes differ (a leg stepping forward) are left alone."""
-    arm = np.array([[0.2, 1.0, 0.0], [0.6, 1.0, 0.0], [1.0, 1.0, 0.0]])
-    left, right = arm, arm * [-1, 1, 1]
-    leg = np.array([[0.2, 0.0, 0.0], [0.2, -0.5, 0.0], [0.2, -1.0, 0.0]])
-    stepping = np.array([[-0.2, 0.0, 0.0], [-0.2, -0.5, 0.3], [-0.2, -1.0, 0.0]])  # same ends, a knee bent forward
+def leaves(*lines):
+    """The chains ``symmetric_joints`` takes: each line a leaf, without widths."""
+    return [(line, None, True) for line in lines]
+
+
+def test_twins_traced_apart_get_the_mirror_image_joints_of_their_mean_line():
+    """Two arms mirrored across x = 0, one traced a little higher and with its elbow a little off: both get the
+    joints of their mean line, mirror images of each other to the last bit, each keeping its own first joint; the
+    spine on the plane is left alone."""
+    arm = np.array([[0.2, 1.0, 0.0], [0.45, 1.05, 0.0], [0.7, 1.0, 0.0]])
+    other = arm * [-1, 1, 1] + [0.0, 0.01, 0.0]
+    other[1] += [-0.01, 0.0, 0.0]
     spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
-    lines = [spine, left, right, leg, stepping]
-    joints = [spine, left + [0, 0.02, 0], right + [0.01, -0.02, 0], leg, stepping]
-    result = symmetric_joints(joints, lines, ACROSS_X, None, leaves=[True] * 5, tuning=TUNING)  # no recount needed
-    np.testing.assert_allclose(result[1][0], joints[1][0])  # first joints stay where the chains attach
-    np.testing.assert_allclose(result[2][0], joints[2][0])
-    np.testing.assert_allclose(result[1][1:], (left + [-0.005, 0, 0])[1:], atol=1e-12)
-    np.testing.assert_allclose(result[2][1:], (right + [0.005, 0, 0])[1:], atol=1e-12)
-    for k in (0, 3, 4):
-        assert result[k] is joints[k]
+    chains = leaves(spine, arm, other)
+    result = symmetric_joints(chains, cutting(), ACROSS_X)
+    np.testing.assert_array_equal(result[0], chain_joints(spine, cutting(), leaf=True))
+    np.testing.assert_array_equal(result[1][0], arm[0])
+    np.testing.assert_array_equal(result[2][0], other[0])
+    np.testing.assert_array_equal(result[1][1:] * [-1, 1, 1], result[2][1:])
+    mean = (arm + other * [-1, 1, 1]) / 2
+    assert len(result[1]) == len(chain_joints(mean, cutting(), leaf=True))
 
 
-def recounter(lines):
-    """``symmetric_joints``' recount for chains ``lines`` at a bone length of 0.1."""
-    return lambda chain, max_bones, min_bones: chain_joints(lines[chain], cutting(max_bones), min_bones=min_bones)
-
-
-def twins(lines, max_bones, leaves=(True, True)):
-    """(each chain's own joints at most ``max_bones`` (a pair) bones long, ``symmetric_joints``' result) for a pair
-    of chains ``lines`` across x = 0, tolerance 0.05, bone length 0.1."""
-    recount = recounter(lines)
-    joints = [recount(chain, bones, 0) for chain, bones in enumerate(max_bones)]
-    return joints, symmetric_joints(joints, lines, ACROSS_X, recount, leaves=list(leaves), tuning=TUNING)
-
-
-def test_a_mirror_pair_gets_one_bone_count_so_every_bone_has_a_twin():
-    """Two legs whose ends mirror but whose shapes differ (one bent at the knee, one straight) keep their own joints
-    but get one bone count: the smaller, unless the one with more bones needs them for its corners; then the other
-    gets as many."""
+def test_twins_whose_lines_differ_keep_their_own_joints_with_one_bone_count():
+    """Two legs whose ends mirror but whose shapes differ (one bent at the knee, one straight: a leg stepping
+    forward) keep their own joints but get one bone count: the smaller, unless the one with more bones needs them
+    for its corners; then the other gets as many."""
     knee = np.array([[0.0, 0.0, 0.0], [0.2, 0.0, 0.15], [0.4, 0.0, 0.0]])
-    joints, result = twins([knee, straight(-0.4)], (4, 3))
-    assert (len(joints[0]), len(joints[1])) == (5, 4)
-    assert len(result[0]) == len(result[1]) == 4
+    own = [chain_joints(line, cutting(), leaf=True) for line in (knee, straight(-0.4))]
+    assert (len(own[0]), len(own[1])) == (6, 5)
+    result = symmetric_joints(leaves(knee, straight(-0.4)), cutting(), ACROSS_X)
+    assert len(result[0]) == len(result[1]) == 5
     assert np.linalg.norm(result[0] - knee[1], axis=1).min() < 1e-9  # the knee keeps its joint
+    np.testing.assert_array_equal(result[1], own[1])
     zigzag = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.1], [0.2, 0.0, 0.0], [0.3, 0.0, 0.1], [0.4, 0.0, 0.0]])
-    joints, result = twins([zigzag, straight(-0.4)], (2, 2))
-    assert (len(joints[0]), len(joints[1])) == (5, 3)  # every corner gets a joint, whatever max_bones
+    own = [chain_joints(line, cutting(2), leaf=True) for line in (zigzag, straight(-0.4))]
+    assert (len(own[0]), len(own[1])) == (5, 3)  # every corner gets a joint, whatever max_bones
+    result = symmetric_joints(leaves(zigzag, straight(-0.4)), cutting(2), ACROSS_X)
     assert len(result[0]) == len(result[1]) == 5
 
 
 def test_a_leaf_running_on_along_its_twins_image_takes_that_image():
-    """One arm stops at the wrist, its twin runs on into a hand whose two corners would want more bones (and starts
-    a little apart in depth): the longer takes the shorter's mirror image, its bone count too, but keeps its own
-    first joint, so both end at the wrist, either way round. So does a leg ending a little lower than its twin
-    along the same line. A longer twin with chains hanging from its tip (fingers) keeps its own joints."""
-    arm = np.array([[0.1, 1.0, 0.0], [0.25, 1.0, 0.0]])  # two bones
+    """One arm stops at the wrist, its twin runs on into the hand (pruning kept the hand's branch on one side
+    only): both are leaves, so the longer takes the shorter's mirror image, its bone count too, either way round,
+    each keeping its own first joint. When the longer has chains hanging from its tip (fingers), the shorter takes
+    the longer's joints instead; when neither is a leaf, each keeps its own joints with one bone count."""
+    arm = np.array([[0.1, 1.0, 0.0], [0.25, 1.0, 0.0]])
     into_hand = np.array([[-0.1, 1.0, 0.03], [-0.25, 1.0, 0.0], [-0.35, 1.1, 0.0], [-0.45, 1.0, 0.0]])
-    leg, lower = np.array([[0.2, 0.0, 0.0], [0.2, -0.33, 0.0]]), np.array([[-0.2, 0.0, 0.0], [-0.2, -0.4, 0.0]])
-    assert len(recounter([into_hand])(0, 2, 0)) > 3  # the hand's corners want more bones than the arm's two
-    for lines, longer in (([arm, into_hand], 1), ([into_hand * [-1, 1, 1], arm * [-1, 1, 1]], 0), ([leg, lower], 1)):
-        joints, result = twins(lines, (0, 0))
-        assert result[1 - longer] is joints[1 - longer]  # the shorter is not recounted
-        np.testing.assert_array_equal(result[longer][0], joints[longer][0])
-        np.testing.assert_allclose(result[longer][1:], joints[1 - longer][1:] * [-1, 1, 1])
-    _, result = twins([arm, into_hand], (0, 0), leaves=(True, False))
+    for lines, longer in (([arm, into_hand], 1), ([into_hand * [-1, 1, 1], arm * [-1, 1, 1]], 0)):
+        result = symmetric_joints(leaves(*lines), cutting(), ACROSS_X)
+        own = chain_joints(lines[1 - longer], cutting(), leaf=True)
+        np.testing.assert_array_equal(result[1 - longer], own)
+        np.testing.assert_array_equal(result[longer][0], lines[longer][0])
+        np.testing.assert_allclose(result[longer][1:], own[1:] * [-1, 1, 1])
+    fingered = [(arm, None, True), (into_hand, None, False)]
+    result = symmetric_joints(fingered, cutting(), ACROSS_X)
+    np.testing.assert_allclose(result[0][-1], into_hand[-1] * [-1, 1, 1])
+    neither = [(arm, None, False), (into_hand, None, False)]
+    result = symmetric_joints(neither, cutting(), ACROSS_X)
     np.testing.assert_allclose(result[1][-1], into_hand[-1])
-
-
-def test_twins_whose_recount_overshoots_still_get_one_count():
-    """Recounting can give a chain more bones than asked (its corners, or no bone longer than three bone lengths):
-    the counts go on rising, one chain then the other, until they agree."""
-    asked = []
-
-    def recount(chain, max_bones, min_bones):  # chain 0 needs four bones; chain 1 gets one more than asked below 5
-        asked.append((chain, max_bones, min_bones))
-        bones = max(max_bones, min_bones, 4) if chain == 0 else max(max_bones, min_bones) + (max_bones < 5)
-        return straight(0.1 * bones, bones + 1) * [1 - 2 * chain, 1, 1]
-
-    lines = [straight(0.5), straight(-0.5)]
-    result = symmetric_joints([recount(0, 4, 0), recount(1, 2, 0)], lines, ACROSS_X, recount, leaves=[True, True],
-                              tuning=TUNING)
-    assert len(result[0]) == len(result[1]) == 6
-    assert asked[2:] == [(0, 3, 0), (1, 4, 4), (0, 5, 5)]
+    assert len(result[0]) == len(result[1])
 
 
 def test_whole_twins_pair_before_partial_ones():

@@ -75,8 +75,17 @@ def test_chains_joints_and_the_mirror_plane_map_to_the_world():
     (lambda: Chains({"a": np.zeros((2, 3))}), "Chains: 'lines' is a dict"),
     (lambda: Chains([np.zeros((2, 2))]), "Chains: line 0 has shape"),
     (lambda: Joints([[0.0, 1.0, 2.0], [1.0]]), "Joints: 'points' is not a regular array of numbers"),
-    (lambda: Frame(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), float("nan"), np.eye(3)), "'depth' is nan"),
-    (lambda: MirrorPlane(3, 0.0, np.zeros(3)), "'axis' is 3"),
+    (lambda: Frame(np.zeros(3), *np.eye(3), float("nan"), np.eye(3)), "'depth' is nan"),
+    (lambda: Frame(np.zeros(3), np.eye(3)[0], np.eye(3)[1], np.zeros(3), 0.0, np.eye(3)), "'direction' is not a unit"),
+    (lambda: Frame(np.zeros(3), *np.eye(3), 0.0, 2 * np.eye(3)), "'axes' are not orthonormal"),
+    (lambda: MirrorPlane(3, 0.0, np.array([1.0, 0, 0])), "'axis' is 3"),
+    (lambda: MirrorPlane(True, 0.0, np.array([1.0, 0, 0])), "'axis' is True"),
+    (lambda: MirrorPlane(0, 0.0, np.array([2.0, 0, 0])), "'normal' is not a unit vector"),
+    (lambda: AxisGraph(frame(), np.zeros((3, 0)), np.ones(3), np.zeros((0, 2), int)), r"shape \(3, 0\)"),
+    (lambda: Lines(np.zeros((2, 3)), np.array([[0, 2]])), "Lines: 'edges' indexes outside 0..1"),
+    (lambda: Points(np.zeros((0, 3))), "Points: no points to draw"),
+    (lambda: ClassedFaces(np.zeros((3, 3)), np.array([[0, 1, 2]]), np.array([5]), ((1, "a", (1, 1, 1)),)),
+     "ClassedFaces: 'classes'"),
 ])
 def test_a_stage_with_bad_arrays_is_refused_saying_what_is_wrong(make, message):
     with pytest.raises(ValueError, match=message):

@@ -142,14 +142,9 @@ def _fingerprint_run(run):
 def stage_fields(skeleton):
     """(key, value) of every tracked field: each stage's ``to_dict`` and the parameters, nested dicts and lists
     flattened into dotted keys."""
-    stages = skeleton.stages
-    if any(isinstance(stage, dict) for stage in stages.values()):
-        stages, params = _typed_shape(stages), stages.get("params", {})
-    else:
-        stages, params = {name: stage.to_dict() for name, stage in stages.items()}, skeleton.params
-    for name in sorted(stages):
-        yield from _flattened(f"stages.{name}", stages[name])
-    yield from _flattened("params", params)
+    for name in sorted(skeleton.stages):
+        yield from _flattened(f"stages.{name}", skeleton.stages[name].to_dict())
+    yield from _flattened("params", skeleton.params)
 
 
 def _flattened(prefix, value):
@@ -161,27 +156,6 @@ def _flattened(prefix, value):
             yield from _flattened(f"{prefix}.{index}", item)
     else:
         yield prefix, value
-
-
-def _typed_shape(stages):
-    """The silhouette method's stages of the dict format before typed stages (b77701f) in the typed stages'
-    ``to_dict`` shape, so that a baseline taken before them compares with a run after."""
-    outline, axis = stages["silhouette"], stages["axis"]
-    frame = {**{key: outline[key] for key in ("origin", "u", "v", "direction", "depth")}, "axes": stages["frame"]}
-    shaped = {
-        "frame": frame,
-        "silhouette": {"frame": frame, "loops": outline["loops"]},
-        "cdt": {"frame": frame, **stages["cdt"]},
-        "axis": {"frame": frame, **axis},
-        "chains": {"lines": stages["chains"]},
-        "joints": {"points": stages["joints"]},
-        **{name: {"frame": frame, "points": axis["points"], "radius": axis["radius"], "links": stages[name]["links"]}
-           for name in ("merged", "pruned")},
-    }
-    if stages["mirror_plane"] is not None:
-        plane_axis, offset = stages["mirror_plane"]
-        shaped["mirror_plane"] = {"axis": plane_axis, "offset": offset, "normal": stages["frame"][plane_axis]}
-    return shaped
 
 
 def _digest(value):

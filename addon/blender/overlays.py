@@ -20,7 +20,7 @@ from collections.abc import Mapping
 import bpy
 import numpy as np
 
-from ..core.stages import Lines, Points, Stage
+from ..core.stages import ClassedFaces, Lines, Points, Stage
 
 COLLECTION_NAME = "Rigger Overlays"
 LINE_SCALE = 0.004  # default line radius, as a fraction of the largest extent of the drawn data
@@ -102,11 +102,14 @@ def _drawings(stages):
             continue
         try:
             drawing = stage.drawing()
-        except (ValueError, TypeError, IndexError) as error:
-            warnings.warn(f"Rigger overlay {name!r} skipped: drawing its {type(stage).__name__} failed: {error}",
-                          RuntimeWarning, stacklevel=3)
+        except Exception as error:  # a method's own stage type must never block rigging
+            warnings.warn(f"Rigger overlay {name!r} skipped: drawing its {type(stage).__name__} failed: "
+                          f"{type(error).__name__}: {error}", RuntimeWarning, stacklevel=3)
             continue
-        if drawing is not None:
+        if drawing is not None and not isinstance(drawing, (Lines, Points, ClassedFaces)):
+            warnings.warn(f"Rigger overlay {name!r} skipped: its drawing is a {type(drawing).__name__}, not Lines, "
+                          f"Points or ClassedFaces", RuntimeWarning, stacklevel=3)
+        elif drawing is not None:
             drawings[name] = stage, drawing
     return drawings
 

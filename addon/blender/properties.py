@@ -113,10 +113,13 @@ def overlay_visibility(settings):
 
 
 def note_overlays(settings, stages, drawn):
-    """Add a toggle to the scene settings for each stage name in ``drawn`` that has none yet, labelled after its
-    stage (``stages[name]``) and shown as the overlay was built (existing toggles keep their state)."""
+    """Add a toggle to the scene settings for each stage name in ``drawn`` that has none yet, shown as the overlay
+    was built (existing toggles keep their state); each is labelled after its stage (``stages[name]``), a toggle a
+    script added without a label too."""
     for name, obj in drawn.items():
-        if name not in settings.overlays:
+        item = settings.overlays.get(name)
+        if item is None:
             item = settings.overlays.add()
-            item.name, item.label = name, stages[name].label or name
+            item.name = name
             item["shown"] = not obj.hide_viewport  # set without the update: the overlay is already so
+        item.label = item.label or stages[name].label or name

@@ -1,10 +1,10 @@
 """Where joints go along a chain (a 3D polyline through a part), and mirror twins given mirror-image joints."""
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .mirror import covering_fit, mirror_chain_pairs
-from .polyline import arc_lengths, point_at, resampled
+from .mirror import mirror_chain_pairs
+from .polyline import arc_lengths, length, point_at, resampled
 from .tuning import TuningTable, tuned
 
 
@@ -20,9 +20,6 @@ class JointTuning(TuningTable):
     corner_tolerance: float = tuned(0.25, "corners are measured on the chain simplified within this: no jitter stubs")
     spare_bend: float = tuned(0.5, "spare bones go to bends a straight bone would leave the part's middle at, this "
                                    "share of the half-width off")
-    same_shape: float = tuned(0.6, "twins whose shapes agree within this many mirror tolerances get the average of "
-                                   "their mirror-image joints")
-    shape_samples: int = tuned(9, "points along each twin compared for that")
 
 
 @dataclass(frozen=True)
@@ -71,8 +68,8 @@ def chain_joints(line, cutting, widths=None, leaf=False, min_bones=0):
     counts = _share(lengths, wanted)
     counts = np.maximum(counts, np.ceil(lengths / (tuning.longest_bone * bone_length)).astype(int))
     at = [0.0]
-    for start, length, count in zip(stops[:-1], lengths, counts):
-        at.extend(start + length * np.arange(1, count + 1) / count)
+    for start, piece, count in zip(stops[:-1], lengths, counts):
+        at.extend(start + piece * np.arange(1, count + 1) / count)
     return point_at(line, arc, np.array(at))
 
 
@@ -151,50 +148,79 @@ def _turns(line, tolerance):
     return turns
 
 
-def symmetric_joints(joints, lines, symmetry, recount, *, leaves, tuning):
-    """``joints`` per chain (3D polylines ``lines``, ``leaves`` telling which end in a tip) with each pair of mirror
-    twins (``mirror_chain_pairs``) made to match, so that every bone has a twin (``.L`` and ``.R``, X-mirror
-    posing).
+def symmetric_joints(chains, cutting, symmetry):
+    """Joints along each of the (polyline, half-widths or None, is a leaf) ``chains`` (``chain_joints``), each pair
+    of mirror twins (``mirror_chain_pairs``) given mirror-image joints where the mesh allows, so every bone has a
+    twin in the mirrored place (``.L`` and ``.R``, X-mirror posing).
 
-    A twin that is a leaf running on along the other's image past its tip (pruning kept a hand's branch on one side
-    only) takes the other's mirror image, bone count too: both arms end at the wrist. Otherwise the pair gets one
-    bone count: the one with more bones is recounted with at most as many as the other, and while the counts differ
-    (its corners need more, or a bone would be too long) the one with fewer gets as many as the other
-    (``recount(chain, max_bones, min_bones)`` gives a chain's joints anew). Twins whose shapes agree then get the
-    average of one's joints and the other's mirror image; twins whose shapes differ (a leg stepping forward) keep
-    their own. Each chain keeps its first joint, where it attaches to its parent.
+    Twins whose lines agree (``Symmetry.agree``) are one limb traced twice: both get the average of their own joints,
+    mirrored, when the lines have one shape, else the joints of their mean line (each placed its knee otherwise).
+    Where one runs on along the other's image past its tip (pruning kept a hand's branch on one side only), both get
+    the joints of one of them: the shorter's when the longer is a leaf (both arms end at the wrist), else the
+    longer's when the shorter is a leaf. Twins whose lines differ (a leg stepping forward) keep their own joints but
+    get one bone count: the smaller, unless the other's corners or the longest bone need more, then the larger.
+    Each chain keeps its first joint, where it attaches to its parent.
     """
-    joints = list(joints)
+    chains = [(line, np.zeros(len(line)) if widths is None else widths, leaf) for line, widths, leaf in chains]
+    joints = [chain_joints(line, cutting, widths, leaf) for line, widths, leaf in chains]
+    lines = [line for line, _, _ in chains]
     for i, j in mirror_chain_pairs(lines, symmetry):
-        runs_on = _runs_on(lines, i, j, symmetry, leaves)
-        if runs_on is not None:
-            longer, shorter = runs_on
-            joints[longer] = np.vstack([joints[longer][:1], symmetry.reflect(joints[shorter])[1:]])
-            continue
-        if len(joints[i]) != len(joints[j]):
-            more, fewer = (i, j) if len(joints[i]) > len(joints[j]) else (j, i)
-            joints[more] = recount(more, len(joints[fewer]) - 1, 0)
-            while len(joints[more]) != len(joints[fewer]):  # the count only grows, up to what both need
-                more, fewer = (more, fewer) if len(joints[more]) > len(joints[fewer]) else (fewer, more)
-                joints[fewer] = recount(fewer, len(joints[more]) - 1, len(joints[more]) - 1)
-        image_of_j = symmetry.reflect(resampled(lines[j], tuning.shape_samples))
-        same_shape = np.linalg.norm(resampled(lines[i], tuning.shape_samples) - image_of_j, axis=1).max() <= (
-            tuning.same_shape * symmetry.tolerance)
-        if same_shape:
-            a, b = joints[i], joints[j]
-            mean = (a + symmetry.reflect(b)) / 2
-            joints[i] = np.vstack([a[:1], mean[1:]])
-            joints[j] = np.vstack([b[:1], symmetry.reflect(mean)[1:]])
+        shared = _shared_joints(chains[i], chains[j], joints[i], joints[j], cutting, symmetry)
+        if shared is not None:
+            joints[i] = np.vstack([joints[i][:1], shared[1:]])
+            joints[j] = np.vstack([joints[j][:1], symmetry.reflect(shared)[1:]])
+        elif len(joints[i]) != len(joints[j]):
+            joints[i], joints[j] = _one_count(chains[i], chains[j], joints[i], joints[j], cutting)
     return joints
 
 
-def _runs_on(lines, i, j, symmetry, leaves):
-    """(longer, shorter) of mirror twins ``i`` and ``j`` when the longer is a leaf that covers the shorter's mirror
-    image (``Symmetry.covers``) and whose tip lies more than a tolerance from the image's tip; else None. A leg
-    stepping forward does not cover its twin's image."""
-    for longer, shorter in ((i, j), (j, i)):
-        image = symmetry.reflect(lines[shorter])
-        if leaves[longer] and symmetry.covers(covering_fit(lines[longer], image)) and (
-                np.linalg.norm(lines[longer][-1] - image[-1]) > symmetry.tolerance):
-            return longer, shorter
+def _shared_joints(chain, twin, joints, twin_joints, cutting, symmetry):
+    """The joints ``chain`` and its mirror ``twin`` share (on ``chain``'s side), or None when their lines differ.
+    Twins whose tips match share the average of their own ``joints`` and the image of ``twin_joints``, recounted to
+    one count, when their lines have one shape (``Symmetry.same_shape``), else the joints of their mean line; a
+    twin running on past the other's tip shares the joints of the one whose joints both can take."""
+    (line, widths, leaf), (other, other_widths, other_leaf) = chain, twin
+    image = symmetry.reflect(other)
+    if not symmetry.agree(line, image):
+        return None
+    longer_is_chain = length(line) >= length(image)
+    longer, shorter = (line, image) if longer_is_chain else (image, line)
+    if np.linalg.norm(longer[-1] - shorter[-1]) <= symmetry.tolerance:
+        if len(joints) != len(twin_joints):
+            joints, twin_joints = _one_count(chain, twin, joints, twin_joints, cutting)
+        if symmetry.same_shape(line, image):
+            return (joints + symmetry.reflect(twin_joints)) / 2
+        count = max(len(line), len(other))
+        mean = (resampled(line, count) + resampled(image, count)) / 2
+        fractions = np.linspace(0.0, 1.0, count)
+        mean_widths = (_at_fractions(line, widths, fractions) + _at_fractions(other, other_widths, fractions)) / 2
+        return chain_joints(mean, cutting, mean_widths, leaf and other_leaf)
+    shorter_leaf, longer_leaf = (other_leaf, leaf) if longer_is_chain else (leaf, other_leaf)
+    if shorter_leaf or longer_leaf:
+        lead_is_chain = longer_is_chain != longer_leaf  # the shorter leads when the longer can be cut back
+        return joints if lead_is_chain else symmetry.reflect(twin_joints)
     return None
+
+
+def _at_fractions(line, values, fractions):
+    """``values`` given at the points of ``line``, at the fractions of its arc length."""
+    arc = arc_lengths(line)
+    return np.interp(fractions * arc[-1], arc, values)
+
+
+def _one_count(chain, twin, joints, twin_joints, cutting):
+    """Both chains' own joints, recounted to one bone count: the smaller, rising while the one recounted needs more
+    (its corners, or no bone longer than ``longest_bone``) until both agree."""
+    pair = [chain, twin]
+    counts = [joints, twin_joints]
+
+    def recount(k, max_bones, min_bones):
+        line, widths, leaf = pair[k]
+        return chain_joints(line, replace(cutting, max_bones=max_bones), widths, leaf, min_bones)
+
+    more, fewer = (0, 1) if len(joints) > len(twin_joints) else (1, 0)
+    counts[more] = recount(more, len(counts[fewer]) - 1, 0)
+    while len(counts[more]) != len(counts[fewer]):  # the count only grows, up to what both need
+        more, fewer = (more, fewer) if len(counts[more]) > len(counts[fewer]) else (fewer, more)
+        counts[fewer] = recount(fewer, len(counts[more]) - 1, len(counts[more]) - 1)
+    return counts

@@ -4,7 +4,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .polyline import length, segment_distances
+from .polyline import length, resampled, segment_distances
 from .tuning import TuningTable, tuned
 
 
@@ -14,12 +14,17 @@ class MirrorTuning(TuningTable):
 
     plane_match: float = tuned(0.01, "a vertex with a mirror image within this share of the size is symmetric")
     plane_samples: int = tuned(600, "vertices tested for a mirror image (at most)")
-    plane_share: float = tuned(0.95, "a plane holds when this share of them has one (loose bits, seams aside)")
-    twin_tolerance: float = tuned(0.05, "chains whose ends mirror each other this close (share of size) are twins")
-    twin_ends: float = tuned(2.0, "... their two ends' gaps summed, in twin tolerances")
-    cover_start: float = tuned(2.0, "a chain covers another's image from starts this close (twin tolerances) ...")
-    cover_tip: float = tuned(1.0, "... to the other's tip this close to it")
-
+    plane_share: float = tuned(0.95, "a plane holds when this share of the vertices tested has a mirror image (loose "
+                                     "bits and seams aside)")
+    twin_tolerance: float = tuned(0.05, "the twin tolerance, a share of the size: how closely twin chains mirror")
+    twin_ends: float = tuned(2.0, "chains whose ends lie this many twin tolerances in all from each other's mirror "
+                                  "images are twins")
+    cover_start: float = tuned(2.0, "a chain covers another's image when their starts lie this many twin tolerances "
+                                    "apart at most ...")
+    cover_tip: float = tuned(1.0, "... and the image's tip lies this many twin tolerances off the chain at most")
+    same_shape: float = tuned(0.6, "twins whose lines lie this many twin tolerances apart at most are one limb "
+                                   "traced twice")
+    shape_samples: int = tuned(9, "points along each twin compared to find whether their shapes match")
 
 @dataclass(frozen=True)
 class Symmetry:
@@ -40,6 +45,20 @@ class Symmetry:
         start_gap, tip_gap = gaps
         return (start_gap <= self.tuning.cover_start * self.tolerance
                 and tip_gap <= self.tuning.cover_tip * self.tolerance)
+
+    def agree(self, line, other):
+        """Whether two polylines are one limb traced twice: every point of the shorter lies within ``same_shape``
+        tolerances of the longer (a leg stepping forward does not agree with one standing)."""
+        shorter, longer = (line, other) if length(line) <= length(other) else (other, line)
+        gaps = segment_distances(shorter, longer[:-1], longer[1:]).min(axis=1)
+        return gaps.max() <= self.tuning.same_shape * self.tolerance
+
+    def same_shape(self, line, other):
+        """Whether two polylines have one shape: ``shape_samples`` points evenly along each (by arc length) lie
+        within ``same_shape`` tolerances of each other's."""
+        count = self.tuning.shape_samples
+        return (np.linalg.norm(resampled(line, count) - resampled(other, count), axis=1).max()
+                <= self.tuning.same_shape * self.tolerance)
 
     def side(self, line, by_tip=False):
         """+1 on the plane's positive side, -1 on its negative side, 0 for a chain on the plane (on average), or with
@@ -93,41 +112,36 @@ def _cell_keys(cells, span):
 
 
 def mirror_chain_pairs(lines, symmetry):
-    """Pairs (i, j) of chains (3D polylines) that are mirror twins: their ends match the mirrored ends (within
-    ``twin_ends`` tolerances summed); then, among the chains left, those whose starts match and where one's tip lies
-    on the other's image (``Symmetry.covers``: a hand whose finger's branch was pruned on one side only, so one arm
-    runs on into the hand). Whole twins pair first, so a stub off a shoulder never takes an arm from its exact twin.
-    Chains on the plane are never paired; one that lies on it on average but whose tip is off it (legs from the
-    middle of the hips) is on its tip's side."""
+    """Pairs (i, j), i < j, of chains (3D polylines) that are mirror twins: their ends match the mirrored ends
+    (within ``twin_ends`` tolerances summed); then, among the chains left, those whose starts match and where one's
+    tip lies on the other's image (``Symmetry.covers``: a hand whose finger's branch was pruned on one side only, so
+    one arm runs on into the hand). Each pass pairs the best fits first, so fingers close together pair with their
+    own images; whole twins pair before partial ones, so a stub off a shoulder never takes an arm from its exact
+    twin. Chains on the plane are never paired; one that lies on it on average but whose tip is off it (legs from
+    the middle of the hips) is on its tip's side."""
     ends = np.array([[line[0], line[-1]] for line in lines])  # (C, 2, 3)
     images = symmetry.reflect(ends)
     side = np.array([symmetry.side(line, by_tip=True) for line in lines])
     pairs, taken = [], np.zeros(len(lines), bool)
     for partial in (False, True):
-        for i in range(len(lines)):
-            if taken[i] or side[i] == 0:
+        fits = []  # (misfit, i, j) of the candidate twins
+        for i, j in zip(*np.nonzero((side[:, None] == -side[None, :]) & (side[:, None] > 0))):
+            if taken[i] or taken[j]:
                 continue
-            candidates = (side == -side[i]) & ~taken
             if partial:
-                j = _partial_twin(lines, symmetry.reflect(lines[i]), candidates, symmetry)
+                image = symmetry.reflect(lines[i])
+                gaps = min((covering_fit(image, lines[j]), covering_fit(lines[j], image)), key=sum)
+                if symmetry.covers(gaps):
+                    fits.append((sum(gaps), min(i, j), max(i, j)))
             else:
-                cost = np.where(candidates, np.linalg.norm(ends - images[i], axis=2).sum(axis=1), np.inf)
-                j = int(np.argmin(cost)) if cost.min() <= symmetry.tuning.twin_ends * symmetry.tolerance else None
-            if j is not None:
-                pairs.append((i, j))
+                cost = float(np.linalg.norm(ends[j] - images[i], axis=1).sum())
+                if cost <= symmetry.tuning.twin_ends * symmetry.tolerance:
+                    fits.append((cost, min(i, j), max(i, j)))
+        for _, i, j in sorted(fits):
+            if not taken[i] and not taken[j]:
+                pairs.append((int(i), int(j)))
                 taken[[i, j]] = True
-    return pairs
-
-
-def _partial_twin(lines, image, candidates, symmetry):
-    """The chain among ``candidates`` (a mask over ``lines``) that fits a chain's mirror ``image`` best, either one
-    running on past the other's tip, if the longer one covers the shorter; else None."""
-    fits = [(sum(gaps), gaps, int(k)) for k in np.flatnonzero(candidates)
-            for gaps in (covering_fit(image, lines[k]), covering_fit(lines[k], image))]
-    if not fits:
-        return None
-    _, gaps, best = min(fits, key=lambda fit: fit[0])
-    return best if symmetry.covers(gaps) else None
+    return sorted(pairs)
 
 
 def covering_fit(long, short):

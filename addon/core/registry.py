@@ -12,6 +12,7 @@ import importlib.util
 import pathlib
 import sys
 import traceback
+import dataclasses
 from dataclasses import dataclass
 from types import MappingProxyType
 
@@ -57,6 +58,8 @@ class RigMethod:
             self.tuning = table().changed(**tuning)
         elif isinstance(tuning, table):
             self.tuning = tuning
+        elif _same_class(type(tuning), table):  # made before discovery loaded the method afresh
+            self.tuning = table(**{field.name: getattr(tuning, field.name) for field in dataclasses.fields(table)})
         else:
             raise ValueError(f"tuning of method {self.name!r} must be a {table.__name__} or a dict of its values, "
                              f"got {type(tuning).__name__}")
@@ -219,14 +222,23 @@ def _load(name, path, is_package):
     finally:
         if finder is not None:
             sys.meta_path.remove(finder)
+    parent, _, child = name.rpartition(".")
+    if parent in sys.modules:  # ``from rigger.methods import silhouette`` gives the fresh package too
+        setattr(sys.modules[parent], child, module)
     return module
 
 
 def _defined_methods(module):
-    """RigMethod subclasses defined in ``module`` itself (not imported into it), in definition order."""
+    """RigMethod subclasses defined in ``module`` itself or, for a package, in its modules (not imported from
+    elsewhere), in the order the module names them."""
     return [value for value in vars(module).values()
             if isinstance(value, type) and issubclass(value, RigMethod) and value is not RigMethod
-            and value.__module__ == module.__name__]
+            and (value.__module__ == module.__name__ or value.__module__.startswith(module.__name__ + "."))]
+
+
+def _same_class(one, other):
+    """Whether two classes are one class loaded twice (same module and name)."""
+    return (one.__module__, one.__qualname__) == (other.__module__, other.__qualname__)
 
 
 def _describe(error, path):

@@ -13,9 +13,8 @@ import numbers
 
 import numpy as np
 
-# Triangle classes of a triangulated outline, by how many of a triangle's edges lie on the outline (two: a branch
-# ends, one: a branch runs through, none: branches meet, three: a whole island).
-TERMINAL, SLEEVE, JUNCTION, ISOLATED = 2, 1, 0, 3
+TERMINAL, SLEEVE, JUNCTION, ISOLATED = 2, 1, 0, 3  # triangle classes: how many edges lie on the outline
+UNIT_TOLERANCE = 1e-6  # directions (view, plane normals, frame axes) are unit vectors within this
 
 
 @dataclasses.dataclass(frozen=True)
@@ -41,22 +40,29 @@ class Placement:
 
 # Drawing primitives: what the Blender layer turns into overlay objects, all in world coordinates.
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, eq=False)
 class Lines:
     """Line segments: ``points`` (K, 3) and ``edges`` (E, 2) indices into them, drawn as tubes."""
 
     points: np.ndarray
     edges: np.ndarray
 
+    def __post_init__(self):
+        _primitive_points(self)
+        object.__setattr__(self, "edges", _indices(self, "edges", 2, len(self.points)).astype(np.int64))
 
-@dataclasses.dataclass(frozen=True)
+
+@dataclasses.dataclass(frozen=True, eq=False)
 class Points:
     """Points (K, 3), drawn as small spheres."""
 
     points: np.ndarray
 
+    def __post_init__(self):
+        _primitive_points(self)
 
-@dataclasses.dataclass(frozen=True)
+
+@dataclasses.dataclass(frozen=True, eq=False)
 class ClassedFaces:
     """Triangles (T, 3) over ``points`` (K, 3), each of a class (``classes`` (T,)), drawn as see-through faces with
     tubes along their edges; ``palette`` gives (class code, name, RGB) per class, in priority order: an edge
@@ -66,6 +72,17 @@ class ClassedFaces:
     triangles: np.ndarray
     classes: np.ndarray
     palette: tuple
+
+    def __post_init__(self):
+        _primitive_points(self)
+        triangles = _indices(self, "triangles", 3, len(self.points)).astype(np.int64)
+        classes = np.asarray(self.classes)
+        codes = [code for code, _, _ in self.palette]
+        if classes.shape != (len(triangles),) or not np.isin(classes, codes).all() or min(codes, default=0) < 0:
+            raise ValueError(f"ClassedFaces: 'classes' of shape {classes.shape} is not one palette code (>= 0) per "
+                             f"triangle")
+        object.__setattr__(self, "triangles", triangles)
+        object.__setattr__(self, "classes", classes.astype(np.int64))
 
 
 class Stage:
@@ -107,10 +124,13 @@ class Frame(Stage):
     label = "View"
 
     def __post_init__(self):
-        for name in ("origin", "u", "v", "direction"):
-            _vector(self, name)
+        _vector(self, "origin")
+        for name in ("u", "v", "direction"):
+            _vector(self, name, unit=True)
         _finite_number(self, "depth")
         _points(self, "axes", 3, count=3)
+        if np.abs(np.asarray(self.axes) @ np.asarray(self.axes).T - np.eye(3)).max() > UNIT_TOLERANCE:
+            raise ValueError("Frame: 'axes' are not orthonormal rows")
 
     def mapped(self, placement):
         return Frame(placement.point(self.origin), placement.vector(self.u), placement.vector(self.v),
@@ -150,15 +170,7 @@ class Outline(Stage):
         return Outline(self.frame.mapped(placement), [placement.length(loop) for loop in self.loops])
 
     def drawing(self):
-        if not self.loops:
-            return None
-        points, edges, offset = [], [], 0
-        for loop in self.loops:
-            ring = np.arange(len(loop))
-            points.append(self.frame.lift(np.asarray(loop, dtype=np.float64)))
-            edges.append(offset + np.stack([ring, np.roll(ring, -1)], axis=1))
-            offset += len(loop)
-        return Lines(np.concatenate(points), np.concatenate(edges))
+        return _polylines([self.frame.lift(np.asarray(loop, dtype=np.float64)) for loop in self.loops], closed=True)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -271,15 +283,7 @@ class Chains(Stage):
         return Chains([placement.point(line) for line in self.lines])
 
     def drawing(self):
-        if not self.lines:
-            return None
-        points, edges, offset = [], [], 0
-        for line in self.lines:
-            step = np.arange(len(line) - 1)
-            points.append(np.asarray(line, dtype=np.float64))
-            edges.append(offset + np.stack([step, step + 1], axis=1))
-            offset += len(line)
-        return Lines(np.concatenate(points), np.concatenate(edges))
+        return _polylines([np.asarray(line, dtype=np.float64) for line in self.lines], closed=False)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -313,10 +317,10 @@ class MirrorPlane(Stage):
     label = "Mirror Plane"
 
     def __post_init__(self):
-        if self.axis not in (0, 1, 2):
+        if not isinstance(self.axis, numbers.Integral) or isinstance(self.axis, bool) or self.axis not in (0, 1, 2):
             raise ValueError(f"{_name(self)}: 'axis' is {self.axis!r}, not 0, 1 or 2")
         _finite_number(self, "offset")
-        _vector(self, "normal")
+        _vector(self, "normal", unit=True)
 
     def mapped(self, placement):
         return MirrorPlane(self.axis, placement.length(self.offset), placement.vector(self.normal))
@@ -331,6 +335,26 @@ def _name(stage):
     return type(stage).__name__
 
 
+def _polylines(lines, closed):
+    """``Lines`` along the (K, 3) polylines ``lines``, each ``closed`` into a loop or not; None for none."""
+    if not lines:
+        return None
+    edges, offset = [], 0
+    for line in lines:
+        step = np.arange(len(line) if closed else len(line) - 1)
+        edges.append(offset + np.stack([step, (step + 1) % len(line)], axis=1))
+        offset += len(line)
+    return Lines(np.concatenate(lines), np.concatenate(edges))
+
+
+def _primitive_points(drawing):
+    """A drawing's ``points`` as a finite (K, 3) float64 array, K > 0."""
+    _points(drawing, "points", 3)
+    object.__setattr__(drawing, "points", np.asarray(drawing.points, dtype=np.float64).reshape(-1, 3))
+    if not len(drawing.points):
+        raise ValueError(f"{_name(drawing)}: no points to draw")
+
+
 def _frame(stage):
     if not isinstance(stage.frame, Frame):
         raise ValueError(f"{_name(stage)}: 'frame' is a {type(stage.frame).__name__}, not a Frame")
@@ -342,9 +366,9 @@ def _check_points(value, width, what, *, minimum=0):
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
         raise ValueError(f"{what} is not a regular array of numbers") from None
-    if array.ndim != 2 or array.shape[1] != width or len(array) < minimum:
-        if not (array.size == 0 and minimum == 0):
-            raise ValueError(f"{what} has shape {array.shape}, not (K, {width}) with K >= {minimum}")
+    empty = array.shape in ((0,), (0, width)) and minimum == 0
+    if not empty and (array.ndim != 2 or array.shape[1] != width or len(array) < minimum):
+        raise ValueError(f"{what} has shape {array.shape}, not (K, {width}) with K >= {minimum}")
     if not np.isfinite(array).all():
         raise ValueError(f"{what} has non-finite values")
 
@@ -355,10 +379,12 @@ def _points(stage, name, width, count=None):
         raise ValueError(f"{_name(stage)}: {name!r} needs {count} rows, not {len(getattr(stage, name))}")
 
 
-def _vector(stage, name):
+def _vector(stage, name, unit=False):
     array = np.asarray(getattr(stage, name))
     if array.shape != (3,) or array.dtype.kind not in "iuf" or not np.isfinite(array).all():
         raise ValueError(f"{_name(stage)}: {name!r} is not a finite 3D vector")
+    if unit and abs(np.linalg.norm(array) - 1) > UNIT_TOLERANCE:
+        raise ValueError(f"{_name(stage)}: {name!r} is not a unit vector")
 
 
 def _finite_number(stage, name):
@@ -370,7 +396,7 @@ def _finite_number(stage, name):
 def _indices(stage, name, width, count):
     """The (K, width) integer array ``name`` of ``stage``, each index below ``count``."""
     array = np.asarray(getattr(stage, name))
-    if array.size == 0:
+    if array.shape in ((0,), (0, width)):
         return array.reshape(0, width)
     if array.ndim != 2 or array.shape[1] != width or array.dtype.kind not in "iu":
         raise ValueError(f"{_name(stage)}: {name!r} of shape {array.shape} and type {array.dtype} is not (K, {width}) "

@@ -6,6 +6,7 @@ declared ``Param``s; tuning is for developers, tests and benchmarks: ``table.cha
 one value changed by name, and ``python -m rigger methods --tuning`` prints every table.
 """
 import dataclasses
+import numbers
 
 
 def tuned(value, why):
@@ -19,19 +20,21 @@ class TuningTable:
 
     def changed(self, **values):
         """A copy with the named values changed; ValueError naming the valid fields for an unknown name, and for a
-        value whose type differs from the default's (an int where a float is expected is fine)."""
+        value of another kind than the default's (any real number for a float, any integer for an int)."""
         fields = {field.name: field for field in dataclasses.fields(self)}
         unknown = sorted(set(values) - set(fields))
         if unknown:
             raise ValueError(f"unknown tuning value{'s' if len(unknown) > 1 else ''} {', '.join(unknown)} of "
                              f"{type(self).__name__}; valid: {', '.join(fields)}")
+        typed = {}
         for name, value in values.items():
             default = fields[name].default
-            numeric = isinstance(default, float) and isinstance(value, int) and not isinstance(value, bool)
-            if type(value) is not type(default) and not numeric:
+            kind = {float: numbers.Real, int: numbers.Integral}.get(type(default), type(default))
+            if not isinstance(value, kind) or isinstance(value, bool) != isinstance(default, bool):
                 raise ValueError(f"tuning value {name} must be a {type(default).__name__} like its default "
                                  f"{default!r}, got {value!r}")
-        return dataclasses.replace(self, **values)
+            typed[name] = type(default)(value)
+        return dataclasses.replace(self, **typed)
 
     @classmethod
     def rows(cls):

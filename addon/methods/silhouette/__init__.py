@@ -17,8 +17,7 @@ from ...core.stages import (AxisGraph, Chains, Frame, Joints, MergedAxis, Mirror
                             PrunedBranches, Triangulation)
 from ...core.timing import StageClock
 from .bones import BoneBuilder
-from .chordal import triangle_classes
-from .depth import Blob, SideAxis, placed_islands
+from .depth import Blob, Placing, SideAxis, placed_islands
 from .rules import Rules
 from .second_view import hidden_limbs
 from .tree import pruned_tree, removed_links
@@ -77,17 +76,17 @@ class SilhouetteMethod(RigMethod):
     def rig(self, mesh, **values):
         params, tuning = SimpleNamespace(**values), self.tuning
         clock = StageClock()
-        frame, view = None, params.view
+        rotation, view = None, params.view
         if view == "DIRECTION":
-            frame, axis = view_frame(params.view_direction, tuning)
+            rotation, axis = view_frame(params.view_direction, tuning)
             view = AXIS_NAMES[axis]
         # rig at unit size (a power of two away: exact), in the frame where the view is an axis; then map back
-        placement = Placement(mesh.unit_factor, frame)
-        mesh = mesh.at_unit_size(frame)
+        placement = Placement(mesh.unit_factor, rotation)
+        mesh = mesh.at_unit_size(rotation)
         try:
             axis, primary = primary_view(mesh, view, params, tuning)
         except silhouette.NoSilhouette as error:
-            if frame is None:
+            if rotation is None:
                 raise
             raise type(error)(f"along view_direction {tuple(params.view_direction)}: {error}") from None
         sil = primary.sil
@@ -107,8 +106,9 @@ class SilhouetteMethod(RigMethod):
 
         builder = BoneBuilder(rules.cutting, rules.symmetry, tuning)
         mirror = None if rules.plane is None else mirror_in_depth(sil, rules.plane, rules.symmetry.tolerance, tuning)
-        for placed in placed_islands(sil, graph, alive, kept, tuning.speck * rules.unit, tuning, side,
-                                     params.split_layers, mirror):
+        placing = Placing(tuning, speck=tuning.speck * rules.unit, side_axis=side, split=params.split_layers,
+                          mirror=mirror)
+        for placed in placed_islands(sil, graph, alive, kept, placing):
             if isinstance(placed, Blob):
                 builder.add_blob(sil, placed.point, placed.radius)
             else:
@@ -127,7 +127,7 @@ class SilhouetteMethod(RigMethod):
             "frame": view_frame_stage,
             "silhouette": Outline(view_frame_stage, sil.loops),
             "cdt": Triangulation(view_frame_stage, primary.triangulation.vertices, primary.triangulation.triangles,
-                                 triangle_classes(primary.triangulation)),
+                                 primary.classes),
             "axis": AxisGraph(view_frame_stage, graph.points, graph.radius, graph.links),
             "merged": MergedAxis(view_frame_stage, graph.points, graph.radius, merged),
             "pruned": PrunedBranches(view_frame_stage, graph.points, graph.radius, removed_links(merged, kept)),

@@ -1,7 +1,5 @@
 """Bone building: bones along the placed chains of each island, hidden limbs hung from the bones they reach, and
 their names."""
-from dataclasses import replace
-
 import numpy as np
 
 from ...core.graphs import components
@@ -60,7 +58,7 @@ class BoneBuilder:
         chains, ups, meets_of = [], [], {}  # meets_of: limb number -> where it meets its bone, for the limbs to extend
         for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
             up, meets = self.attachment(line[0], views)  # from the left one's extension, which passes nearer it)
-            if meets is not None and np.linalg.norm(line[0] - meets) > self.tuning.bridge * self.bone_length:
+            if meets is not None and np.linalg.norm(line[0] - meets) > self.tuning.bridge_reach * self.bone_length:
                 meets_of[len(chains)] = meets
             chains.append((line, widths, True))
             ups.append(up)
@@ -107,17 +105,10 @@ class BoneBuilder:
         return groups
 
     def _joints(self, chains):
-        """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror pairs made symmetric."""
-        def joints_of(chain, max_bones, min_bones=0):
-            """Joints along chain number ``chain`` (``chain_joints``), at most and at least that many bones."""
-            line, widths, leaf = chains[chain]
-            return chain_joints(line, replace(self.cutting, max_bones=max_bones), widths, leaf, min_bones)
-
-        joints = [joints_of(chain, self.cutting.max_bones) for chain in range(len(chains))]
+        """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror twins made symmetric."""
         if self.symmetry is None:
-            return joints
-        return symmetric_joints(joints, [line for line, _, _ in chains], self.symmetry, joints_of,
-                                leaves=[leaf for _, _, leaf in chains], tuning=self.cutting.tuning)
+            return [chain_joints(line, self.cutting, widths, leaf) for line, widths, leaf in chains]
+        return symmetric_joints(chains, self.cutting, self.symmetry)
 
     def _add_chain(self, line, joints, up):
         """Bones between consecutive ``joints`` of one chain, the first hanging from bone ``up``; returns the

@@ -53,11 +53,11 @@ def triangle_classes(tri):
     return 3 - internal.sum(axis=1)
 
 
-def chordal_axis(tri):
-    """The chordal axis of a ``rigger.cdt.Triangulation`` made in mode ``"inside"``, as a :class:`ChordalAxis`."""
+def chordal_axis(tri, classes):
+    """The chordal axis of a ``rigger.cdt.Triangulation`` made in mode ``"inside"`` whose triangles are of
+    ``classes`` (``triangle_classes``), as a :class:`ChordalAxis`."""
     corners = tri.vertices[tri.triangles]                       # (T, 3, 2)
     internal = (tri.neighbors >= 0) & ~tri.constrained          # (T, 3): edge opposite corner k is internal
-    classes = 3 - internal.sum(axis=1)
     count = len(tri.triangles)
 
     # one node per internal edge, numbered from the triangle with the lower index

@@ -9,6 +9,7 @@ off the one arm). Where the chosen interval is much thicker than the part is wid
 its own chordal axis, seen from the side, says at which depth a part of that width and height lies. The thresholds
 are the tuning's depth section (``tuning.py``).
 """
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -31,41 +32,57 @@ class PlacedIsland(NamedTuple):
     chains: list
 
 
-def placed_islands(sil, graph, alive, kept, speck, tuning, side=None, split=True, mirror=None):
+@dataclass(frozen=True)
+class Placing:
+    """How one view's chains are put in depth.
+
+    Attributes:
+        tuning: the method's ``Tuning``.
+        speck: islands other than the largest whose axis is shorter than this (mesh units) get no bones.
+        side_axis: the perpendicular view's ``SideAxis``, for depth where this view is occluded; None: none.
+        split: split chains that run through several separate parts along the view (else follow one).
+        mirror: (depth, tolerance) of a mirror plane the view looks across, or None: with ``split``, a chain on
+            the plane stays on it where its rays pass only beside it, through parts mirroring each other (the gap
+            between a head's ears seen from the side), and a leaf chain ends before a tip that does, rather than
+            follow one ear off the plane; the perpendicular views find the ears (``_plane_course``).
+    """
+
+    tuning: object
+    speck: float = 0.0
+    side_axis: object = None
+    split: bool = True
+    mirror: tuple = None
+
+
+def placed_islands(sil, graph, alive, kept, placing):
     """Per island of the pruned axis (``graph``'s nodes ``alive`` joined by the links ``kept``), largest first: a
-    ``PlacedIsland`` (its chains in 3D), or a ``Blob`` for an island that is a single node; islands other than the
-    largest and smaller than ``speck`` are skipped (skinning gives them to the nearest bone). ``side``, ``split`` and
-    ``mirror``: see ``place_chains``."""
+    ``PlacedIsland`` (its chains in 3D), or a ``Blob`` for an island that is a single node; specks (``Placing``)
+    are skipped: skinning gives them to the nearest bone."""
     for number, (nodes, links, size) in enumerate(islands(graph, alive, kept)):
-        if number and size < speck:
+        if number and size < placing.speck:
             continue
         keys, island_chains = chains_of(nodes, links)
         if not island_chains:
             widest = nodes[int(np.argmax(graph.radius[nodes]))]
             yield Blob(graph.points[widest], graph.radius[widest])
             continue
-        root, rooted = rooted_chains(graph.points, keys, island_chains, graph.radius, tuning)
-        yield PlacedIsland(*place_chains(sil, graph.points, graph.radius, root, rooted, tuning, side, split, mirror))
+        root, rooted = rooted_chains(graph.points, keys, island_chains, graph.radius, placing.tuning)
+        yield PlacedIsland(*place_chains(sil, graph.points, graph.radius, root, rooted, placing))
 
 
-def place_chains(sil, points, radius, root, chains, tuning, side_axis=None, split=True, mirror=None):
+def place_chains(sil, points, radius, root, chains, placing):
     """3D polylines for the rooted ``chains`` (see ``tree.rooted_chains``).
 
     Args:
-        sil: the primary ``Silhouette``.
+        sil: the view's ``Silhouette``.
         points, radius: the axis nodes (n, 2) in ``sil``'s frame and their half-widths.
         root: the root node; chains: ``tree.Chain`` list, parents first.
-        tuning: the method's ``Tuning``.
-        side_axis: optional ``SideAxis`` of the perpendicular view, used where the primary view is occluded.
-        split: split chains that run through several separate parts along the view (else follow one).
-        mirror: (depth, tolerance) of a mirror plane the view looks across, or None: with ``split``, a chain on
-            the plane stays on it where its rays pass only beside it, through parts mirroring each other (the gap
-            between a head's ears seen from the side), and a leaf chain ends before a tip that does, rather than
-            follow one ear off the plane; the perpendicular views find the ears (see ``_plane_course``).
+        placing: how (``Placing``).
 
     Returns (root_point, placed) with ``placed`` a list of (polyline (k, 3), parent_index, half-widths (k,)) —
     parents first; a split chain yields several entries with the same parent.
     """
+    tuning, mirror = placing.tuning, placing.mirror
     used = sorted({root} | {n for c in chains for n in c.nodes})
     slot = {n: i for i, n in enumerate(used)}
     layers = [solid_layers(layer, radius[n], tuning) for layer, n in zip(sil.layers(points[used]), used)]
@@ -80,7 +97,7 @@ def place_chains(sil, points, radius, root, chains, tuning, side_axis=None, spli
         nodes = np.asarray(chain.nodes)
         node_layers = [layers[slot[n]] for n in chain.nodes]
         copies, parts, plane = 1, node_layers, None  # plane: the mirror this chain keeps to, if any
-        if split:
+        if placing.split:
             parts = [separate_parts(layer, r, tuning) for layer, r in zip(node_layers, radius[nodes])]
             copies = layer_count(parts, tuning)
             if copies == 1 and mirror is not None:
@@ -100,7 +117,7 @@ def place_chains(sil, points, radius, root, chains, tuning, side_axis=None, spli
                                 plane) for copy in range(count)]
             for copy in range(count):
                 depths = resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
-                                           followed[copy], side_axis, tuning, followed[:copy] + followed[copy + 1:])
+                                           followed[copy], placing, followed[:copy] + followed[copy + 1:])
                 line = sil.lift(chain_points[part], depths)
                 parent = -1
                 if parents:
@@ -120,23 +137,23 @@ def _middle(interval):
 
 
 def solid_layers(layer, radius, tuning):
-    """One node's depth intervals without those thinner than ``thin`` times its half-width when a thicker one
+    """One node's depth intervals without those thinner than ``sheet_thickness`` times its half-width when a thicker one
     exists: the zero-thickness intervals of open sheets (a cloak's hem) are not parts a chain should split into."""
     if len(layer) < 2:
         return layer  # the common case, kept free of numpy calls: nodes are many
-    thick = layer[:, 1] - layer[:, 0] >= tuning.thin * radius
+    thick = layer[:, 1] - layer[:, 0] >= tuning.sheet_thickness * radius
     return layer[thick] if thick.any() else layer
 
 
 def separate_parts(layer, radius, tuning):
-    """The intervals of one node that count as separate parts for splitting: those at least ``part`` times its
+    """The intervals of one node that count as separate parts for splitting: those at least ``part_thickness`` times its
     half-width thick, a limb's round cross-section, not the plates and shells of one limb (a robot's forearm, a
-    sheet), and ``alike`` as thick as the thickest (legs and fingers side by side are alike; a nose or a hat's brim
+    sheet), and ``part_alike`` as thick as the thickest (legs and fingers side by side are alike; a nose or a hat's brim
     beside a head is not a second head); a single part spanning all the intervals when none is that thick."""
     if len(layer) < 2:
         return layer  # the common case, kept free of numpy calls: nodes are many
     size = layer[:, 1] - layer[:, 0]
-    thick = size >= max(tuning.part * radius, tuning.alike * size.max())
+    thick = size >= max(tuning.part_thickness * radius, tuning.part_alike * size.max())
     if thick.any():
         return layer[thick]
     return np.array([[layer[0, 0], layer[-1, 1]]])
@@ -144,14 +161,14 @@ def separate_parts(layer, radius, tuning):
 
 def fork_point(parts, radius, copies, tuning):
     """Where a chain that runs through ``copies`` parts forks into them: the last node before the outer stretch over
-    which (for ``fork`` of its nodes) the parts are apart, when the chain runs through one round part of its own
+    which (for ``fork_share`` of its nodes) the parts are apart, when the chain runs through one round part of its own
     width before it (a hand's fingers off an arm: one arm, then a chain per finger); else 0, the parts apart from
     the start (a leg pair seen from the side merges with the body and each other towards its parent)."""
     apart = np.array([len(layer) >= 2 for layer in parts], dtype=float)
     share = np.cumsum(apart[::-1])[::-1] / np.arange(len(apart), 0, -1)
-    if not (share >= tuning.fork).any():
+    if not (share >= tuning.fork_share).any():
         return 0
-    start = int(np.argmax(share >= tuning.fork))
+    start = int(np.argmax(share >= tuning.fork_share))
     start += int(np.argmax(apart[start:]))  # the stretch begins where the parts are first apart
     if start < 2 or not any(len(layer) == copies for layer in parts[start:]):
         return 0
@@ -192,16 +209,16 @@ def _holds(intervals, depth):
 
 def layer_count(node_layers, tuning):
     """How many separate parts a chain runs through, judged over its outer nodes (all but the first
-    ``1 / outer_share``: near its parent it often runs into the body): the fewest parts (more than one) that a
-    ``several`` share of those nodes cross, else the most frequent count. Fewest, because parts split further towards
+    ``1 / near_parent_divisor``: near its parent it often runs into the body): the fewest parts (more than one) that a
+    ``split_share`` of those nodes cross, else the most frequent count. Fewest, because parts split further towards
     the tip (a dinosaur's feet, each with its toes) are still one limb each."""
     counts = np.array([len(layer) for layer in node_layers])
-    outer = counts[len(counts) // tuning.outer_share:]
+    outer = counts[len(counts) // tuning.near_parent_divisor:]
     outer = outer[outer > 0]
     if not len(outer):
         return 1
     frequency = np.bincount(outer)
-    several = np.flatnonzero(frequency[2:] >= tuning.several * len(outer)) + 2
+    several = np.flatnonzero(frequency[2:] >= tuning.split_share * len(outer)) + 2
     return int(several[0]) if len(several) else int(np.argmax(frequency))
 
 
@@ -240,7 +257,7 @@ def _track(node_layers, order, previous, depths, stay=False, mirror=None):
         depths[i] = previous
 
 
-def resolve_occlusion(sil, points, radius, node_layers, depths, side_axis, tuning, siblings=()):
+def resolve_occlusion(sil, points, radius, node_layers, depths, placing, siblings=()):
     """Where a node's interval is much thicker than its part is wide, take the depth from the side view instead,
     choosing among the side-view candidates the one closest to the previous node's depth (so a chain never
     hops between two legs that the side view shows at the same height). A thick interval at one node alone, between
@@ -248,6 +265,7 @@ def resolve_occlusion(sil, points, radius, node_layers, depths, side_axis, tunin
     front of the body: it is left alone. So is one that holds a ``siblings`` depth, the other copies of a split
     chain: there the parts merge (a cow's thighs into its hips) and each copy keeps its own side, rather than two of
     them taking the same side-view part."""
+    side_axis, tuning = placing.side_axis, placing.tuning
     if side_axis is None:
         return depths
     out = depths.copy()

@@ -11,7 +11,7 @@ edge-on) are never doubled.
 import numpy as np
 
 from ...core.polyline import length, segment_distances
-from .depth import PlacedIsland, placed_islands
+from .depth import PlacedIsland, Placing, placed_islands
 from .tree import pruned_tree
 
 
@@ -31,8 +31,8 @@ def hidden_limbs(sil, view, lines, rules):
     view.sil.share_parts(sil)  # the mesh's welded parts, found once for the primary view, give the view's layers
     limbs = []
     # placed without the plane: only the limbs off the skeleton are kept, and add_limbs completes their mirror pairs
-    for placed in placed_islands(view.sil, view_graph, alive, kept, tuning.speck * rules.unit, tuning, None,
-                                 params.split_layers, None):
+    placing = Placing(tuning, speck=tuning.speck * rules.unit, split=params.split_layers)
+    for placed in placed_islands(view.sil, view_graph, alive, kept, placing):
         if isinstance(placed, PlacedIsland):
             limbs += uncovered_limbs(placed.chains, cover, sil, pruning.min_reach, tuning)
     return limbs

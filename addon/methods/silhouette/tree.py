@@ -281,8 +281,8 @@ def _root_single_path(chains, keys, radius, tuning):
     end instead, one chain from its base, as an artist would rig it."""
     nodes = chains[0] if chains else sorted(keys)
     width = radius[nodes]
-    quarter = max(1, len(nodes) // tuning.end_share)  # the very ends taper to a point whatever the part's width
-    if width.max() <= tuning.uniform * np.median(width):
+    quarter = max(1, len(nodes) // tuning.end_divisor)  # the very ends taper to a point whatever the part's width
+    if width.max() <= tuning.column_ratio * np.median(width):
         if width[-quarter:].mean() > width[:quarter].mean():
             nodes = nodes[::-1]
         return nodes[0], [Chain(list(nodes), -1)] if len(nodes) > 1 else []

@@ -6,7 +6,7 @@ import numpy as np
 
 from ... import cdt, silhouette
 from ...core.mirror import mirrored
-from .chordal import chordal_axis
+from .chordal import chordal_axis, triangle_classes
 from .outline import outline_segments, without_small_holes
 
 AXES = np.eye(3)
@@ -14,10 +14,12 @@ AXIS_NAMES = ("X", "Y", "Z")
 
 
 class View(NamedTuple):
-    """A view of the mesh: its ``Silhouette``, the outline's ``rigger.cdt`` triangulation and its ``ChordalAxis``."""
+    """A view of the mesh: its ``Silhouette``, the outline's ``rigger.cdt`` triangulation with the class of each
+    triangle, and its ``ChordalAxis``."""
 
     sil: object
     triangulation: object
+    classes: np.ndarray
     axis_graph: object
 
 
@@ -111,7 +113,8 @@ def planar_view(vertices, triangles, direction, resolution, params):
     sil = silhouette.trace(vertices, triangles, direction, resolution=resolution)
     points, segments = outline_segments(without_small_holes(sil.loops, params.min_hole), params.outline_spacing)
     tri = cdt.triangulate(points, segments, mode="inside")
-    return View(sil, tri, chordal_axis(tri))
+    classes = triangle_classes(tri)
+    return View(sil, tri, classes, chordal_axis(tri, classes))
 
 
 def reflection_in_view(sil, plane, tuning):
