@@ -31,7 +31,7 @@ from rigger.blender.headless import empty_scene, temporary_user_folder  # noqa: 
 from rigger.skeletonize.polyline import segment_distances  # noqa: E402  (bpy-free)
 
 MODELS_DIR = SHARED_MODELS / "gt"
-REPAIR_STAGES = ("welded bone heat", "island bone heat", "nearest bones")
+REPAIR_STAGES = ("island bone heat", "nearest bones")
 SKELETONS = ("artist", "rigger")
 SAMPLES_PER_BONE = 9  # points along each of Rigger's bones when finding the nearest true bone
 SPEED_POINTS = (10_000, 100_000, 1_000_000)
@@ -56,16 +56,6 @@ def load_model(folder):
     skeleton, head_joint = rigdata.armature_skeleton(rig)
     place = np.unique(vertices, axis=0, return_inverse=True)[1].ravel()
     return Model(folder.name, vertices, triangles, skeleton, head_joint, rigdata.dominant_joints(rig), place)
-
-
-def vertex_normals(vertices, triangles):
-    """Area-weighted vertex normals (not normalised; ``rigger.weights`` accepts any length)."""
-    corners = vertices[triangles]
-    face_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    normals = np.zeros_like(vertices)
-    for k in range(3):
-        np.add.at(normals, triangles[:, k], face_normals)
-    return normals
 
 
 def nearest_true_bones(ours, truth):
@@ -136,7 +126,8 @@ def skin_model(model, kind):
         dominant = dominant_bones(obj, names)
         record["seam_gap"] = seam_gap(rigdata.vertex_weights(obj, names), model.place)
         record.update(
-            bones=len(names), unweighted=report.unweighted, recounted_unweighted=int((dominant < 0).sum()),
+            bones=len(names), welded=report.welded, unweighted=report.unweighted,
+            recounted_unweighted=int((dominant < 0).sum()),
             failed=any(FAILURE_MESSAGE in message for message in report.stages[0].messages),
             left_by_bone_heat=report.vertices - report.stages[0].weighted,
             stages={stage.name: stage.weighted for stage in report.stages[1:]},
@@ -149,9 +140,11 @@ def skin_model(model, kind):
 
 def fallback_alone(model):
     """Top-1 agreement of the nearest-bones weighting on every vertex, with the artist skeleton (no bone heat)."""
-    from rigger.weights import bone_weights
+    from rigger.weights import bone_weights, vertex_normals
 
-    normals = vertex_normals(model.vertices, model.triangles)
+    places = np.zeros((model.place.max() + 1, 3))
+    places[model.place] = model.vertices
+    normals = vertex_normals(places, model.place[model.triangles])[model.place]  # of the mesh with its seams welded
     result = bone_weights(model.vertices, model.skeleton.heads, model.skeleton.tails, normals)
     return agreement(model.head_joint, result.bones[:, 0], model.artist_joint)
 
@@ -245,7 +238,7 @@ def summary_rows(records, alone):
                   format_seconds(max(seconds)) if seconds else "–",
                   percent(np.nanmean([r["agreement"] for r in good]) if good else None)]
         rows.append(cells)
-    rows.append(["artist, nearest bones alone", str(len(alone)), "", "0", "", "", "", "", "", "", "", "",
+    rows.append(["artist, nearest bones alone", str(len(alone)), "", "0", "", "", "", "", "", "", "",
                  percent(np.nanmean(list(alone.values())) if alone else None)])
     return rows
 
@@ -264,7 +257,9 @@ def markdown(records, alone, speed, run):
         f"{', '.join(f'{v:.2f}' for v in run['load'])}); Blender {bpy.app.version_string} as the `bpy` module, "
         f"Python {platform.python_version()}, numpy {np.__version__}.",
         "- Meshes: each model's OBJ (`v`/`f` lines, polygons fan-triangulated, UV-seam duplicates kept as the file "
-        "has them) becomes one Blender mesh object, skinned with `rigger.blender.skinning.skin` in a fresh scene.",
+        "has them) becomes one Blender mesh object, skinned with `rigger.blender.skinning.skin` in a fresh scene. "
+        "Skinning welds the seams first (*welded*: vertices merged into another at the same place) and runs bone "
+        "heat on the welded copy.",
         "- Skeletons: **artist** = the rig_info joints, one bone per parent→child pair, helper joints and zero-length "
         "bones dropped (`rigdata.armature_skeleton`); **rigger** = `rigger.rig_mesh` with the silhouette method's "
         "defaults.",
@@ -274,7 +269,8 @@ def markdown(records, alone, speed, run):
         f"distance from {SAMPLES_PER_BONE} points along our bone to the true bone segment), so the score asks "
         "whether a vertex follows the right body part, and is limited by how well our bones match the artist's.",
         "- *Nearest bones alone*: `rigger.weights.bone_weights` (the last repair stage) on every vertex with the "
-        "artist skeleton and area-weighted vertex normals, no bone heat: what the fallback is worth on its own.",
+        "artist skeleton and the area-weighted vertex normals of the mesh with its seams welded (vertices at one "
+        "position merged), no bone heat: what the fallback is worth on its own.",
         "- Repair columns: models where the stage ran / where it weighted vertices / vertices it weighted.",
         "- Seams: *seam vertices* share their exact position with another vertex (the file split them for UVs or "
         "normals); the *seam gap* is the largest difference of one bone's weight between two such copies (0: the "
@@ -288,24 +284,25 @@ def markdown(records, alone, speed, run):
         "",
     ]
     out += markdown_table(["skeleton", "models", "errors", "unweighted vertices", "bone heat failed (message)",
-                  "bone heat left vertices silently", "welded bone heat", "island bone heat", "nearest bones",
+                  "bone heat left vertices silently", "island bone heat", "nearest bones",
                   "seams cracked / largest gap", "time (median)", "time (max)", "top-1 agreement (mean)"],
                          summary_rows(records, alone))
     out += ["", "![agreement per model, skinning time, fallback speed](skinning.png)", "", "## Per model", ""]
     rows = []
     for record in sorted(records, key=lambda r: (r["model"], SKELETONS.index(r["skeleton"]))):
         if "error" in record:
-            rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}"] + [""] * 10
+            rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}"] + [""] * 9
                         + [f"error: {table_cell(record['error'])}"])
             continue
         rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}", str(record["bones"]),
-                     bone_heat_cell(record), *(stage_cell(record, stage) for stage in REPAIR_STAGES),
-                     str(unweighted_count(record)), f"{record['seam_vertices']:,}", f"{record['seam_gap']:.3f}",
+                     f"{record['seam_vertices']:,}", f"{record['welded']:,}", bone_heat_cell(record),
+                     *(stage_cell(record, stage) for stage in REPAIR_STAGES), str(unweighted_count(record)),
+                     f"{record['seam_gap']:.3f}",
                      format_seconds(record["seconds"]),
                      percent(record["agreement"]),
                      percent(alone.get(record["model"])) if record["skeleton"] == "artist" else ""])
-    out += markdown_table(["model", "skeleton", "vertices", "bones", "bone heat", "welded", "islands", "nearest",
-                  "unweighted", "seam vertices", "seam gap", "skin time", "top-1 agreement", "nearest bones alone"], rows)
+    out += markdown_table(["model", "skeleton", "vertices", "bones", "seam vertices", "welded", "bone heat",
+                  "islands", "nearest", "unweighted", "seam gap", "skin time", "top-1 agreement", "nearest bones alone"], rows)
     if speed:
         out += ["", "## The compiled nearest-bones weighting alone", "",
                 "`rigger.weights.bone_weights(points, heads, tails, normals)` (4 bones per point), random bone "
