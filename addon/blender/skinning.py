@@ -34,7 +34,7 @@ import bpy
 import bmesh
 import numpy as np
 
-from ..core.arrays import column_bounds
+from ..core.arrays import column_bounds, concatenated_ranges
 from ..core.graphs import components
 from ..weights import bone_weights, vertex_normals
 from .meshdata import mesh_arrays, world_points
@@ -398,21 +398,26 @@ def _transfer(mesh_obj, bone_names, entries, targets, sources, weighted):
     weight) ``entries``), where the copy has any; marks them in ``weighted`` and returns how many it weighted.
 
     The weights are normalised over the deforming bones as they are written (bone heat leaves sums of 0.9 to 1),
-    in Python rather than with Blender's operator, whose poll refuses hidden objects. Each weight is written to all
-    the targets that share its copy vertex at once: a seam's copies get the same weights."""
+    in Python rather than with Blender's operator, whose poll refuses hidden objects. Each distinct (bone, weight)
+    is written once, to every target that carries it (a seam's copies, and the many vertices on one bone alone)."""
     copy_vertices, bones, weights = entries
-    order = np.argsort(copy_vertices, kind="stable")
-    copy_vertices, bones, weights = copy_vertices[order], bones[order], weights[order]
-    sums = np.bincount(copy_vertices, weights)
-    weights = weights / sums[copy_vertices]
+    if not len(copy_vertices):
+        return 0
+    weights = (weights / np.bincount(copy_vertices, weights)[copy_vertices]).astype(np.float32)  # Blender's floats
     found = np.isin(sources, copy_vertices)
     targets, sources = targets[found], sources[found]
     by_source = np.argsort(sources, kind="stable")
     starts = np.searchsorted(sources[by_source], copy_vertices, side="left")
-    ends = np.searchsorted(sources[by_source], copy_vertices, side="right")
+    counts = np.searchsorted(sources[by_source], copy_vertices, side="right") - starts
+    order = np.lexsort((weights, bones))
+    bones, weights, starts, counts = bones[order], weights[order], starts[order], counts[order]
+    members = targets[by_source[concatenated_ranges(starts, counts)]]  # each entry's targets, entry after entry
+    firsts = np.flatnonzero(np.r_[True, (bones[1:] != bones[:-1]) | (weights[1:] != weights[:-1])])
+    bounds = np.r_[0, np.cumsum(counts)][np.r_[firsts, len(bones)]]
     groups = [mesh_obj.vertex_groups[name] for name in bone_names]
-    for bone, weight, start, end in zip(bones.tolist(), weights.tolist(), starts.tolist(), ends.tolist()):
-        if end > start:
-            groups[bone].add(targets[by_source[start:end]].tolist(), weight, 'REPLACE')
+    for bone, weight, begin, end in zip(bones[firsts].tolist(), weights[firsts].tolist(), bounds[:-1].tolist(),
+                                        bounds[1:].tolist()):
+        if end > begin:
+            groups[bone].add(members[begin:end].tolist(), weight, 'REPLACE')
     weighted[targets] = True
     return len(targets)
