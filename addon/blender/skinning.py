@@ -21,7 +21,7 @@ vertices are counted directly.
 
 Every stage uses the mesh's own vertex positions (before modifiers) in world space, as Blender's bone heat does when
 parenting, except that with a Subsurf modifier Blender's bone heat takes each vertex's place on the limit surface:
-the welded copy (triangulated) then gets a Subsurf modifier too. Weights are normalised over the deforming bones as
+the welded copies (triangulated) then get a Subsurf modifier too. Weights are normalised over the deforming bones as
 they are written.
 """
 import contextlib
@@ -133,10 +133,9 @@ def skin(mesh_obj, armature_obj):
 
     weld = _welded(mesh_obj)
     report.welded = report.vertices - len(weld.positions)
-    subsurf = any(modifier.type == 'SUBSURF' for modifier in mesh_obj.modifiers)
     stage = SkinStage("bone heat", note=f"{report.welded} seam vertices welded" if report.welded else "")
     result, entries, stage.messages = _bone_heat_weights(weld.positions, weld.triangles, armature_obj, bone_names,
-                                                         subsurf=subsurf)
+                                                         weld.subsurf)
     report.bone_heat_result = ",".join(sorted(result))
     weighted = np.zeros(report.vertices, dtype=bool)
     stage.weighted = _transfer(mesh_obj, bone_names, entries, np.arange(report.vertices), weld.map, weighted)
@@ -283,7 +282,7 @@ def _repair_islands(mesh_obj, armature_obj, bone_names, weighted, weld, report):
             continue
         tried += 1
         _, entries, messages = _bone_heat_weights(welded_positions[vertices_by_island[island]],
-                                                  local_index[faces], armature_obj, bone_names)
+                                                  local_index[faces], armature_obj, bone_names, weld.subsurf)
         stage.messages += messages
         vertices = targets[island_targets]
         stage.weighted += _transfer(mesh_obj, bone_names, entries, vertices, local_index[weld_map[vertices]],
@@ -331,11 +330,13 @@ def _world_bones(armature_obj, bone_names):
 class Weld:
     """A mesh with its seams welded: ``map`` (N,) original vertex -> welded vertex, ``positions`` the welded
     vertices (each the position of the first original vertex merged into it) in world space, ``triangles`` the
-    welded triangles, those welding collapsed dropped."""
+    welded triangles, those welding collapsed dropped; ``subsurf``: the mesh has a Subsurf modifier, so bone heat
+    takes the limit surface."""
 
     map: np.ndarray
     positions: np.ndarray
     triangles: np.ndarray
+    subsurf: bool
 
 
 def _welded(mesh_obj):
@@ -360,7 +361,8 @@ def _welded(mesh_obj):
     kept, weld_map = np.unique(target, return_inverse=True)
     welded = weld_map[triangles]
     distinct = (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & (welded[:, 2] != welded[:, 0])
-    return Weld(weld_map, world_points(positions[kept], mesh_obj.matrix_world), welded[distinct])
+    return Weld(weld_map, world_points(positions[kept], mesh_obj.matrix_world), welded[distinct],
+                any(modifier.type == 'SUBSURF' for modifier in mesh_obj.modifiers))
 
 
 def _bone_heat_weights(positions, triangles, armature_obj, bone_names, subsurf=False):
