@@ -236,8 +236,8 @@ def _batch_axes(args, sources):
         raise CliError(str(error)) from None
     fixed = sum(source.suffix.lower() not in AXIS_SUFFIXES for source in sources)
     if fixed:
-        print(f"warning: --up and --forward apply to OBJ and FBX files only; {fixed} other files are read in their "
-              f"own frames", file=sys.stderr)
+        print(f"warning: --up and --forward apply to OBJ and FBX files only; {fixed} glTF or .blend file(s) keep "
+              f"their own frames", file=sys.stderr)
     return {suffix: [f"--up={up}", f"--forward={forward}"] for suffix, (up, forward) in axes.items()}
 
 

@@ -305,8 +305,8 @@ def test_a_batch_gives_the_axes_to_its_obj_and_fbx_files_only(tmp_path):
     folder.mkdir()
     (folder / "scene.glb").write_bytes(b"not a glTF")
     result = run("batch", folder, "-o", tmp_path / "out", "--up", "Z")
-    assert "warning: --up and --forward apply to OBJ and FBX files only; 1 other files are read in their own frames" \
-        in result.stderr
+    assert "warning: --up and --forward apply to OBJ and FBX files only; 1 glTF or .blend file(s) keep their own " \
+           "frames" in result.stderr
     (row,) = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert row["status"] == "failed" and "could not import" in row["message"]  # not refused for its axes
 
