@@ -15,6 +15,7 @@ import subprocess
 import sys
 import time
 
+from .axes import AXES, AXIS_SUFFIXES, file_axes
 from .core.files import remove_leftovers, replaced_on_success
 
 INPUTS = (".obj", ".glb", ".gltf", ".fbx", ".blend")
@@ -29,7 +30,7 @@ class CliError(Exception):
 
 def main(argv=None):
     parser = _parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_axis_values_joined(sys.argv[1:] if argv is None else list(argv)))
     try:
         return args.run(args)
     except CliError as error:
@@ -47,6 +48,7 @@ def _parser():
                      help=f"where to save ({', '.join(OUTPUTS)}); default INPUT_rigged.blend beside the input")
     rig.add_argument("--report", type=pathlib.Path, help="write a JSON report here")
     _method_options(rig)
+    _axis_options(rig)
     rig.set_defaults(run=_run_rig)
 
     batch = commands.add_parser("batch", help="rig every model file of a folder in parallel processes")
@@ -58,6 +60,7 @@ def _parser():
     batch.add_argument("--timeout", type=float, metavar="SECONDS",
                        help="give up on a file after this many seconds (default: no limit)")
     _method_options(batch)
+    _axis_options(batch)
     batch.set_defaults(run=_run_batch)
 
     methods = commands.add_parser("methods", help="list the rigging methods and their parameters")
@@ -72,6 +75,25 @@ def _method_options(parser):
     parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
                         help="a method parameter, e.g. --set bone_length=0.08 (repeatable)")
     parser.add_argument("--no-skin", action="store_true", help="make the armature only, do not skin the mesh")
+
+
+def _axis_options(parser):
+    names = ", ".join(AXES)
+    parser.add_argument("--up", help=f"the file's up axis ({names}; OBJ and FBX only; default Y for OBJ, the FBX "
+                                     f"file's own)")
+    parser.add_argument("--forward", help=f"the file's forward axis, which becomes Blender's +Y ({names}; OBJ and "
+                                          f"FBX only; default -Z, or Y when --up is Z or -Z)")
+
+
+def _axis_values_joined(argv):
+    """``argv`` with ``--up -Z`` written ``--up=-Z``: argparse takes a value that starts with a dash for an option."""
+    joined = []
+    for arg in argv:
+        if joined and joined[-1] in ("--up", "--forward") and str(arg).upper() in ("-X", "-Y", "-Z"):
+            joined[-1] = f"{joined[-1]}={arg}"
+        else:
+            joined.append(arg)
+    return joined
 
 
 def _settings(pairs):
@@ -115,9 +137,10 @@ def _run_rig(args):
     if output.suffix.lower() not in OUTPUTS:
         raise CliError(f"{output}: cannot write {output.suffix or 'files without a suffix'}; use {', '.join(OUTPUTS)}")
     _check_destinations(source, output, args.report)
-    try:  # check the method and parameters before the slow import
+    try:  # check the method, parameters and axes before the slow import
         method = method_registry().lookup(args.method)
         params = resolve(method.params, _settings(args.settings))
+        file_axes(source.suffix, args.up, args.forward)
     except ValueError as error:
         raise CliError(str(error)) from None
 
@@ -126,7 +149,8 @@ def _run_rig(args):
 
     register()  # the properties the Blender layer keeps on scenes and objects
     try:
-        report = scenefiles.rig_file(source, output, method.name, params, skin=not args.no_skin)
+        report = scenefiles.rig_file(source, output, method.name, params, skin=not args.no_skin, up=args.up,
+                                     forward=args.forward)
         if args.report is not None:
             with replaced_on_success(args.report) as path:
                 path.write_text(json.dumps(report, indent=2))
@@ -185,6 +209,7 @@ def _run_batch(args):
     sources = sorted(path for path in args.folder.iterdir() if path.suffix.lower() in INPUTS and path.is_file())
     if not sources:
         raise CliError(f"{args.folder}: no model files ({', '.join(INPUTS)})")
+    axes = _batch_axes(args, sources)
     _check_folder(args.output, "the results")
     args.output.mkdir(parents=True, exist_ok=True)
     extra = [f"--method={args.method}", *(f"--set={pair}" for pair in args.settings)]
@@ -193,7 +218,8 @@ def _run_batch(args):
     rows = []
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         futures = [pool.submit(rig_in_child, source, args.output / f"{stem}.{args.format}",
-                               args.output / f"{stem}.json", extra, args.timeout)
+                               args.output / f"{stem}.json", extra + axes.get(source.suffix.lower(), []),
+                               args.timeout)
                    for source, stem in zip(sources, stems)]
         for done, future in enumerate(concurrent.futures.as_completed(futures), start=1):
             rows.append(future.result())
@@ -203,6 +229,22 @@ def _run_batch(args):
     (args.output / SUMMARY).write_text(json.dumps(rows, indent=2))
     failed = sum(row["status"] != "ok" for row in rows)
     return EXIT_FAILED if failed else 0
+
+
+def _batch_axes(args, sources):
+    """The ``--up``/``--forward`` arguments of a batch's children by file suffix: given only to the OBJ and FBX files
+    (checked here, once); a warning when other files are read in their own frames."""
+    if args.up is None and args.forward is None:
+        return {}
+    try:
+        axes = {suffix: file_axes(suffix, args.up, args.forward) for suffix in AXIS_SUFFIXES}
+    except ValueError as error:
+        raise CliError(str(error)) from None
+    fixed = sum(source.suffix.lower() not in AXIS_SUFFIXES for source in sources)
+    if fixed:
+        print(f"warning: --up and --forward apply to OBJ and FBX files only; {fixed} glTF or .blend file(s) keep "
+              f"their own frames", file=sys.stderr)
+    return {suffix: [f"--up={up}", f"--forward={forward}"] for suffix, (up, forward) in axes.items()}
 
 
 def output_stems(sources, suffix, in_place):

@@ -7,6 +7,7 @@ the bundled compiled module ``rigger._rigger_weights`` (``ext/skin_weights.c``);
 Example::
 
     from rigger import weights
+    normals = weights.vertex_normals(points, triangles)           # of a mesh with its seams welded
     result = weights.bone_weights(points, heads, tails, normals)   # (N, 3), (B, 3), (B, 3), (N, 3) or None
     result.bones[:, 0]            # each point's dominant bone
     result.dense(len(heads))      # (N, B) weights, rows summing to 1
@@ -28,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _rigger_weights
-from .core.arrays import point_array
+from .core.arrays import index_array, point_array
 
 DEFAULT_BONES_PER_POINT = 4
 DEFAULT_POWER = 4.0
@@ -108,6 +109,25 @@ def bone_weights(points, heads, tails, normals=None, *, bones_per_point=DEFAULT_
     bones, weights = _rigger_weights.bone_weights(point_rows, normal_array, head_array, tail_array,
                                                   int(bones_per_point), power_value, penalty_value)
     return BoneWeights(bones, weights)
+
+
+def vertex_normals(vertices, triangles):
+    """Area-weighted vertex normals (N, 3) of a triangle mesh, not normalised (``bone_weights`` takes any length):
+    each vertex sums the cross products of its triangles' edges. A vertex without triangles, or whose triangles
+    cancel out, gets a zero normal, which switches the facing penalty off for it.
+
+    Weld a mesh's seams before: a vertex split along a seam would otherwise get the normal of its own side's
+    triangles only, and its copies could take different bones.
+    """
+    vertex_rows = point_array(vertices, 3, "vertices")
+    triangle_rows = index_array(triangles, 3, len(vertex_rows), name="triangles", item="triangle",
+                                target=("vertex", "vertices"), dtype=np.int64)
+    corners = vertex_rows[triangle_rows]
+    face_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normals = np.zeros_like(vertex_rows)
+    for corner in range(3):
+        np.add.at(normals, triangle_rows[:, corner], face_normals)
+    return normals
 
 
 def _number(value, name):

@@ -4,7 +4,9 @@ Every model is skinned twice in headless Blender: to an armature of its artist's
 one of Rigger's own skeleton (``rigger.rig_mesh``, silhouette method). Measured: vertices left unweighted (must be 0
 everywhere), what bone heat printed, how often each repair stage ran and how many vertices it weighted, time, and the
 agreement of the dominant bone with the artist's weights. The compiled nearest-bones weighting alone is scored too,
-and timed on synthetic bone sets up to a million points and thousands of bones. Writes
+and timed on synthetic bone sets up to a million points and thousands of bones. Seams: vertices at one position (split
+for UVs or normals) must carry the same weights, or the posed mesh cracks open there; the largest weight difference
+between them is measured and must be 0. Writes
 ``bench/results/skinning.md`` and ``bench/results/skinning.png``.
 
     .venv/bin/python bench/skinning.py [--models SUBSTR,...] [--skip-speed]
@@ -29,7 +31,7 @@ from rigger.blender.headless import empty_scene, temporary_user_folder  # noqa: 
 from rigger.core.polyline import segment_distances  # noqa: E402  (bpy-free)
 
 MODELS_DIR = SHARED_MODELS / "gt"
-REPAIR_STAGES = ("welded bone heat", "island bone heat", "nearest bones")
+REPAIR_STAGES = ("island bone heat", "nearest bones")
 SKELETONS = ("artist", "rigger")
 SAMPLES_PER_BONE = 9  # points along each of Rigger's bones when finding the nearest true bone
 SPEED_POINTS = (10_000, 100_000, 1_000_000)
@@ -46,22 +48,14 @@ class Model:
     skeleton: object  # rigger Skeleton of the artist's bones
     head_joint: np.ndarray  # (B,) joint where each artist bone starts
     artist_joint: np.ndarray  # (V,) the owner joint of each vertex's largest artist weight, -1 for none
+    place: np.ndarray  # (V,) index of each vertex's exact position: vertices sharing one are a seam's copies
 
 
 def load_model(folder):
     vertices, triangles, rig = rigdata.load_ground_truth(folder)
     skeleton, head_joint = rigdata.armature_skeleton(rig)
-    return Model(folder.name, vertices, triangles, skeleton, head_joint, rigdata.dominant_joints(rig))
-
-
-def vertex_normals(vertices, triangles):
-    """Area-weighted vertex normals (not normalised; ``rigger.weights`` accepts any length)."""
-    corners = vertices[triangles]
-    face_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    normals = np.zeros_like(vertices)
-    for k in range(3):
-        np.add.at(normals, triangles[:, k], face_normals)
-    return normals
+    place = np.unique(vertices, axis=0, return_inverse=True)[1].ravel()
+    return Model(folder.name, vertices, triangles, skeleton, head_joint, rigdata.dominant_joints(rig), place)
 
 
 def nearest_true_bones(ours, truth):
@@ -79,6 +73,16 @@ def agreement(joint_of_bone, dominant_bone, artist_joint):
     if not weighted.any():
         return float("nan")
     return float((joint_of_bone[dominant_bone[weighted]] == artist_joint[weighted]).mean())
+
+
+def seam_gap(table, place):
+    """The largest difference of one bone's weight between two vertices at one position (``table``: (V, B)
+    weights, ``place``: (V,) position index); 0 when every seam's copies are weighted alike."""
+    high = np.full((place.max() + 1, table.shape[1]), -np.inf)
+    low = np.full_like(high, np.inf)
+    np.maximum.at(high, place, table)
+    np.minimum.at(low, place, table)
+    return float((high - low).max())
 
 
 def dominant_bones(obj, names):
@@ -99,7 +103,8 @@ def skin_model(model, kind):
     from rigger.blender.armature import build_armature
     from rigger.blender.skinning import FAILURE_MESSAGE, skin
 
-    record = {"model": model.name, "skeleton": kind, "vertices": len(model.vertices)}
+    record = {"model": model.name, "skeleton": kind, "vertices": len(model.vertices),
+              "seam_vertices": int((np.bincount(model.place)[model.place] > 1).sum())}
     try:
         empty_scene()
         mesh = bpy.data.meshes.new(model.name)
@@ -119,8 +124,10 @@ def skin_model(model, kind):
         record["seconds"] = time.perf_counter() - started
         names = list(skeleton.names)
         dominant = dominant_bones(obj, names)
+        record["seam_gap"] = seam_gap(rigdata.vertex_weights(obj, names), model.place)
         record.update(
-            bones=len(names), unweighted=report.unweighted, recounted_unweighted=int((dominant < 0).sum()),
+            bones=len(names), welded=report.welded, unweighted=report.unweighted,
+            recounted_unweighted=int((dominant < 0).sum()),
             failed=any(FAILURE_MESSAGE in message for message in report.stages[0].messages),
             left_by_bone_heat=report.vertices - report.stages[0].weighted,
             stages={stage.name: stage.weighted for stage in report.stages[1:]},
@@ -133,9 +140,11 @@ def skin_model(model, kind):
 
 def fallback_alone(model):
     """Top-1 agreement of the nearest-bones weighting on every vertex, with the artist skeleton (no bone heat)."""
-    from rigger.weights import bone_weights
+    from rigger.weights import bone_weights, vertex_normals
 
-    normals = vertex_normals(model.vertices, model.triangles)
+    places = np.zeros((model.place.max() + 1, 3))
+    places[model.place] = model.vertices
+    normals = vertex_normals(places, model.place[model.triangles])[model.place]  # of the mesh with its seams welded
     result = bone_weights(model.vertices, model.skeleton.heads, model.skeleton.tails, normals)
     return agreement(model.head_joint, result.bones[:, 0], model.artist_joint)
 
@@ -196,6 +205,20 @@ def verdict(records):
             f"the vertices without a weight > 0 in any deforming bone's group).")
 
 
+def seam_verdict(records):
+    """The seam target: vertices at one position weighted alike (gap 0) in every run."""
+    good = [r for r in records if "error" not in r]
+    cracked = [r for r in good if r["seam_gap"] > 0]
+    worst = max(good, key=lambda r: r["seam_gap"], default=None)
+    passed = not cracked and len(good) == len(records)
+    text = (f"Target, vertices at one position weighted alike: **{'PASS' if passed else 'FAIL'}**: "
+            f"{len(cracked)} of {len(good)} runs have a seam whose copies differ")
+    if cracked:
+        text += f"; the largest weight difference is {worst['seam_gap']:.3f} ({worst['model']}, {worst['skeleton']} " \
+                f"skeleton)"
+    return text + "."
+
+
 def summary_rows(records, alone):
     rows = []
     for kind in SKELETONS:
@@ -210,6 +233,7 @@ def summary_rows(records, alone):
             cells.append(f"{len(ran)} / {sum(r['stages'][stage] > 0 for r in ran)} / "
                          f"{sum(r['stages'][stage] for r in ran)}")
         seconds = [r["seconds"] for r in good]
+        cells.append(f"{sum(r['seam_gap'] > 0 for r in good)} / {max((r['seam_gap'] for r in good), default=0):.3f}")
         cells += [format_seconds(statistics.median(seconds)) if seconds else "–",
                   format_seconds(max(seconds)) if seconds else "–",
                   percent(np.nanmean([r["agreement"] for r in good]) if good else None)]
@@ -233,7 +257,9 @@ def markdown(records, alone, speed, run):
         f"{', '.join(f'{v:.2f}' for v in run['load'])}); Blender {bpy.app.version_string} as the `bpy` module, "
         f"Python {platform.python_version()}, numpy {np.__version__}.",
         "- Meshes: each model's OBJ (`v`/`f` lines, polygons fan-triangulated, UV-seam duplicates kept as the file "
-        "has them) becomes one Blender mesh object, skinned with `rigger.blender.skinning.skin` in a fresh scene.",
+        "has them) becomes one Blender mesh object, skinned with `rigger.blender.skinning.skin` in a fresh scene. "
+        "Skinning welds the seams first (*welded*: vertices merged into another at the same place) and runs bone "
+        "heat on the welded copy.",
         "- Skeletons: **artist** = the rig_info joints, one bone per parent→child pair, helper joints and zero-length "
         "bones dropped (`rigdata.armature_skeleton`); **rigger** = `rigger.rig_mesh` with the silhouette method's "
         "defaults.",
@@ -243,31 +269,40 @@ def markdown(records, alone, speed, run):
         f"distance from {SAMPLES_PER_BONE} points along our bone to the true bone segment), so the score asks "
         "whether a vertex follows the right body part, and is limited by how well our bones match the artist's.",
         "- *Nearest bones alone*: `rigger.weights.bone_weights` (the last repair stage) on every vertex with the "
-        "artist skeleton and area-weighted vertex normals, no bone heat: what the fallback is worth on its own.",
+        "artist skeleton and the area-weighted vertex normals of the mesh with its seams welded (vertices at one "
+        "position merged), no bone heat: what the fallback is worth on its own.",
         "- Repair columns: models where the stage ran / where it weighted vertices / vertices it weighted.",
+        "- Seams: *seam vertices* share their exact position with another vertex (the file split them for UVs or "
+        "normals); the *seam gap* is the largest difference of one bone's weight between two such copies (0: the "
+        "posed mesh cannot crack there). *Seams cracked* counts the models whose gap is above 0.",
         "",
         "## Summary",
         "",
         verdict(records),
         "",
+        seam_verdict(records),
+        "",
     ]
     out += markdown_table(["skeleton", "models", "errors", "unweighted vertices", "bone heat failed (message)",
-                  "bone heat left vertices silently", "welded bone heat", "island bone heat", "nearest bones",
-                  "time (median)", "time (max)", "top-1 agreement (mean)"], summary_rows(records, alone))
+                  "bone heat left vertices silently", "island bone heat", "nearest bones",
+                  "seams cracked / largest gap", "time (median)", "time (max)", "top-1 agreement (mean)"],
+                         summary_rows(records, alone))
     out += ["", "![agreement per model, skinning time, fallback speed](skinning.png)", "", "## Per model", ""]
     rows = []
     for record in sorted(records, key=lambda r: (r["model"], SKELETONS.index(r["skeleton"]))):
         if "error" in record:
-            rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}"] + [""] * 8
+            rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}"] + [""] * 9
                         + [f"error: {table_cell(record['error'])}"])
             continue
         rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}", str(record["bones"]),
-                     bone_heat_cell(record), *(stage_cell(record, stage) for stage in REPAIR_STAGES),
-                     str(unweighted_count(record)), format_seconds(record["seconds"]),
+                     f"{record['seam_vertices']:,}", f"{record['welded']:,}", bone_heat_cell(record),
+                     *(stage_cell(record, stage) for stage in REPAIR_STAGES), str(unweighted_count(record)),
+                     f"{record['seam_gap']:.3f}",
+                     format_seconds(record["seconds"]),
                      percent(record["agreement"]),
                      percent(alone.get(record["model"])) if record["skeleton"] == "artist" else ""])
-    out += markdown_table(["model", "skeleton", "vertices", "bones", "bone heat", "welded", "islands", "nearest",
-                  "unweighted", "skin time", "top-1 agreement", "nearest bones alone"], rows)
+    out += markdown_table(["model", "skeleton", "vertices", "bones", "seam vertices", "welded", "bone heat",
+                  "islands", "nearest", "unweighted", "seam gap", "skin time", "top-1 agreement", "nearest bones alone"], rows)
     if speed:
         out += ["", "## The compiled nearest-bones weighting alone", "",
                 "`rigger.weights.bone_weights(points, heads, tails, normals)` (4 bones per point), random bone "

@@ -12,7 +12,8 @@ from characters import strictly_inside_fraction, load_character
 bpy = pytest.importorskip("bpy")
 
 import rigger  # noqa: E402
-from rigger import cli  # noqa: E402
+from bpy_extras.io_utils import axis_conversion  # noqa: E402  (Blender's own axis table)
+from rigger import axes, cli  # noqa: E402
 from rigger.blender.armature import build_armature  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
 from rigger.core.skeleton import Skeleton  # noqa: E402
@@ -191,6 +192,125 @@ def test_errors_exit_non_zero_with_a_message_and_write_nothing(case, message, hu
     assert set(leaves_nothing(tmp_path)) == before
 
 
+# --up and --forward (issue 28, defect 8)
+
+AXIS_PAIRS = [(up, forward) for up in axes.AXES for forward in axes.AXES if up[-1] != forward[-1]]
+
+
+def test_axes_turn_a_file_as_blenders_obj_importer_does(scene, tmp_path):
+    """For each of the 24 (up, forward) pairs, the rotation the report maps bones back through is the one Blender's
+    OBJ importer puts the file in its world with (and Blender's own axis table)."""
+    source = write_obj(tmp_path / "corner.obj", [(1.0, 2.0, 3.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0)], [(0, 1, 2)])
+    for up, forward in AXIS_PAIRS:
+        scene_objects = bpy.context.scene.objects
+        for obj in list(scene_objects):
+            bpy.data.objects.remove(obj)
+        bpy.ops.wm.obj_import(filepath=str(source), up_axis=up.replace("-", "NEGATIVE_"),
+                              forward_axis=forward.replace("-", "NEGATIVE_"))
+        (obj,) = scene_objects
+        turn = axes.to_blender(up, forward)
+        np.testing.assert_allclose(np.array(obj.matrix_world)[:3, :3] @ obj.data.vertices[0].co, turn @ [1, 2, 3],
+                                   atol=1e-6, err_msg=f"up {up}, forward {forward}")
+        np.testing.assert_allclose(turn, np.array(axis_conversion(from_forward=forward, from_up=up, to_forward="Y",
+                                                                  to_up="Z")), atol=1e-12)
+
+
+def saved_scene(path):
+    """Open a .blend the CLI saved: (its mesh's world vertices, {bone: world head} of its armature)."""
+    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+    mesh = next(obj for obj in bpy.data.objects if obj.type == 'MESH')
+    armature = next(obj for obj in bpy.data.objects if obj.type == 'ARMATURE')
+    vertices = np.array([mesh.matrix_world @ vertex.co for vertex in mesh.data.vertices])
+    heads = {bone.name: np.array(armature.matrix_world @ bone.head_local) for bone in armature.data.bones}
+    return vertices, heads
+
+
+@pytest.mark.parametrize("up, forward, options", [("Z", "Y", ["--up", "Z"]),
+                                                  ("-X", "Z", ["--up", "-X", "--forward", "z"])])
+def test_an_obj_read_with_its_own_up_axis_stands_upright_and_reports_its_own_coordinates(
+        scene, tmp_path, up, forward, options):
+    """The humanoid written with another up axis (Z up, as CesiumMan's OBJ; or -X up): read with --up (and
+    --forward), it stands in Blender as generated, Z up, and the report's bones are in the file's coordinates."""
+    vertices, triangles = load_character("humanoid")
+    turn = axes.to_blender(up, forward)
+    source = write_obj(tmp_path / "upright.obj", vertices @ turn, triangles)  # rows: file = turn^T @ world
+    result = run("rig", source, "-o", tmp_path / "out.blend", "--report", tmp_path / "r.json", *options)
+    assert result.returncode == 0, result.stderr
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["axes"] == {"up": up, "forward": forward}
+    assert f"read with up {up}, forward {forward}" in report["frame"]
+
+    world, heads = saved_scene(tmp_path / "out.blend")
+    np.testing.assert_allclose(world, vertices, atol=1e-5)  # upright: exactly the generated, Z-up character
+    bones = {bone["name"]: bone for bone in report["bones"]}
+    for name, head in heads.items():  # the report's bones are the armature's, in the file's coordinates
+        np.testing.assert_allclose(bones[name]["head"], head @ turn, atol=1e-5)
+    root = next(bone["name"] for bone in report["bones"] if bone["parent"] is None)
+    top = max(heads, key=lambda name: heads[name][2])
+    rise = heads[top] - heads[root]
+    assert rise[2] > 0.9 * np.linalg.norm(rise) and rise[2] > 0.5  # from the hips up to the head, along +Z
+
+
+def test_a_z_up_obj_read_with_the_default_axes_lies_on_its_side(scene, tmp_path):
+    vertices, triangles = load_character("humanoid")
+    source = write_obj(tmp_path / "upright.obj", vertices, triangles)
+    result = run("rig", source, "-o", tmp_path / "out.blend", "--report", tmp_path / "r.json", "--no-skin")
+    assert result.returncode == 0, result.stderr
+    assert json.loads((tmp_path / "r.json").read_text())["axes"] == {"up": "Y", "forward": "-Z"}
+    world, _ = saved_scene(tmp_path / "out.blend")
+    np.testing.assert_allclose(world, vertices @ Y_UP_TO_Z_UP.T, atol=1e-5)  # the file's Z became Blender's -Y
+
+
+def test_an_fbx_is_read_with_its_own_axes_unless_told_otherwise(scene, humanoid_obj, tmp_path):
+    """Blender writes FBX files Y up, forward -Z, and says so in the file: read as they are by default or with those
+    axes given; told Z up, Blender's importer turns the file's Y-up data onto its back."""
+    assert run("rig", humanoid_obj[0], "-o", tmp_path / "in.fbx", "--no-skin").returncode == 0
+    worlds = {}
+    for options in ((), ("--up", "Y", "--forward", "-Z"), ("--up", "Z")):
+        result = run("rig", tmp_path / "in.fbx", "-o", tmp_path / "out.blend", "--report", tmp_path / "r.json",
+                     "--no-skin", *options)
+        assert result.returncode == 0, result.stderr
+        report = json.loads((tmp_path / "r.json").read_text())
+        assert report["frame"].startswith("blender world") and report["axes"] == (
+            dict(zip(("up", "forward"), axes.file_axes(".fbx", *options[1::2]))) if options else None)
+        worlds[options] = saved_scene(tmp_path / "out.blend")[0]
+    upright, given, on_its_back = worlds.values()
+    np.testing.assert_allclose(upright, humanoid_obj[1] @ Y_UP_TO_Z_UP.T, atol=1e-5)
+    np.testing.assert_allclose(given, upright, atol=1e-5)
+    np.testing.assert_allclose(on_its_back, upright @ Y_UP_TO_Z_UP, atol=1e-5)
+
+
+@pytest.mark.parametrize("source, options, message", [
+    ("model.obj", ["--up", "W"], "--up must be one of X, Y, Z, -X, -Y, -Z, got 'W'"),
+    ("model.obj", ["--up", "Z", "--forward", "-Z"], "--up Z and --forward -Z lie on one axis"),
+    ("model.obj", ["--forward=y"], "--up Y and --forward Y lie on one axis"),
+    ("model.glb", ["--up", "Z"], "--up and --forward apply to OBJ and FBX files only; glTF is Y-up"),
+    ("model.blend", ["--forward", "X"], "--up and --forward apply to OBJ and FBX files only; a .blend file is in "
+                                        "Blender's Z-up world already"),
+])
+def test_bad_axes_are_one_error_line_before_anything_is_read(tmp_path, source, options, message):
+    (tmp_path / source).write_text("never read")
+    for command in (["rig", tmp_path / source, "-o", tmp_path / "out" / "x.blend"],
+                    ["batch", tmp_path, "-o", tmp_path / "out"]):
+        if command[0] == "batch" and source != "model.obj":
+            continue  # a batch applies the axes to its OBJ and FBX files only, and warns about the others
+        result = run(*command, *options)
+        assert result.returncode == 1 and result.stderr.startswith(f"rigger: error: {message}"), result.stderr
+        assert len(result.stderr.strip().splitlines()) == 1
+        assert not (tmp_path / "out").exists()
+
+
+def test_a_batch_gives_the_axes_to_its_obj_and_fbx_files_only(tmp_path):
+    folder = tmp_path / "models"
+    folder.mkdir()
+    (folder / "scene.glb").write_bytes(b"not a glTF")
+    result = run("batch", folder, "-o", tmp_path / "out", "--up", "Z")
+    assert "warning: --up and --forward apply to OBJ and FBX files only; 1 glTF or .blend file(s) keep their own " \
+           "frames" in result.stderr
+    (row,) = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert row["status"] == "failed" and "could not import" in row["message"]  # not refused for its axes
+
+
 def test_methods_lists_every_method_and_its_parameters():
     result = run("methods")
     assert result.returncode == 0
@@ -205,9 +325,10 @@ def test_batch_rigs_a_folder_in_parallel_and_summarises(humanoid_obj, tmp_path):
     (folder / "snake.fbx").write_text("not an FBX")  # the same stem: the results must not share a name
     (folder / "notes.txt").write_text("not a model")
     out = tmp_path / "rigged"
-    result = run("batch", folder, "-o", out, "--jobs", 2, "--format", "glb", "--timeout", 300)
+    result = run("batch", folder, "-o", out, "--jobs", 2, "--format", "glb", "--timeout", 300, "--up", "Z")
     assert result.returncode == 1  # one file failed
-    assert "1 of 2 rigged" in result.stdout and "2/2" in result.stderr
+    assert "1 of 2 rigged" in result.stdout and "2/2" in result.stderr and "warning" not in result.stderr
+    assert json.loads((out / "snake_obj.json").read_text())["axes"] == {"up": "Z", "forward": "Y"}
     rows = {row["file"]: row for row in json.loads((out / "summary.json").read_text())}
     assert rows["snake.obj"]["status"] == "ok" and rows["snake.obj"]["bones"] > 0
     assert rows["snake.obj"]["output"] == "snake_obj.glb"

@@ -181,3 +181,37 @@ def test_no_points_gives_empty_rows():
 def test_bad_input_is_a_clear_value_error(arguments, keywords, message):
     with pytest.raises(ValueError, match=message):
         weights.bone_weights(*arguments, **keywords)
+
+
+def test_vertex_normals_sum_the_area_weighted_normals_of_each_vertexs_triangles():
+    """A unit square as two triangles (each cross product of length 1, twice its area), a triangle of the square's
+    size standing on its edge, and a vertex without a triangle."""
+    vertices = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 2), (5, 5, 5)]
+    triangles = [(0, 1, 2), (0, 2, 3), (0, 4, 1)]
+    normals = weights.vertex_normals(vertices, triangles)
+    np.testing.assert_allclose(normals, [(0, 2, 2), (0, 2, 1), (0, 0, 2), (0, 0, 1), (0, 2, 0), (0, 0, 0)])
+    assert weights.vertex_normals(np.zeros((0, 3)), np.zeros((0, 3), int)).shape == (0, 3)
+    with pytest.raises(ValueError, match=r"triangle 1 \[0, 2, 6\] indexes outside the 6 vertices"):
+        weights.vertex_normals(vertices, [(0, 1, 2), (0, 2, 6)])
+    with pytest.raises(ValueError, match="vertices must be finite"):
+        weights.vertex_normals([(0, 0, np.nan)] * 3, [(0, 1, 2)])
+
+
+def test_a_seams_copies_get_one_row_once_welded():
+    """A closed box split along every edge (each face its own corners, as flat shading leaves it): each copy's own
+    face normal sends the facing penalty different ways; the normals of the welded box do not."""
+    corners = np.array([(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float) - 0.5
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    welded_triangles = np.array([(a, b, c) for a, b, c, d in quads] + [(a, c, d) for a, b, c, d in quads])
+    split_of = welded_triangles.ravel()  # each corner of each triangle is its own vertex
+    split_vertices = corners[split_of]
+    split_triangles = np.arange(len(split_of)).reshape(-1, 3)
+    heads, tails = np.array([(-2.0, 0.2, 0.0), (2.0, -0.3, 0.1)]), np.array([(-1.0, 0.2, 0.0), (1.0, -0.3, 0.4)])
+
+    def largest_spread(normals):
+        """The largest difference of one bone's weight between two copies of a corner."""
+        table = weights.bone_weights(split_vertices, heads, tails, normals).dense(len(heads))
+        return max(np.ptp(table[split_of == corner], axis=0).max() for corner in range(8))
+
+    assert largest_spread(weights.vertex_normals(split_vertices, split_triangles)) > 0.1
+    assert largest_spread(weights.vertex_normals(corners, welded_triangles)[split_of]) == 0

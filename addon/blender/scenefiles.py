@@ -5,6 +5,7 @@ import pathlib
 import bpy
 import numpy as np
 
+from ..axes import file_axes, to_blender
 from ..core.files import replaced_on_success
 from . import overlays, skinning
 from .armature import delete_armature
@@ -12,14 +13,14 @@ from .headless import empty_scene
 from .pipeline import METHOD_PROPERTY, rig_object, skin_meshes, skin_summary
 from .properties import ARMATURE_POINTER
 
-# Blender's OBJ and glTF importers turn the file's Y-up frame into Blender's Z-up one with this rotation (file x, y,
-# z → Blender x, -z, y), so the report maps bones back through its inverse to the file's own coordinates.
-Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
 
 
-def rig_file(source, output, method, params, *, skin=True):
+def rig_file(source, output, method, params, *, skin=True, up=None, forward=None):
     """Rig the meshes of model file ``source`` together, skin them, save them with their armature to ``output`` and
-    return the report (bones in the file's frame, timings, skinning outcome, warnings).
+    return the report (bones in the file's frame, the axes it was read with, timings, skinning outcome, warnings).
+
+    ``up`` and ``forward`` are the file axes that become Blender's +Z and +Y (``rigger.axes``: OBJ and FBX only; None
+    takes the defaults, up Y and forward -Z for OBJ, the file's own axes for FBX).
 
     The meshes are those the file's scene shows: importers' hidden helpers (glTF's bone shapes) and excluded
     collections are left alone. Armatures the file already deformed them with are replaced: unbound, and deleted
@@ -28,9 +29,10 @@ def rig_file(source, output, method, params, *, skin=True):
     renamed into place).
     """
     source, output = pathlib.Path(source), pathlib.Path(output)
+    axes = file_axes(source.suffix, up, forward)
     empty_scene()
     try:
-        frame = _import(source)
+        frame = _import(source, axes)
     except RuntimeError as error:
         raise ValueError(f"{source}: Blender could not import it: {blender_message(error)}") from None
     meshes = shown_meshes(bpy.context.view_layer)
@@ -44,7 +46,8 @@ def rig_file(source, output, method, params, *, skin=True):
         outcomes, skin_warnings = skin_meshes(meshes, result.armature)
         warnings += skin_warnings
     save_scene(output, [*meshes, result.armature])
-    return {"input": str(source), "output": str(output), **rig_report(result, outcomes, *frame, warnings=warnings)}
+    return {"input": str(source), "output": str(output),
+            **rig_report(result, outcomes, *frame, warnings=warnings, axes=axes)}
 
 
 def shown_meshes(view_layer):
@@ -86,10 +89,11 @@ def blender_message(error):
     return str(error).strip().removeprefix("Error:").strip()
 
 
-def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warnings=()):
+def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warnings=(), axes=None):
     """The JSON-ready report of a rig: method, parameters, bones (mapped from Blender's world into the frame named
-    ``frame`` by the inverse of ``to_world``), timings, the skinning outcome per mesh (``outcomes``: mesh name →
-    skinning report, or None when not skinned) and warnings (``warnings`` first).
+    ``frame`` by the inverse of ``to_world``), the (up, forward) ``axes`` the file was read with (None: Blender's
+    importer chose), timings, the skinning outcome per mesh (``outcomes``: mesh name → skinning report, or None when
+    not skinned) and warnings (``warnings`` first).
 
     Timings are plain floats whatever number type the method recorded (numpy scalars are not JSON).
     """
@@ -108,6 +112,7 @@ def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warn
     timings = {**result.timings, **{f"method.{k}": v for k, v in skeleton.timings.items()}}
     return {
         "frame": frame,
+        "axes": None if axes is None else dict(zip(("up", "forward"), axes)),
         "method": result.armature.get(METHOD_PROPERTY),
         "params": skeleton.params,
         "bones": skeleton.transformed(to_frame).to_dict()["bones"],
@@ -117,23 +122,35 @@ def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warn
     }
 
 
-def _import(source):
-    """Import ``source`` into the empty scene; (3x3 matrix from the file's frame to Blender's world, its name)."""
+def _import(source, axes):
+    """Import ``source`` into the empty scene, read with ``axes`` (``rigger.axes.file_axes``); (3x3 matrix from the
+    file's frame to Blender's world, the frame's name)."""
     suffix = source.suffix.lower()
     path = str(source)
     if suffix == ".obj":
-        bpy.ops.wm.obj_import(filepath=path, forward_axis='NEGATIVE_Z', up_axis='Y')
-        return Y_UP_TO_Z_UP, "file (the OBJ's v coordinates)"
+        up, forward = axes
+        bpy.ops.wm.obj_import(filepath=path, up_axis=_enum(up), forward_axis=_enum(forward))
+        return to_blender(up, forward), f"file (the OBJ's v coordinates, read with up {up}, forward {forward})"
     if suffix in (".glb", ".gltf"):
         bpy.ops.import_scene.gltf(filepath=path)
-        return Y_UP_TO_Z_UP, "file (glTF, Y up)"
+        return to_blender(*axes), "file (glTF, Y up)"
     if suffix == ".fbx":
-        bpy.ops.import_scene.fbx(filepath=path)
-        return np.eye(3), "blender world (FBX axes and units converted by Blender's importer)"
+        if axes is None:
+            bpy.ops.import_scene.fbx(filepath=path)
+            return np.eye(3), "blender world (FBX axes and units converted by Blender's importer)"
+        up, forward = axes
+        bpy.ops.import_scene.fbx(filepath=path, use_manual_orientation=True, axis_up=up, axis_forward=forward)
+        return np.eye(3), f"blender world (FBX read with up {up}, forward {forward}, units converted by Blender's " \
+                          f"importer)"
     if suffix == ".blend":
         bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
         return np.eye(3), "blender world"
     raise ValueError(f"{source}: unsupported file type {suffix!r}")
+
+
+def _enum(axis):
+    """Blender's OBJ importer's name for ``axis``: 'NEGATIVE_Z' for '-Z'."""
+    return axis.replace("-", "NEGATIVE_")
 
 
 def save_scene(output, objects=None):

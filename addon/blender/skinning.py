@@ -1,21 +1,28 @@
 """Skin a mesh object to an armature so that every vertex ends up weighted, and say what it took.
 
+Every stage weights the *welded* mesh: vertices closer than ``WELD_DISTANCE`` of the mesh's size (the copies that
+UV seams and flat shading split a surface into) are merged first, and the weights are carried back to the original
+vertices through the exact weld map. Copies of one vertex therefore always get identical weights, so a posed mesh
+cannot crack open along its seams, and bone heat sees one connected surface instead of the pieces that make its heat
+system singular.
+
 Blender's bone heat (``parent_set(type='ARMATURE_AUTO')``) returns FINISHED even when it prints "Bone Heat
 Weighting: failed to find solution for one or more bones" and leaves every vertex unweighted: the heat system of a
-mesh split along UV seams into many pieces, or made of loose parts, can be singular. Loose parts and inner shells can
-also leave vertices unweighted with no message (a part that sees no bone, or whose bones another part hides). In
-bpy 4.2 and 5.0 the message goes through Python's ``sys.stdout`` (measured: nothing reaches file descriptor 1), so it
-is captured with ``contextlib.redirect_stdout``; unweighted vertices are counted directly.
+mesh with loose parts that see no bone (another part hides them) is singular. Loose parts and inner shells can also
+leave vertices unweighted with no message. In bpy 4.2 and 5.0 the message goes through Python's ``sys.stdout``
+(measured: nothing reaches file descriptor 1), so it is captured with ``contextlib.redirect_stdout``; unweighted
+vertices are counted directly.
 
-:func:`skin` runs bone heat on the mesh, then repairs only what is still unweighted, stage by stage:
+:func:`skin` runs bone heat on a temporary welded copy of the mesh, then repairs only what is still unweighted:
 
-1. bone heat on a welded copy (vertices closer than ``WELD_DISTANCE`` of the mesh's size merged, as UV seams split
-   them), the weights carried back to the original vertices through the exact weld map;
-2. bone heat on each loose part of the welded mesh alone, for the parts still unweighted;
-3. ``rigger.weights.bone_weights``: the nearest few bones by distance, which always succeeds.
+1. bone heat on each loose part of the welded mesh alone, for the parts still unweighted;
+2. ``rigger.weights.bone_weights``: the nearest few bones by distance, which always succeeds (its facing penalty
+   takes area-weighted normals of the welded mesh, so a seam's copies face alike).
 
-The repair stages use the mesh's own vertex positions (before modifiers) in world space; bone heat on the mesh itself
-sees them as Blender does, through the modifier stack. Weights are finally normalised over the deforming bones.
+Every stage uses the mesh's own vertex positions (before modifiers) in world space, as Blender's bone heat does when
+parenting, except that with a Subsurf modifier Blender's bone heat takes each vertex's place on the limit surface:
+the welded copies (triangulated) then get a Subsurf modifier too. Weights are normalised over the deforming bones as
+they are written.
 """
 import contextlib
 import io
@@ -29,7 +36,7 @@ import numpy as np
 
 from ..core.arrays import column_bounds, concatenated_ranges
 from ..core.graphs import components
-from ..weights import bone_weights
+from ..weights import bone_weights, vertex_normals
 from .meshdata import mesh_arrays, world_points
 
 MODIFIER_NAME = "Rigger Armature"
@@ -37,7 +44,6 @@ GROUPS_PROPERTY = "rigger_vertex_groups"  # mesh object property: JSON list of t
 FAILURE_MESSAGE = "Bone Heat Weighting: failed to find solution"
 WELD_DISTANCE = 1e-5  # fraction of the mesh's largest extent under which two vertices are one (UV-seam duplicates)
 TEMPORARY_NAME = "Rigger skinning"
-NORMALIZED_TOLERANCE = 1e-6  # a vertex whose weights sum this close to 1 is left as it is (weights are float32)
 
 
 @dataclass
@@ -55,16 +61,18 @@ class SkinStage:
 class SkinReport:
     """What :func:`skin` did.
 
-    ``stages`` lists the stages that ran, first ``"bone heat"`` (``weighted`` = the vertices it weighted), then any
-    of ``"welded bone heat"``, ``"island bone heat"`` and ``"nearest bones"`` (``weighted`` = the vertices each
-    fixed). ``bone_heat_result`` is the operator's return value, ``unweighted`` the vertices left without any
-    deforming weight at the end (always 0), ``warnings`` human-readable sentences about anything that went wrong.
+    ``stages`` lists the stages that ran, first ``"bone heat"`` on the welded mesh (``weighted`` = the vertices it
+    weighted), then any of ``"island bone heat"`` and ``"nearest bones"`` (``weighted`` = the vertices each fixed).
+    ``welded`` counts the vertices merged into another at the same place before weighting (they share its weights),
+    ``bone_heat_result`` is the operator's return value, ``unweighted`` the vertices left without any deforming
+    weight at the end (always 0), ``warnings`` human-readable sentences about anything that went wrong.
     """
 
     mesh: str
     armature: str
     vertices: int
     bones: int
+    welded: int = 0
     bone_heat_result: str = ""
     stages: list = field(default_factory=list)
     unweighted: int = 0
@@ -85,6 +93,8 @@ class SkinReport:
         """One line for the operator's report."""
         head = f"Skinned {self.mesh!r} to {self.armature!r}: {self.vertices} vertices, {self.bones} bones, " \
                f"{self.seconds:.2f} s"
+        if self.welded:
+            head += f", {self.welded} seam vertices welded"
         if not self.warnings:
             return f"{head}, bone heat weighted every vertex"
         parts = []
@@ -119,15 +129,16 @@ def skin(mesh_obj, armature_obj):
     if bpy.context.mode != 'OBJECT':
         bpy.ops.object.mode_set(mode='OBJECT')
     _remove_previous_skin(mesh_obj, armature_obj, bone_names)
-
-    stage = SkinStage("bone heat")
-    result, stage.messages = _bone_heat(mesh_obj, armature_obj)
-    report.bone_heat_result = ",".join(sorted(result))
     _bind(mesh_obj, armature_obj, bone_names)
-    entries = _weight_entries(mesh_obj, bone_names)
+
+    weld = _welded(mesh_obj)
+    report.welded = report.vertices - len(weld.positions)
+    stage = SkinStage("bone heat", note=f"{report.welded} seam vertices welded" if report.welded else "")
+    result, entries, stage.messages = _bone_heat_weights(weld.positions, weld.triangles, armature_obj, bone_names,
+                                                         weld.subsurf)
+    report.bone_heat_result = ",".join(sorted(result))
     weighted = np.zeros(report.vertices, dtype=bool)
-    weighted[entries[0]] = True
-    stage.weighted = int(weighted.sum())
+    stage.weighted = _transfer(mesh_obj, bone_names, entries, np.arange(report.vertices), weld.map, weighted)
     stage.seconds = time.perf_counter() - started
     report.stages.append(stage)
     for message in stage.messages:
@@ -135,10 +146,11 @@ def skin(mesh_obj, armature_obj):
     if not weighted.all():
         report.warnings.append(f"Bone heat left {report.vertices - stage.weighted} of {report.vertices} vertices "
                                f"unweighted")
-        _repair(mesh_obj, armature_obj, bone_names, weighted, report)
-        entries = _weight_entries(mesh_obj, bone_names)  # the repairs wrote weights
+        _repair_islands(mesh_obj, armature_obj, bone_names, weighted, weld, report)
+        if not weighted.all():
+            _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report)
 
-    report.unweighted = int((~_normalize(mesh_obj, bone_names, entries)).sum())
+    report.unweighted = int((~weighted).sum())
     if report.unweighted:
         report.warnings.append(f"{report.unweighted} vertices are still unweighted")
     report.seconds = time.perf_counter() - started
@@ -246,38 +258,11 @@ def _weight_entries(obj, bone_names):
     return np.array(vertices, dtype=np.int64), np.array(bones, dtype=np.int64), np.array(weights)
 
 
-def _repair(mesh_obj, armature_obj, bone_names, weighted, report):
-    """Run the repair ladder for the vertices ``weighted`` says are not; updates ``weighted`` and ``report``."""
-    started = time.perf_counter()
-    local_positions, triangles = mesh_arrays(mesh_obj.data)
-    positions = world_points(local_positions, mesh_obj.matrix_world)
-    weld_map, kept, welded_triangles = _welded(mesh_obj.data, local_positions, triangles)
-    welded = (weld_map, positions[kept], welded_triangles)
-    if len(kept) < len(positions):
-        _repair_welded(mesh_obj, armature_obj, bone_names, weighted, welded, report, started)
-    if not weighted.all():
-        _repair_islands(mesh_obj, armature_obj, bone_names, weighted, welded, report)
-    if not weighted.all():
-        _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, positions, report)
-
-
-def _repair_welded(mesh_obj, armature_obj, bone_names, weighted, welded, report, started):
-    """Stage 1: bone heat on the welded copy, weights carried back through the weld map."""
-    weld_map, welded_positions, welded_triangles = welded
-    merged = len(weld_map) - len(welded_positions)
-    stage = SkinStage("welded bone heat", note=f"{merged} duplicate vertices merged")
-    entries, stage.messages = _bone_heat_weights(welded_positions, welded_triangles, armature_obj, bone_names)
-    targets = np.flatnonzero(~weighted)
-    stage.weighted = _transfer(mesh_obj, bone_names, entries, targets, weld_map[targets], weighted)
-    _finish_stage(stage, started, report, f"Bone heat on a welded copy ({merged} duplicate vertices merged) "
-                                          f"weighted {stage.weighted} of them")
-
-
-def _repair_islands(mesh_obj, armature_obj, bone_names, weighted, welded, report):
-    """Stage 2: bone heat on each loose part of the welded mesh that still holds unweighted vertices, alone (no
+def _repair_islands(mesh_obj, armature_obj, bone_names, weighted, weld, report):
+    """Repair 1: bone heat on each loose part of the welded mesh that still holds unweighted vertices, alone (no
     other part hides its bones, no other part makes its heat system singular)."""
     started = time.perf_counter()
-    weld_map, welded_positions, welded_triangles = welded
+    weld_map, welded_positions, welded_triangles = weld.map, weld.positions, weld.triangles
     edges = np.concatenate([welded_triangles[:, [0, 1]], welded_triangles[:, [1, 2]]])
     island_of = components(len(welded_positions), edges)
     parts = int(island_of.max()) + 1
@@ -296,8 +281,8 @@ def _repair_islands(mesh_obj, armature_obj, bone_names, weighted, welded, report
         if not len(island_targets) or not len(faces):
             continue
         tried += 1
-        entries, messages = _bone_heat_weights(welded_positions[vertices_by_island[island]], local_index[faces],
-                                               armature_obj, bone_names)
+        _, entries, messages = _bone_heat_weights(welded_positions[vertices_by_island[island]],
+                                                  local_index[faces], armature_obj, bone_names, weld.subsurf)
         stage.messages += messages
         vertices = targets[island_targets]
         stage.weighted += _transfer(mesh_obj, bone_names, entries, vertices, local_index[weld_map[vertices]],
@@ -307,16 +292,20 @@ def _repair_islands(mesh_obj, armature_obj, bone_names, weighted, welded, report
                   f"Bone heat per loose part ({stage.note}) weighted {stage.weighted} more vertices")
 
 
-def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, positions, report):
-    """Stage 3: every vertex still unweighted gets its nearest bones (``rigger.weights``), which always succeeds."""
+def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report):
+    """Repair 2: every vertex still unweighted gets the nearest bones (``rigger.weights``) of its welded vertex, which
+    always succeeds. The facing penalty takes the welded mesh's area-weighted normals: a seam's copies, each with the
+    normal of its own side's faces, would otherwise face apart and get different bones."""
     started = time.perf_counter()
     stage = SkinStage("nearest bones")
     targets = np.flatnonzero(~weighted)
+    sources = np.unique(weld.map[targets])
     heads, tails = _world_bones(armature_obj, bone_names)
-    result = bone_weights(positions[targets], heads, tails, _world_normals(mesh_obj)[targets])
+    normals = vertex_normals(weld.positions, weld.triangles)[sources]
+    result = bone_weights(weld.positions[sources], heads, tails, normals)
     rows, slots = np.nonzero(result.bones >= 0)
-    _write_weights(mesh_obj, bone_names, targets[rows], result.bones[rows, slots], result.weights[rows, slots])
-    weighted[targets] = True
+    entries = (sources[rows], result.bones[rows, slots], result.weights[rows, slots])
+    _transfer(mesh_obj, bone_names, entries, targets, weld.map[targets], weighted)
     stage.weighted = len(targets)
     _finish_stage(stage, started, report,
                   f"The remaining {len(targets)} vertices were weighted by their nearest bones (distance fallback)")
@@ -329,17 +318,6 @@ def _finish_stage(stage, started, report, sentence):
     report.warnings.append(sentence)
 
 
-def _world_normals(obj):
-    """Unit vertex normals (N, 3) in world space (zero where a vertex has none)."""
-    mesh = obj.data
-    normals = np.empty(len(mesh.vertices) * 3)
-    mesh.vertex_normals.foreach_get("vector", normals)
-    linear = np.array(obj.matrix_world)[:3, :3]
-    normals = normals.reshape(-1, 3) @ np.linalg.inv(linear)  # normals map by the inverse transpose
-    lengths = np.linalg.norm(normals, axis=1, keepdims=True)
-    return np.divide(normals, lengths, out=np.zeros_like(normals), where=lengths > 0)
-
-
 def _world_bones(armature_obj, bone_names):
     """Heads and tails (B, 3) of the named bones in world space, rest pose."""
     bones = [armature_obj.data.bones[name] for name in bone_names]
@@ -348,10 +326,24 @@ def _world_bones(armature_obj, bone_names):
     return ends[:, 0], ends[:, 1]
 
 
-def _welded(mesh, positions, triangles):
-    """Merge vertices closer than ``WELD_DISTANCE`` of the mesh's size (``positions``: its object-space vertices):
-    (weld map (N,) original -> welded index, the original index of each welded vertex, welded triangles without
-    the ones welding collapsed)."""
+@dataclass
+class Weld:
+    """A mesh with its seams welded: ``map`` (N,) original vertex -> welded vertex, ``positions`` the welded
+    vertices (each the position of the first original vertex merged into it) in world space, ``triangles`` the
+    welded triangles, those welding collapsed dropped; ``subsurf``: the mesh has a Subsurf modifier, so bone heat
+    takes the limit surface."""
+
+    map: np.ndarray
+    positions: np.ndarray
+    triangles: np.ndarray
+    subsurf: bool
+
+
+def _welded(mesh_obj):
+    """Mesh object ``mesh_obj`` with its vertices closer than ``WELD_DISTANCE`` of its size merged: a :class:`Weld`.
+    Vertices in a chain of such neighbours all merge into one."""
+    mesh = mesh_obj.data
+    positions, triangles = mesh_arrays(mesh)
     bounds = column_bounds(positions)
     size = float((bounds[1] - bounds[0]).max())
     work = bmesh.new()
@@ -369,11 +361,13 @@ def _welded(mesh, positions, triangles):
     kept, weld_map = np.unique(target, return_inverse=True)
     welded = weld_map[triangles]
     distinct = (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & (welded[:, 2] != welded[:, 0])
-    return weld_map, kept, welded[distinct]
+    return Weld(weld_map, world_points(positions[kept], mesh_obj.matrix_world), welded[distinct],
+                any(modifier.type == 'SUBSURF' for modifier in mesh_obj.modifiers))
 
 
-def _bone_heat_weights(positions, triangles, armature_obj, bone_names):
-    """Bone heat on a temporary world-space mesh: ((vertex, bone, weight) arrays, printed lines); leaves nothing."""
+def _bone_heat_weights(positions, triangles, armature_obj, bone_names, subsurf=False):
+    """Bone heat on a temporary world-space mesh (with a Subsurf modifier when ``subsurf``, so that bone heat takes
+    its limit surface): (the operator's result, (vertex, bone, weight) arrays, printed lines); leaves nothing."""
     mesh = bpy.data.meshes.new(TEMPORARY_NAME)
     obj = bpy.data.objects.new(TEMPORARY_NAME, mesh)
     try:
@@ -385,8 +379,10 @@ def _bone_heat_weights(positions, triangles, armature_obj, bone_names):
         mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * len(triangles), 3, dtype=np.int32))
         mesh.update()
         bpy.context.scene.collection.objects.link(obj)
-        _, messages = _bone_heat(obj, armature_obj)
-        return _weight_entries(obj, bone_names), messages
+        if subsurf:
+            obj.modifiers.new(TEMPORARY_NAME, 'SUBSURF')
+        result, messages = _bone_heat(obj, armature_obj)
+        return result, _weight_entries(obj, bone_names), messages
     finally:
         bpy.data.objects.remove(obj)
         bpy.data.meshes.remove(mesh)
@@ -401,35 +397,29 @@ def _grouped(labels, count):
 
 def _transfer(mesh_obj, bone_names, entries, targets, sources, weighted):
     """Give the original vertices ``targets`` the weights of copy vertices ``sources`` (the copy's (vertex, bone,
-    weight) ``entries``), where the copy has any; marks them in ``weighted`` and returns how many it weighted."""
+    weight) ``entries``), where the copy has any; marks them in ``weighted`` and returns how many it weighted.
+
+    The weights are normalised over the deforming bones as they are written (bone heat leaves sums of 0.9 to 1),
+    in Python rather than with Blender's operator, whose poll refuses hidden objects. Each distinct (bone, weight)
+    is written once, to every target that carries it (a seam's copies, and the many vertices on one bone alone)."""
     copy_vertices, bones, weights = entries
-    order = np.argsort(copy_vertices, kind="stable")
-    copy_vertices, bones, weights = copy_vertices[order], bones[order], weights[order]
-    first = np.searchsorted(copy_vertices, sources, side="left")
-    last = np.searchsorted(copy_vertices, sources, side="right")
-    found = last > first
-    counts = (last - first)[found]
-    rows = concatenated_ranges(first[found], counts)
-    _write_weights(mesh_obj, bone_names, np.repeat(targets[found], counts), bones[rows], weights[rows])
-    weighted[targets[found]] = True
-    return int(found.sum())
-
-
-def _normalize(mesh_obj, bone_names, entries):
-    """Scale each vertex's deforming weights (``_weight_entries``) to sum to 1 (bone heat leaves sums of 0.9 to 1),
-    in Python rather than with Blender's operator, whose poll refuses hidden objects. Returns the (N,) mask of
-    weighted vertices."""
-    vertices, bones, weights = entries
-    sums = np.bincount(vertices, weights, minlength=len(mesh_obj.data.vertices))
-    scaled = weights / sums[vertices]
-    off = np.abs(sums[vertices] - 1.0) > NORMALIZED_TOLERANCE
-    _write_weights(mesh_obj, bone_names, vertices[off], bones[off], scaled[off])
-    return sums > 0
-
-
-def _write_weights(mesh_obj, bone_names, vertices, bones, weights):
-    """Set weight ``weights[k]`` of vertex ``vertices[k]`` in the group of bone ``bones[k]`` (an index into
-    ``bone_names``)."""
+    if not len(copy_vertices):
+        return 0
+    weights = (weights / np.bincount(copy_vertices, weights)[copy_vertices]).astype(np.float32)  # Blender's floats
+    found = np.isin(sources, copy_vertices)
+    targets, sources = targets[found], sources[found]
+    by_source = np.argsort(sources, kind="stable")
+    starts = np.searchsorted(sources[by_source], copy_vertices, side="left")
+    counts = np.searchsorted(sources[by_source], copy_vertices, side="right") - starts
+    order = np.lexsort((weights, bones))
+    bones, weights, starts, counts = bones[order], weights[order], starts[order], counts[order]
+    members = targets[by_source[concatenated_ranges(starts, counts)]]  # each entry's targets, entry after entry
+    firsts = np.flatnonzero(np.r_[True, (bones[1:] != bones[:-1]) | (weights[1:] != weights[:-1])])
+    bounds = np.r_[0, np.cumsum(counts)][np.r_[firsts, len(bones)]]
     groups = [mesh_obj.vertex_groups[name] for name in bone_names]
-    for vertex, bone, weight in zip(vertices.tolist(), bones.tolist(), weights.tolist()):
-        groups[bone].add([vertex], weight, 'REPLACE')
+    for bone, weight, begin, end in zip(bones[firsts].tolist(), weights[firsts].tolist(), bounds[:-1].tolist(),
+                                        bounds[1:].tolist()):
+        if end > begin:
+            groups[bone].add(members[begin:end].tolist(), weight, 'REPLACE')
+    weighted[targets] = True
+    return len(targets)
