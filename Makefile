@@ -8,8 +8,8 @@ STAMP := $(VENV)/.installed
 BPY42_VENV := $(VENV)/bpy42
 BPY42_STAMP := $(BPY42_VENV)/.installed
 
-.PHONY: test build demo addon bpy42 bench bench-quality bench-silhouette bench-skinning bench-rig-time regress \
-	regress-baseline clean
+.PHONY: test build demo addon bpy42 bench bench-quality bench-silhouette bench-skinning bench-posing \
+	bench-rig-time regress regress-baseline clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -50,6 +50,10 @@ bench-silhouette: build
 # Skinning over ../shared/models/gt with the artists' skeletons and Rigger's: bench/results/skinning.md and .png.
 bench-skinning: build
 	$(PY) bench/skinning.py
+
+# Posing over ../shared/models/gt: random artist poses reproduced by each rig; bench/results/posing.{md,png,json}.
+bench-posing: build
+	$(PY) bench/posing.py
 
 bench-rig-time: build
 	$(PY) bench/rig_time.py

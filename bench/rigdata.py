@@ -139,6 +139,21 @@ class Rig:
             (name for name, parent in zip(names, parents) if parent < 0), None)
         return Rig(names, self.positions[keep], parents, root, self.skin[:, keep])
 
+    def attached(self):
+        """The rig as one tree: the root of every part not under ``root`` (Quaternius rigs keep their IK-driven feet
+        as separate roots) becomes a child of the nearest joint under ``root``, which carries it as the IK chain
+        would when the rig is posed."""
+        parents = self.parents.copy()
+        top = np.arange(len(parents))
+        for _ in range(len(parents)):
+            top = np.where(parents[top] >= 0, parents[top], top)
+        main = np.flatnonzero(top == self.names.index(self.root))
+        for part_root in np.flatnonzero(parents < 0):
+            if part_root != self.names.index(self.root):
+                distances = np.linalg.norm(self.positions[main] - self.positions[part_root], axis=1)
+                parents[part_root] = main[np.argmin(distances)]
+        return Rig(self.names, self.positions, parents, self.root, self.skin)
+
 
 def kept_ancestors(parents, keep):
     """Parent indices among the kept nodes only: each kept node's nearest kept ancestor (-1 when none)."""
@@ -366,6 +381,23 @@ def dominant_joints(rig):
     top = np.asarray(skin.argmax(axis=1)).ravel()
     weighted = np.asarray(skin.max(axis=1).todense()).ravel() > 0
     return np.where(weighted, weight_owners(rig.parents)[top], -1)
+
+
+def skinned_mesh(name, vertices, triangles, skeleton):
+    """Blender mesh object ``name`` of ``vertices`` and ``triangles`` (as they are: UV-seam duplicates stay), alone
+    in a fresh scene with an armature of ``skeleton``, skinned by ``rigger.blender.skinning.skin``: (the mesh
+    object, the skinning report). Imports bpy."""
+    import bpy
+    from rigger.blender.armature import build_armature
+    from rigger.blender.headless import empty_scene
+    from rigger.blender.skinning import skin
+
+    empty_scene()
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(np.asarray(vertices).tolist(), [], np.asarray(triangles).tolist())
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj, skin(obj, build_armature(skeleton, f"{name}_rig"))
 
 
 def vertex_group_weights(obj, names):

@@ -27,7 +27,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
 from benchkit import (RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit, format_seconds,  # noqa: E402
                       markdown_table, table_cell)
-from rigger.blender.headless import empty_scene, temporary_user_folder  # noqa: E402  (bpy-free)
+from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
 from rigger.core.polyline import segment_distances  # noqa: E402  (bpy-free)
 
 MODELS_DIR = SHARED_MODELS / "gt"
@@ -98,19 +98,12 @@ def dominant_bones(obj, names):
 
 def skin_model(model, kind):
     """Skin one model to one kind of skeleton in a fresh scene; a record of what happened (errors included)."""
-    import bpy
     import rigger
-    from rigger.blender.armature import build_armature
-    from rigger.blender.skinning import FAILURE_MESSAGE, skin
+    from rigger.blender.skinning import FAILURE_MESSAGE
 
     record = {"model": model.name, "skeleton": kind, "vertices": len(model.vertices),
               "seam_vertices": int((np.bincount(model.place)[model.place] > 1).sum())}
     try:
-        empty_scene()
-        mesh = bpy.data.meshes.new(model.name)
-        mesh.from_pydata(model.vertices.tolist(), [], model.triangles.tolist())
-        obj = bpy.data.objects.new(model.name, mesh)
-        bpy.context.scene.collection.objects.link(obj)
         if kind == "artist":
             skeleton, joint_of_bone = model.skeleton, model.head_joint
         else:
@@ -118,10 +111,8 @@ def skin_model(model, kind):
             skeleton = rigger.rig_mesh(model.vertices, model.triangles.astype(np.int32))
             record["rig_seconds"] = time.perf_counter() - started
             joint_of_bone = model.head_joint[nearest_true_bones(skeleton, model.skeleton)]
-        armature = build_armature(skeleton, f"{model.name}_rig")
-        started = time.perf_counter()
-        report = skin(obj, armature)
-        record["seconds"] = time.perf_counter() - started
+        obj, report = rigdata.skinned_mesh(model.name, model.vertices, model.triangles, skeleton)
+        record["seconds"] = report.seconds
         names = list(skeleton.names)
         dominant = dominant_bones(obj, names)
         record["seam_gap"] = seam_gap(rigdata.vertex_weights(obj, names), model.place)

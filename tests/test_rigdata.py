@@ -98,6 +98,17 @@ def test_helper_joints_are_dropped_and_their_children_reparented(tmp_path):
     assert bones.parents.tolist() == [-1, -1, 0]
 
 
+def test_parts_off_the_root_are_attached_to_the_nearest_joint_under_it():
+    # an IK-driven foot kept as a root of its own (as in Quaternius rigs), with a toe under it
+    skin = csr_matrix(np.eye(5))
+    rig = rigdata.Rig(("hips", "knee", "ankle", "foot", "toe"),
+                      np.array([[0, 0, 1], [0, 0, 0.5], [0, 0, 0.1], [0, 0, 0], [0, -0.2, 0]], dtype=float),
+                      np.array([-1, 0, 1, -1, 3]), "hips", skin)
+    attached = rig.attached()
+    assert attached.parents.tolist() == [-1, 0, 1, 2, 3]
+    assert attached.names == rig.names and attached.skin is skin and rig.parents.tolist() == [-1, 0, 1, -1, 3]
+
+
 @pytest.mark.parametrize("extra, message", [
     ("hier hips ghost\n", "unknown joint"),
     ("hier head hips\n", "two parents|cycle"),
