@@ -608,3 +608,30 @@ def test_any_triangle_soup_gives_a_valid_tree_or_a_clear_error(seed, count, flat
         return
     assert len(skeleton.roots) == 1
     assert np.isfinite(skeleton.heads).all() and np.isfinite(skeleton.tails).all()
+
+
+@pytest.mark.parametrize("model, all_paired", [("nogt/cheburashka.obj", True), ("nogt/woody.obj", True),
+                                               ("gt/BrainStem/BrainStem.obj", False)])
+def test_a_figure_with_a_left_and_a_right_but_no_exact_mirror_plane_gets_sides(model, all_paired):
+    """Hand-made (cheburashka, woody) or posed (BrainStem): no plane within 1% of the size, but the body mirrors
+    within 3% and its spine lies on that plane, so every bone more than 3% of the size off it is named for its side,
+    with ``.L`` on the +X side, and the legs and arms pair as twins with one bone count, sharing their numbers
+    (BrainStem's tilted head has no twin)."""
+    vertices, triangles = load_obj(shared_path("models", model))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert "mirror_plane" not in skeleton.stages
+    size = np.ptp(vertices, axis=0).max()
+    middle = (skeleton.heads + skeleton.tails) / 2
+    trunk = [i for i, name in enumerate(skeleton.names) if name.startswith("trunk")]
+    plane = np.mean(middle[trunk, 0])
+    for name, x in zip(skeleton.names, middle[:, 0]):
+        if abs(x - plane) > 0.03 * size:
+            assert name.endswith(".L" if x > plane else ".R"), name
+    assert_side_bones_paired(skeleton, 4, complete=all_paired)
+
+
+def test_a_side_view_cut_out_gets_no_sides():
+    """The alligator, a flat side view, is about as symmetric front to back as a body is left to right, but its
+    spine crosses that plane: head and tail are no left and right."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "alligator.obj"))
+    assert not [name for name in rigger.rig_mesh(vertices, triangles).names if name.endswith((".L", ".R"))]

@@ -9,7 +9,7 @@ from rigger import silhouette
 from rigger.core.arrays import column_bounds
 from rigger.core.graphs import chains_of
 from rigger.core.joints import Cutting, chain_joints, symmetric_joints
-from rigger.core.mirror import Symmetry, mirror_chain_pairs, mirror_completed, mirror_plane
+from rigger.core.mirror import Symmetry, mirror_chain_pairs, mirror_completed, mirror_plane, sided_symmetry
 from rigger.core.naming import bone_names
 from rigger.core.polyline import arc_lengths, segment_distances
 from rigger.methods.silhouette import depth
@@ -566,3 +566,41 @@ def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_
         assert np.abs(image - outline).max() > 1  # and moved
     assert reflection_in_view(traces["X"], (0, 2.0), TUNING) is None
     assert reflection_in_view(traces["Y"], None, TUNING) is None
+
+
+def test_legs_close_together_from_the_middle_of_the_hips_get_their_sides():
+    """Legs leaving the middle of the hips whose feet lie 3 hundredths off the plane: on average on the plane, but
+    their tips are beyond the side tolerance, so they pair and are named for their sides; with the twin tolerance
+    for both, they would stay unsided."""
+    spine = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    leg = np.array([[0.0, 0.0, 0.0], [0.01, -0.5, 0.0], [0.03, -1.0, 0.0]])
+    chains, where = [0, 1, 1, 2, 2], [0, 0, 1, 0, 1]
+    names = bone_names(chains, where, [spine, leg, leg * [-1, 1, 1]], Symmetry((0, 0.0), 0.05, TUNING, 0.02))
+    assert names == ["trunk.00", "limb01.00.L", "limb01.01.L", "limb01.00.R", "limb01.01.R"]
+    assert bone_names(chains, where, [spine, leg, leg * [-1, 1, 1]], ACROSS_X) == [
+        "trunk.00", "limb01.00", "limb01.01", "limb02.00", "limb02.01"]
+
+
+def figure(arm_heights, spine_along):
+    """Vertices of a stick figure sampled densely: a spine through the origin along ``spine_along`` (an axis), and
+    two arms along x at the given heights (y), one each way."""
+    t = np.linspace(0.0, 1.0, 200)[:, None]
+    spine = (t - 0.5) * 2 * np.eye(3)[spine_along]
+    arms = [np.column_stack([sign * t[:, 0], np.full(len(t), height), np.zeros(len(t))])
+            for sign, height in zip((1, -1), arm_heights)]
+    return np.concatenate([spine, *arms])
+
+
+def test_a_roughly_symmetric_body_gets_a_plane_for_its_sides_through_its_spine():
+    """Arms at heights 2% of the size apart: no exact mirror plane, but a rough one across x, through the spine;
+    with the spine lying along x instead (a side-view cut-out), the only rough plane crosses it: none."""
+    vertices = figure((0.52, 0.48), spine_along=1)
+    bounds = column_bounds(vertices)
+    assert mirror_plane(vertices, bounds, 0.02, TUNING) is None
+    spine = np.array([[0.0, -1.0, 0.0], [0.0, 1.0, 0.0]])
+    arms = [np.array([[0.0, 0.52, 0.0], [1.0, 0.52, 0.0]]), np.array([[0.0, 0.48, 0.0], [-1.0, 0.48, 0.0]])]
+    sides = sided_symmetry(vertices, bounds, 2.0, [spine, *arms], TUNING)
+    assert sides.plane == (0, 0.0) and mirror_chain_pairs([spine, *arms], sides) == [(1, 2)]
+    lying = figure((0.52, 0.48), spine_along=0)
+    along_x = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    assert sided_symmetry(lying, column_bounds(lying), 2.0, [along_x, *arms], TUNING) is None

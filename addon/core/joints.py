@@ -148,7 +148,7 @@ def _turns(line, tolerance):
     return turns
 
 
-def symmetric_joints(chains, cutting, symmetry):
+def symmetric_joints(chains, cutting, symmetry, mirror=True):
     """Joints along each of the (polyline, half-widths or None, is a leaf) ``chains`` (``chain_joints``), each pair
     of mirror twins (``mirror_chain_pairs``) given mirror-image joints where the mesh allows, so every bone has a
     twin in the mirrored place (``.L`` and ``.R``, X-mirror posing).
@@ -159,13 +159,14 @@ def symmetric_joints(chains, cutting, symmetry):
     the joints of one of them: the shorter's when the longer is a leaf (both arms end at the wrist), else the
     longer's when the shorter is a leaf. Twins whose lines differ (a leg stepping forward) keep their own joints but
     get one bone count: the smaller, unless the other's corners or the longest bone need more, then the larger.
-    Each chain keeps its first joint, where it attaches to its parent.
+    Each chain keeps its first joint, where it attaches to its parent. Without ``mirror`` (a body that only roughly
+    mirrors about the plane: its twins are no images of each other) twins only get one bone count.
     """
     chains = [(line, np.zeros(len(line)) if widths is None else widths, leaf) for line, widths, leaf in chains]
     joints = [chain_joints(line, cutting, widths, leaf) for line, widths, leaf in chains]
     lines = [line for line, _, _ in chains]
     for i, j in mirror_chain_pairs(lines, symmetry):
-        shared = _shared_joints(chains[i], chains[j], joints[i], joints[j], cutting, symmetry)
+        shared = _shared_joints(chains[i], chains[j], joints[i], joints[j], cutting, symmetry) if mirror else None
         if shared is not None:
             joints[i] = np.vstack([joints[i][:1], shared[1:]])
             joints[j] = np.vstack([joints[j][:1], symmetry.reflect(shared)[1:]])

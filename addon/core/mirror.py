@@ -17,6 +17,8 @@ class MirrorTuning(TuningTable):
     plane_share: float = tuned(0.95, "a plane holds when this share of the vertices tested has a mirror image (loose "
                                      "bits and seams aside)")
     twin_tolerance: float = tuned(0.05, "the twin tolerance, a share of the size: how closely twin chains mirror")
+    side_share: float = tuned(0.02, "a chain whose tip (or middle) lies farther off the plane than this share of the "
+                                    "size is on a side (legs close together from the middle of the hips)")
     twin_ends: float = tuned(2.0, "chains whose ends lie this many twin tolerances in all from each other's mirror "
                                   "images are twins")
     cover_start: float = tuned(2.0, "a chain covers another's image when their starts lie this many twin tolerances "
@@ -25,15 +27,21 @@ class MirrorTuning(TuningTable):
     same_shape: float = tuned(0.6, "twins whose lines lie this many twin tolerances apart at most are one limb "
                                    "traced twice")
     shape_samples: int = tuned(9, "points along each twin compared to find whether their shapes match")
+    rough_match: float = tuned(0.03, "a body without an exact plane has sides when its vertices mirror within this "
+                                     "share of the size (a hand-made or posed figure)")
+    rough_twin_tolerance: float = tuned(0.1, "on such a body, the twin tolerance (share of the size) for naming "
+                                             "twins")
 
 @dataclass(frozen=True)
 class Symmetry:
     """A mirror ``plane`` (axis 0, 1 or 2, offset), the ``tolerance`` (mesh units) within which chains mirror each
-    other, and the ``tuning``."""
+    other, the ``tuning``, and how far off the plane the tip of a chain that leaves it lies on a side
+    (``side_tolerance``, mesh units; None: the tolerance)."""
 
     plane: tuple
     tolerance: float
     tuning: MirrorTuning
+    side_tolerance: float = None
 
     def reflect(self, points):
         """``mirrored(points, plane)``."""
@@ -61,13 +69,17 @@ class Symmetry:
                 <= self.tuning.same_shape * self.tolerance)
 
     def side(self, line, by_tip=False):
-        """+1 on the plane's positive side, -1 on its negative side, 0 for a chain on the plane (on average), or with
-        ``by_tip`` for one whose tip is on it too."""
+        """+1 on the plane's positive side, -1 on its negative side, 0 for a chain on the plane (its middle within
+        the tolerance), or with ``by_tip`` for one whose tip is on it too (within ``side_tolerance``: legs close
+        together leaving the middle of the hips are on their tips' sides)."""
         axis, offset = self.plane
         distance = float(np.mean(line[:, axis])) - offset
-        if by_tip and abs(distance) <= self.tolerance:
-            distance = float(line[-1, axis]) - offset
-        return 0 if abs(distance) <= self.tolerance else int(np.sign(distance))
+        if abs(distance) > self.tolerance:
+            return int(np.sign(distance))
+        tip = float(line[-1, axis]) - offset
+        if by_tip and abs(tip) > (self.tolerance if self.side_tolerance is None else self.side_tolerance):
+            return int(np.sign(tip))
+        return 0
 
 
 def mirrored(points, plane):
@@ -79,11 +91,18 @@ def mirrored(points, plane):
 
 
 def mirror_plane(vertices, bounds, tolerance, tuning):
-    """The axis (0, 1, 2) and offset of a plane the ``vertices`` are mirror-symmetric about, or None.
+    """The axis (0, 1, 2) and offset of a plane the ``vertices`` are mirror-symmetric about, or None: of the
+    ``symmetric_planes`` within ``tolerance``, the one most vertices fit."""
+    planes = symmetric_planes(vertices, bounds, tolerance, tuning)
+    return max(planes, key=lambda plane: plane[2])[:2] if planes else None
+
+
+def symmetric_planes(vertices, bounds, tolerance, tuning):
+    """(axis, offset, share) of each plane the ``vertices`` are mirror-symmetric about within ``tolerance``.
 
     Tries the planes through the centre of ``bounds`` (their (2, 3) bounding box) perpendicular to X, Y and Z where
     the box is more than two ``tolerance`` deep (across a flat mesh's own plane nothing has a side); a plane fits
-    when ``plane_share`` of (up to ``plane_samples``) vertices have a mirror image among the vertices within
+    when a ``plane_share`` of (up to ``plane_samples``) vertices have a mirror image among the vertices within
     ``tolerance``: vertices are hashed to a grid of that size and the mirrored ones looked up in the sorted hashes,
     with their 26 neighbour cells.
     """
@@ -94,7 +113,7 @@ def mirror_plane(vertices, bounds, tolerance, tuning):
     step = max(1, len(vertices) // tuning.plane_samples)
     probe = vertices[::step]
     offsets = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)])
-    best = None
+    planes = []
     for axis in np.flatnonzero(high - low > 2 * tolerance):
         centre = 0.5 * (low[axis] + high[axis])
         cells = np.floor((mirrored(probe, (axis, centre)) - origin) / tolerance).astype(np.int64)
@@ -102,9 +121,28 @@ def mirror_plane(vertices, bounds, tolerance, tuning):
         keys = _cell_keys(around, span)
         at = np.minimum(np.searchsorted(table, keys), len(table) - 1)
         score = (table[at] == keys).reshape(len(probe), -1).any(axis=1).mean()
-        if score >= tuning.plane_share and (best is None or score > best[2]):
-            best = (int(axis), centre, score)
-    return None if best is None else best[:2]
+        if score >= tuning.plane_share:
+            planes.append((int(axis), centre, score))
+    return planes
+
+
+def sided_symmetry(vertices, bounds, size, lines, tuning):
+    """For a body that is no exact mirror image (hand-made, posed) but has a left and a right: the ``Symmetry``
+    whose sides name its bones, or None. A plane qualifies when the ``vertices`` are symmetric about it within
+    ``rough_match`` of the ``size`` and the trunk (``lines[0]``, the chain the root bone starts) lies on it within
+    the twin tolerance, as a spine does (a side-view cut-out of an animal is symmetric front to back, but its spine
+    crosses that plane); of those, moved to pass through the trunk, the plane across which most chains (``lines``)
+    pair as twins, within ``rough_twin_tolerance``."""
+    best, most = None, 0
+    for axis, offset, _ in symmetric_planes(vertices, bounds, tuning.rough_match * size, tuning):
+        if not lines or np.abs(lines[0][:, axis] - offset).max() > tuning.twin_tolerance * size:
+            continue
+        spine = float(np.mean(lines[0][:, axis]))  # a posed body's middle: its spine, not its bounding box's
+        symmetry = Symmetry((axis, spine), tuning.rough_twin_tolerance * size, tuning, tuning.side_share * size)
+        pairs = len(mirror_chain_pairs(lines, symmetry))
+        if pairs > most:
+            best, most = symmetry, pairs
+    return best
 
 
 def _cell_keys(cells, span):

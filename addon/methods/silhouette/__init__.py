@@ -10,6 +10,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from ... import silhouette
+from ...core.mirror import sided_symmetry
 from ...core.params import Param
 from ...core.registry import RigMethod
 from ...core.skeleton import Skeleton
@@ -104,17 +105,16 @@ class SilhouetteMethod(RigMethod):
             other_views = [found for found in (side_of, end_on) if found is not None]
         clock.lap("other_views")
 
-        builder = BoneBuilder(rules.cutting, rules.symmetry, tuning)
         mirror = None if rules.plane is None else mirror_in_depth(sil, rules.plane, rules.symmetry.tolerance, tuning)
         placing = Placing(tuning, speck=tuning.speck * rules.unit, side_axis=side, split=params.split_layers,
                           mirror=mirror)
-        for placed in placed_islands(sil, graph, alive, kept, placing):
-            if isinstance(placed, Blob):
-                builder.add_blob(sil, placed.point, placed.radius)
-            else:
-                builder.add_island(placed.root_point, placed.chains)
-        for view_of in other_views:
-            builder.add_limbs(hidden_limbs(sil, view_of, builder.lines, rules), (sil, view_of.sil))
+        islands = list(placed_islands(sil, graph, alive, kept, placing))
+        builder = _bones(sil, islands, other_views, rules, rules.symmetry)
+        sides = rules.symmetry
+        if sides is None:  # a body with a left and a right that is no exact mirror image: twins get one bone count
+            sides = sided_symmetry(mesh.used_vertices, mesh.bbox, mesh.scale, builder.lines, tuning)
+            if sides is not None:
+                builder = _bones(sil, islands, other_views, rules, sides, exact=False)
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()
@@ -139,3 +139,17 @@ class SilhouetteMethod(RigMethod):
         heads, tails = placement.point(heads), placement.point(tails)
         stages["joints"] = Joints(np.unique(np.concatenate([heads, tails]), axis=0))
         return Skeleton(names, heads, tails, parents, stages=stages, timings=clock.laps)
+
+
+def _bones(sil, islands, other_views, rules, symmetry, exact=True):
+    """A ``BoneBuilder`` with the bones of the placed ``islands`` (``Blob`` or ``PlacedIsland`` each) and of the limbs
+    the ``other_views`` find hidden, twins across ``symmetry`` (``exact``: see ``BoneBuilder``)."""
+    builder = BoneBuilder(rules.cutting, symmetry, rules.tuning, exact)
+    for placed in islands:
+        if isinstance(placed, Blob):
+            builder.add_blob(sil, placed.point, placed.radius)
+        else:
+            builder.add_island(placed.root_point, placed.chains)
+    for view_of in other_views:
+        builder.add_limbs(hidden_limbs(sil, view_of, builder.lines, rules), (sil, view_of.sil))
+    return builder

@@ -11,11 +11,13 @@ from ...core.polyline import nearest_on_segments
 
 class BoneBuilder:
     """Accumulates bones island by island; the first island's trunk holds the single root bone. Chains are cut as
-    ``cutting`` says; with a ``symmetry`` (None without a mirror plane), mirror twins get mirror-image joints, so a
-    symmetric mesh gets a symmetric rig. ``tuning``: the method's (hanging hidden limbs)."""
+    ``cutting`` says. With a ``symmetry`` (None without a mirror plane) twins are named for their sides; across an
+    ``exact`` one, the mesh's mirror plane, they get mirror-image joints and a limb its longer twin's image, so a
+    symmetric mesh gets a symmetric rig; across a plane a body only roughly mirrors about, just one bone count.
+    ``tuning``: the method's (hanging hidden limbs)."""
 
-    def __init__(self, cutting, symmetry, tuning):
-        self.cutting, self.symmetry, self.tuning = cutting, symmetry, tuning
+    def __init__(self, cutting, symmetry, tuning, exact=True):
+        self.cutting, self.symmetry, self.tuning, self.exact = cutting, symmetry, tuning, exact
         self.bone_length = cutting.bone_length
         self.heads, self.tails, self.parents = [], [], []
         self.chain_of_bone, self.index_in_chain = [], []
@@ -53,7 +55,7 @@ class BoneBuilder:
         pairs stay mirror pairs."""
         if not limbs:
             return
-        if self.symmetry is not None:
+        if self.symmetry is not None and self.exact:
             limbs = mirror_completed(limbs, self.symmetry)
         chains, ups, meets_of = [], [], {}  # meets_of: limb number -> where it meets its bone, for the limbs to extend
         for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
@@ -108,7 +110,7 @@ class BoneBuilder:
         """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror twins made symmetric."""
         if self.symmetry is None:
             return [chain_joints(line, self.cutting, widths, leaf) for line, widths, leaf in chains]
-        return symmetric_joints(chains, self.cutting, self.symmetry)
+        return symmetric_joints(chains, self.cutting, self.symmetry, self.exact)
 
     def _add_chain(self, line, joints, up):
         """Bones between consecutive ``joints`` of one chain, the first hanging from bone ``up``; returns the
@@ -166,5 +168,5 @@ class BoneBuilder:
         return np.array(self.heads), np.array(self.tails), np.array(self.parents, dtype=np.int64)
 
     def names(self):
-        """The bones' names (``bone_names``), mirror-suffixed across the builder's plane."""
+        """The bones' names (``bone_names``), mirror-suffixed across the builder's symmetry."""
         return bone_names(self.chain_of_bone, self.index_in_chain, self.lines, self.symmetry)

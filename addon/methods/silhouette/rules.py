@@ -32,7 +32,8 @@ class Rules:
         """How chains twin across the mirror plane (None without one)."""
         if self.plane is None:
             return None
-        return Symmetry(self.plane, self.tuning.twin_tolerance * self.size, self.tuning)
+        return Symmetry(self.plane, self.tuning.twin_tolerance * self.size, self.tuning,
+                        self.tuning.side_share * self.size)
 
     @property
     def cutting(self):
