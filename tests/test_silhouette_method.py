@@ -635,3 +635,34 @@ def test_a_side_view_cut_out_gets_no_sides():
     spine crosses that plane: head and tail are no left and right."""
     vertices, triangles = load_obj(shared_path("models", "nogt", "alligator.obj"))
     assert not [name for name in rigger.rig_mesh(vertices, triangles).names if name.endswith((".L", ".R"))]
+
+
+def test_a_chain_on_the_mirror_plane_never_hangs_from_a_side_chain():
+    """Two chains leave the root of a figure, an arm (the wider, off the plane) and the spine (on it): the spine
+    becomes the trunk, and a head the triangulation hung from the arm near the shoulder hangs from the spine's
+    root instead, starting there: raising the arm must not carry the head."""
+    builder = bone_builder(0.3, plane=(0, 0.0))
+    spine = (np.array([[0.0, 0.0, 0.0], [0.0, -1.0, 0.0]]), -1, np.full(2, 0.2))
+    arm = (np.array([[0.0, 0.0, 0.0], [0.3, 0.1, 0.0], [1.0, 0.1, 0.0]]), -1, np.full(3, 0.3))
+    head = (np.array([[0.3, 0.1, 0.0], [0.05, 0.5, 0.0], [0.0, 0.9, 0.0]]), 1, np.full(3, 0.1))
+    builder.add_island(np.zeros(3), [spine, arm, head])
+    heads, _, parents = builder.arrays()
+    names = builder.names()
+    assert names[0].startswith("trunk") and not names[0].endswith((".L", ".R"))
+    first_head_bone = next(i for i, name in enumerate(names) if name.startswith("limb") and name[-2:] not in (".L", ".R"))
+    assert names[parents[first_head_bone]].startswith("trunk")
+    np.testing.assert_array_equal(heads[first_head_bone], [0.0, 0.0, 0.0])
+
+
+def test_on_a_four_armed_figure_each_arm_keeps_its_hand_and_the_head_hangs_from_the_spine():
+    """rignet_17364's two arms on each side lie one behind the other seen from the front: each keeps its own depth
+    into its own hand (no bone crosses from one arm's depth to the other's), and the head hangs from the spine."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_17364", "rignet_17364.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    size = np.ptp(vertices, axis=0).max()
+    depth_steps = np.abs(skeleton.tails[:, 2] - skeleton.heads[:, 2]) / size
+    along = np.linalg.norm((skeleton.tails - skeleton.heads)[:, :2], axis=1) / size
+    assert not ((depth_steps > 0.05) & (along > 0.05)).any()  # no bone strides across from one arm to the other
+    for bone, parent in enumerate(skeleton.parents):
+        if parent >= 0 and not skeleton.names[bone].endswith((".L", ".R")):
+            assert not skeleton.names[parent].endswith((".L", ".R")), skeleton.names[bone]

@@ -604,3 +604,13 @@ def test_a_roughly_symmetric_body_gets_a_plane_for_its_sides_through_its_spine()
     lying = figure((0.52, 0.48), spine_along=0)
     along_x = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
     assert sided_symmetry(lying, column_bounds(lying), 2.0, [along_x, *arms], TUNING) is None
+
+
+def test_copies_of_a_split_chain_keep_their_own_parts_to_the_end():
+    """Two arms seen one behind the other (depths 0.5 and 3.5), and past the front one's wrist the rays hit only
+    the back one: the front arm's copy keeps its depth instead of running into the back arm, so the two arms end
+    apart and each carries its own hand."""
+    node_layers = [layers((0, 4))] * 4 + [layers((0, 1), (3, 4))] * 12 + [layers((3, 4))] * 3
+    _, placed = placed_along_x(node_layers)
+    tips = sorted(line[-1, 2] for line, _, _ in placed)
+    np.testing.assert_allclose(tips, [0.5, 3.5])

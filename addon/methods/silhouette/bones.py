@@ -24,9 +24,14 @@ class BoneBuilder:
         self.lines = []  # one polyline per chain, indexed by chain number
 
     def add_island(self, root_point, placed):
-        """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk."""
+        """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk, the
+        widest on the mirror plane when one leaves it there (a spine, not an arm, carries the body). Across a plane,
+        a chain on it never hangs from a chain off it (``_on_plane_parents``)."""
+        if self.symmetry is not None:
+            placed = self._on_plane_parents(placed)
         roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
-        trunk = max(roots, key=lambda i: placed[i][2].mean())
+        on_plane = {i: self.symmetry is not None and self.symmetry.side(placed[i][0]) == 0 for i in roots}
+        trunk = max(roots, key=lambda i: (on_plane[i], placed[i][2].mean()))
         order = [trunk] + [i for i in range(len(placed)) if i != trunk]
         inner = {parent for _, parent, _ in placed}
         joints = self._joints([(line, widths, i not in inner) for i, (line, _, widths) in enumerate(placed)])
@@ -42,6 +47,25 @@ class BoneBuilder:
                 up = first_bone[trunk]
             added = self._add_chain(line, joints[i], up)
             first_bone[i], last_bone[i] = (added[0], added[-1]) if added else (up, up)
+
+    def _on_plane(self, line):
+        """Whether the chain ``line`` lies on the builder's mirror plane (False without one)."""
+        return self.symmetry is not None and self.symmetry.side(line) == 0
+
+    def _on_plane_parents(self, placed):
+        """The placed chains with each chain on the plane that hangs from a chain off it (a head whose branch the
+        triangulation put on an arm near the shoulders) hung instead from the nearest ancestor on the plane (or the
+        root), starting where its sided ancestors leave that one: raising an arm must not carry the head."""
+        side = [self.symmetry.side(line[1:]) for line, _, _ in placed]  # its own course, after it leaves its parent
+        moved = list(placed)
+        for i, (line, parent, widths) in enumerate(placed):
+            if side[i] != 0 or parent < 0 or side[parent] == 0:
+                continue
+            start = placed[parent][0][0]
+            while parent >= 0 and side[parent] != 0:
+                start, parent = placed[parent][0][0], placed[parent][1]
+            moved[i] = (np.vstack([start, line[1:]]), parent, widths)
+        return moved
 
     def add_limbs(self, limbs, views):
         """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone already there that their
@@ -59,7 +83,7 @@ class BoneBuilder:
             limbs = mirror_completed(limbs, self.symmetry)
         chains, ups, meets_of = [], [], {}  # meets_of: limb number -> where it meets its bone, for the limbs to extend
         for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
-            up, meets = self.attachment(line[0], views)  # from the left one's extension, which passes nearer it)
+            up, meets = self.attachment(line[0], views, self._on_plane(line))  # from the left one's extension)
             if meets is not None and np.linalg.norm(line[0] - meets) > self.tuning.bridge_reach * self.bone_length:
                 meets_of[len(chains)] = meets
             chains.append((line, widths, True))
@@ -139,9 +163,11 @@ class BoneBuilder:
         ends = np.array([centre - half, centre + half])
         self._add_chain(ends, ends, self.attachment(centre)[0])
 
-    def attachment(self, point, views=()):
+    def attachment(self, point, views=(), on_plane=False):
         """(bone, where a path from ``point`` meets it): the bone nearest ``point``, or -1 before the first island,
-        met nowhere in particular (None). With silhouettes ``views``, the nearest bone that a straight path from
+        met nowhere in particular (None); ``on_plane``: of the bones on the mirror plane, if any (a head found in a
+        perpendicular view hangs from the spine, not from an arm near it). With silhouettes ``views``, the nearest
+        bone that a straight path from
         ``point`` reaches within the mesh as each of them sees it (``Silhouette.encloses``, sampled every grid cell,
         up to ``path_slack`` outside: a path may graze the surface, but a foot beside a hanging hand belongs to the
         body, not the hand), and the point the path meets it at; the nearest bone, met nowhere (None), when no path
@@ -151,6 +177,10 @@ class BoneBuilder:
             return -1, None
         targets = nearest_on_segments(point[None], np.array(self.heads), np.array(self.tails))[0]
         distance = np.linalg.norm(targets - point, axis=1)
+        if on_plane:
+            sided = np.array([not self._on_plane(self.lines[chain]) for chain in self.chain_of_bone])
+            if not sided.all():
+                distance = np.where(sided, np.inf, distance)
         order = np.argsort(distance, kind="stable")
         if views:
             cell = min(view.cell for view in views)

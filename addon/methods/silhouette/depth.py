@@ -113,8 +113,7 @@ def place_chains(sil, points, radius, root, chains, placing):
         parents = ends_of[chain.parent]
         for part, count in pieces:
             first = len(placed)
-            followed = [_follow((parts if count > 1 else node_layers)[part], copy, count, end_depth[chain.parent],
-                                plane) for copy in range(count)]
+            followed = _follow((parts if count > 1 else node_layers)[part], count, end_depth[chain.parent], plane)
             for copy in range(count):
                 depths = resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
                                            followed[copy], placing, followed[:copy] + followed[copy + 1:])
@@ -222,23 +221,40 @@ def layer_count(node_layers, tuning):
     return int(several[0]) if len(several) else int(np.argmax(frequency))
 
 
-def _follow(node_layers, copy, copies, start, mirror=None):
-    """Depth along a chain, always the middle of an interval. A single chain follows, from its start, the interval
-    nearest the previous depth; on a ``mirror`` plane ((depth, tolerance) or None) it stays there across nodes
-    whose rays pass only beside it (ears on each side of a head), not stepping to the one side or the other. Copy
-    ``copy`` of a split chain is anchored at interval ``copy`` (front to back) of the outermost node crossing exactly
-    ``copies`` intervals, and followed from there both ways by nearest depth, so it never jumps to the other part
-    where some node sees the parts merged or an extra part."""
-    depths = np.full(len(node_layers), np.nan)
+def _follow(node_layers, copies, start, mirror=None):
+    """Depth along a chain for each of its ``copies`` (one unless it is split), always the middle of an interval.
+
+    A single chain follows, from its start, the interval nearest the previous depth; on a ``mirror`` plane ((depth,
+    tolerance) or None) it stays there across nodes whose rays pass only beside it (ears on each side of a head), not
+    stepping to the one side or the other. Copy k of a split chain is anchored at interval k (front to back) of the
+    outermost node crossing exactly ``copies`` intervals and followed from there both ways by nearest depth, so it
+    never jumps to the other part where some node sees the parts merged or an extra part: towards the parent it keeps
+    its depth while an interval holds it (the parts merge with each other and the body there), and past the anchor it
+    never steps into an interval another copy is in (two arms seen one behind the other, where the rays past the
+    front one's wrist hit only the back one: the front arm's copy keeps its depth).
+    """
     if copies == 1:
+        depths = np.full(len(node_layers), np.nan)
         _track(node_layers, range(len(node_layers)), start, depths, mirror=mirror)
-    else:
-        anchor = max(i for i, layer in enumerate(node_layers) if len(layer) == copies)
+        return [depths]
+    anchor = max(i for i, layer in enumerate(node_layers) if len(layer) == copies)
+    followed = [np.full(len(node_layers), np.nan) for _ in range(copies)]
+    for copy, depths in enumerate(followed):
         depths[anchor] = _middle(node_layers[anchor][copy])
-        # towards the parent the parts often merge with each other and the body: stay on this part's side
-        _track(node_layers, range(anchor + 1, len(node_layers)), depths[anchor], depths, stay=True)
         _track(node_layers, range(anchor - 1, -1, -1), depths[anchor], depths, stay=True)
-    return depths
+    for i in range(anchor + 1, len(node_layers)):
+        intervals = node_layers[i].tolist()
+        held = [next((k for k, (low, high) in enumerate(intervals) if low <= depths[i - 1] <= high), None)
+                for depths in followed]
+        for copy, depths in enumerate(followed):
+            previous = depths[i - 1]
+            free = [(max(low - previous, 0.0) + max(previous - high, 0.0), low, high)
+                    for k, (low, high) in enumerate(intervals) if k not in held[:copy] + held[copy + 1:]]
+            if held[copy] is None and free:
+                _, low, high = min(free)
+                previous = 0.5 * (low + high)
+            depths[i] = previous
+    return followed
 
 
 def _track(node_layers, order, previous, depths, stay=False, mirror=None):

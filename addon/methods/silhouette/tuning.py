@@ -56,6 +56,8 @@ class Tuning(JointTuning, MirrorTuning):
                                        "view")
     part_alike: float = tuned(0.45, "a separate part is at least this share of the thickest one's thickness (not a "
                                     "nose beside a head)")
+    copy_jump: float = tuned(1.0, "past the node where a split chain's parts are last apart, a copy steps to a part "
+                                  "at most this many part widths away (not to the part another copy follows)")
     side_width_cost: float = tuned(0.1, "matching a side-view node, a width difference costs this much per unit of "
                                         "depth difference")
     # 8. islands
