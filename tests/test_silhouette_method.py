@@ -10,6 +10,7 @@ from characters import strictly_inside_fraction, load_character
 from meshes import box, combine, ellipsoids, far_apart_cubes, grid_surface, uv_sphere
 from rigger import samples
 from rigger.core.joints import Cutting
+from rigger.core.polyline import segment_distances
 from rigger.core.mirror import Symmetry
 from rigger.methods.silhouette.bones import BoneBuilder
 from rigger.methods.silhouette.tuning import Tuning
@@ -667,3 +668,17 @@ def test_on_a_four_armed_figure_each_arm_keeps_its_hand_and_the_head_hangs_from_
     for bone, parent in enumerate(skeleton.parents):
         if parent >= 0 and not skeleton.names[bone].endswith((".L", ".R")):
             assert not skeleton.names[parent].endswith((".L", ".R")), skeleton.names[bone]
+
+
+def test_a_cat_s_stubby_front_legs_seen_from_the_side_get_bones():
+    """rignet_8338 seen from the side: its front legs are a bump as long as it is thick, but they stand on the ground
+    with the hind legs, so they keep a chain (split in depth into the two legs): a bone passes by each front ankle
+    of the artist's rig, on its side."""
+    folder = shared_path("models", "gt", "rignet_8338")
+    vertices, triangles = load_obj(folder / "rignet_8338.obj")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    size = np.ptp(vertices, axis=0).max()
+    for side, ankle in ((".R", (-0.12096142, 0.07314362, 0.08340533)), (".L", (0.12096142, 0.07314362, 0.08340533))):
+        bones = [i for i, name in enumerate(skeleton.names) if name.endswith(side)]
+        gaps = segment_distances(np.array([ankle]), skeleton.heads[bones], skeleton.tails[bones])
+        assert gaps.min() < 0.04 * size

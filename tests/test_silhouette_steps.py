@@ -614,3 +614,25 @@ def test_copies_of_a_split_chain_keep_their_own_parts_to_the_end():
     _, placed = placed_along_x(node_layers)
     tips = sorted(line[-1, 2] for line, _, _ in placed)
     np.testing.assert_allclose(tips, [0.5, 3.5])
+
+
+def test_a_stubby_leg_standing_on_the_ground_with_the_others_is_a_leg():
+    """A body (radius 1) on two thin legs whose feet stand on the ground (y = -3.2), and a stubby leg as long as it
+    is thick whose foot stands there too: under prune it is a bump, but it stands where the kept legs stand, so it
+    stays; without the ground, or off the ground, it goes."""
+    nodes = [(0.0, 0.0, 1.0)]
+    chains = []
+    for part in ([(x, y, 0.2) for y in np.linspace(-1.2, -3.0, 6)] for x in (-0.5, -1.5)):
+        chains.append([0] + list(range(len(nodes), len(nodes) + len(part))))
+        nodes += part
+
+    def kept(stub, ground=((-5.0, -3.2), (5.0, 5.0), 0.1)):
+        points = np.array(nodes + stub)
+        branch = [[0] + list(range(len(nodes), len(nodes) + len(stub)))]
+        links = prune_spurs(points[:, :2], points[:, 2], chains + branch, Pruning(1.35, pair_prune=0.74, ground=ground))
+        return len(nodes) + len(stub) - 1 in links
+
+    stubby = [(1.2, -0.8, 1.4), (2.0, -1.4, 1.4), (2.5, -1.8, 1.4)]  # its foot reaches y = -3.2
+    assert kept(stubby)
+    assert not kept(stubby, ground=None)
+    assert not kept([(x, y + 0.5, r) for x, y, r in stubby])

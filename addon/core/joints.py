@@ -18,6 +18,8 @@ class JointTuning(TuningTable):
     disc_exit: float = tuned(0.3, "the joint where a chain leaves its branch point's disc is this far along at least")
     disc_exit_rest: float = tuned(0.5, "... and this much of the chain lies beyond it")
     corner_tolerance: float = tuned(0.25, "corners are measured on the chain simplified within this: no jitter stubs")
+    narrowing: float = tuned(0.8, "spare bones go first to where a part narrows to this share of its width on both "
+                                  "sides within a bone length (a knee, an elbow, a wrist)")
     spare_bend: float = tuned(0.5, "spare bones go to bends a straight bone would leave the part's middle at, this "
                                    "share of the half-width off")
 
@@ -90,8 +92,24 @@ def _candidate_stops(line, arc, widths, cutting):
         return found, len(found)
     found += [arc[i] for i in _simplified(line, np.maximum(widths, 1e-12 * bone_length))[1:-1]]
     needed = len(found)
+    found += [arc[i] for i in _narrowings(arc, widths, tuning.narrowing, bone_length)]
     found += [arc[i] for i in _simplified(line, np.maximum(tuning.spare_bend * widths, 1e-12 * bone_length))[1:-1]]
     return found, needed
+
+
+def _narrowings(arc, widths, ratio, reach):
+    """Nodes where the part narrows, narrowest first: the least half-width within ``reach`` (arc length) either
+    side, and at most ``ratio`` times the widest on each side within that reach (a knee between thigh and calf, an
+    elbow, a wrist); not within ``reach`` of the chain's end, where a part tapers to its tip."""
+    found = []
+    for i in range(1, len(arc) - 1):
+        near = (arc >= arc[i] - reach) & (arc <= arc[i] + reach)
+        if arc[i] > arc[-1] - reach or widths[i] > widths[near].min():
+            continue
+        before, after = widths[near & (arc < arc[i])], widths[near & (arc > arc[i])]
+        if len(before) and len(after) and widths[i] <= ratio * min(before.max(), after.max()):
+            found.append((widths[i] / min(before.max(), after.max()), i))
+    return [i for _, i in sorted(found)]
 
 
 def _share(lengths, total):

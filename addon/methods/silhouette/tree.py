@@ -67,6 +67,8 @@ class Pruning:
             None: spurs never pair.
         mirror: a function reflecting (P, 2) points of the view across the mesh's mirror plane, or None.
         local_pairs: without a mirror plane, pair spurs alike in size (``_local_pairs``).
+        ground: (low (2,), high (2,), tolerance) of the view's outline: a stubby spur standing on a side of it that a
+            kept leaf stands on too stays (``_standing``); None: no such rule.
         tuning: the method's tuning (``round_tip``, ``local_pair``, ``width_nodes``).
     """
 
@@ -76,6 +78,7 @@ class Pruning:
     pair_prune: float = None
     mirror: object = None
     local_pairs: bool = False
+    ground: tuple = None
     tuning: Tuning = Tuning()
 
 
@@ -128,7 +131,9 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
     arms, each near the threshold, are kept or dropped together), and with ``pair_prune`` two spurs off one base
     that mirror each other stay: a pair is a limb where a lone bump of that size is not (a dog's ears; outline noise
     is not symmetric). With ``pair_prune`` and ``local_pairs`` instead, two such spurs off one base that stick out
-    about as far and are about as wide stay (``_local_pairs``).
+    about as far and are about as wide stay (``_local_pairs``). With ``pair_prune`` and a ``ground``, such a spur
+    stays when its tip stands where a kept leaf stands (``_standing``): a cat's stubby front legs beside its hind
+    legs, seen from the side.
     """
     prune, min_reach, max_reach, pair_prune = pruning.prune, pruning.min_reach, pruning.max_reach, pruning.pair_prune
     tuning = pruning.tuning
@@ -166,6 +171,8 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                     break
         if spurs and pruning.mirror is not None:
             spurs = _unmirrored(spurs, pairable, leaves, points, radius, pruning.mirror)
+        if spurs and pruning.ground is not None:
+            spurs = _standing(spurs, pairable, leaves, chains, points, radius, pruning.ground)
         if not spurs:
             links = links_of(chains)
             if not dropped:
@@ -178,6 +185,32 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
         if not kept:
             return np.zeros((0, 2), dtype=np.int64)
         _, chains = chains_of(sorted({n for c in kept for n in c}), links_of(kept))
+
+
+def _standing(spurs, pairable, leaves, chains, points, radius, ground):
+    """The ``spurs`` (chain -> (base, tip)) without the ``pairable`` ones whose tip stands on a side of the view's
+    outline (``ground``: its low and high corner and a tolerance) that a kept leaf's tip stands on too, farther from
+    it than either is wide: legs reach the ground together, however stubby (a foot's toe beside its own leg's foot
+    is no leg)."""
+    low, high, tolerance = ground
+
+    def sides(node):
+        reach = points[node] + radius[node], points[node] - radius[node]
+        return {(axis, end) for axis in range(2) for end, touches in
+                ((1, reach[0][axis] >= high[axis] - tolerance), (0, reach[1][axis] <= low[axis] + tolerance))
+                if touches}
+
+    kept_tips = [(chains[i][-1] if chains[i][0] == base else chains[i][0]) for i, base, _ in leaves if i not in spurs]
+    standing = [(sides(tip), tip) for tip in kept_tips]
+    result = {}
+    for i, (base, tip) in spurs.items():
+        width = pairable[i][3] if i in pairable else None
+        stands = width is not None and any(
+            sides(tip) & on and np.linalg.norm(points[tip] - points[other]) > max(width, 2 * radius[other])
+            for on, other in standing)
+        if not stands:
+            result[i] = base, tip
+    return result
 
 
 def _round_part(apart, radius, blobs, base, tip, round_tip):
