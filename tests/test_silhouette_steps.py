@@ -636,3 +636,16 @@ def test_a_stubby_leg_standing_on_the_ground_with_the_others_is_a_leg():
     assert kept(stubby)
     assert not kept(stubby, ground=None)
     assert not kept([(x, y + 0.5, r) for x, y, r in stubby])
+
+
+def test_a_straight_leg_gets_its_knee_where_it_narrows():
+    """A straight leg 0.4 long cut into four bones of 0.1: evenly, its joints would fall at 0.1, 0.2 and 0.3; its
+    width narrows to 0.6 of the thigh's and calf's at 0.23 (the knee), where a joint goes instead."""
+    line = straight(0.4, 81)
+    along = line[:, 0]
+    widths = 0.03 - 0.012 * np.exp(-((along - 0.23) / 0.02) ** 2)
+    joints = chain_joints(line, cutting(4), widths, leaf=True)
+    assert len(joints) == 5
+    assert np.abs(joints[:, 0] - 0.23).min() < 0.006
+    even = chain_joints(line, cutting(4), np.full(len(line), 0.03), leaf=True)
+    assert np.abs(even[:, 0] - 0.23).min() > 0.02
