@@ -50,8 +50,9 @@ TARGET_EXCESS_MEAN, TARGET_EXCESS_MAX, TARGET_CRACK, TARGET_RECALL, TARGET_TWIN 
 ISSUE_NOW = {"artist": 0.0, "artist_skin": 0.0053, "rigger": 0.0081, "stick": 0.0495}
 
 
-def measure(folder, seeds, poses=POSES, max_degrees=MAX_DEGREES):
-    """Every measurement of one model; failures of one rig or one step become text in the record."""
+def measure(folder, seeds, poses=POSES, max_degrees=MAX_DEGREES, params=None):
+    """Every measurement of one model (Rigger rigging it with the method parameters ``params``, default none);
+    failures of one rig or one step become text in the record."""
     started = time.perf_counter()
     vertices, triangles, rig = rigdata.load_ground_truth(folder)
     rig = rig.attached()  # posed as one tree: feet the artist drives by IK follow the leg
@@ -65,7 +66,7 @@ def measure(folder, seeds, poses=POSES, max_degrees=MAX_DEGREES):
         import rigger
 
         rig_started = time.perf_counter()
-        skeletons["rigger"] = rigger.rig_mesh(vertices, triangles.astype(np.int32))
+        skeletons["rigger"] = rigger.rig_mesh(vertices, triangles.astype(np.int32), **(params or {}))
         record["rig_seconds"] = time.perf_counter() - rig_started
     except Exception as error:  # the product failing on one model is a result, not a crash
         record["errors"]["rigger"] = f"rig_mesh: {type(error).__name__}: {error}"
@@ -121,7 +122,8 @@ def measure(folder, seeds, poses=POSES, max_degrees=MAX_DEGREES):
             worst = int(totals.argmax())  # the most excess in all: small regions with a large mean are noise
             seed_record["excess_at"] = {
                 "joint": str(joint_names[worst]), "excess": float(totals[worst] / counts[worst]),
-                "vertices": int(counts[worst]), "share": float(totals[worst] / max(np.maximum(excess, 0).sum(), 1e-300))}
+                "vertices": int(counts[worst]),
+                "share": float(totals[worst] / max(np.maximum(excess, 0).sum(), 1e-300))}
         record["seeds"][str(seed)] = seed_record
     if "rigger" in skeletons:
         record["skeleton"] = skeleton_measures(rig, artist_skeleton, skeletons["rigger"], vertices, triangles, size)
@@ -145,11 +147,11 @@ def skeleton_measures(rig, artist_skeleton, skeleton, vertices, triangles, size)
             "twins": twins, "unsided": unsided if plane.two_sided() else None}
 
 
-def measured(folder, seeds, poses, max_degrees):
+def measured(folder, seeds, poses, max_degrees, params):
     """``measure`` for a worker process: never raises, so one model cannot stop the run."""
     temporary_user_folder()
     try:
-        return measure(folder, seeds, poses, max_degrees)
+        return measure(folder, seeds, poses, max_degrees, params)
     except Exception as error:
         return {"model": folder.name, "failed": f"{type(error).__name__}: {error}",
                 "traceback": traceback.format_exc(limit=-4)}
@@ -329,7 +331,7 @@ def report(records, summary, run):
         f"- Models: {len(records)} from `../shared/models/gt` (helper joints dropped; a part the artist keeps as a "
         "root of its own, such as the IK-driven feet of the Quaternius rigs, hangs from the nearest joint under the "
         "root, for the poses and for the artist skeleton alike: `rigdata.Rig.attached`)"
-        + (f"; filtered by `--models`" if run["filtered"] else "") + ". Sizes are fractions of the mesh's largest "
+        + ("; filtered by `--models`" if run["filtered"] else "") + ". Sizes are fractions of the mesh's largest "
         "bounding-box extent.",
         f"- Poses: {run['poses']} per seed; every artist joint turns about its own position by an angle uniform in "
         f"[0°, {run['max_degrees']:g}°] about a uniformly random axis, applied down the hierarchy; the mesh is "
@@ -505,7 +507,10 @@ def main(argv=None):
     parser.add_argument("--out", type=pathlib.Path,
                         help="results folder (default bench/results, or out/posing with --models)")
     parser.add_argument("--compare", type=pathlib.Path, help="a previous run's posing.json to compare against")
+    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                        help="a parameter of Rigger's method, e.g. --set bone_length=0.08 (repeatable)")
     args = parser.parse_args(argv)
+    params = dict(setting.split("=", 1) for setting in args.settings)
     if not MODELS_DIR.is_dir():
         raise SystemExit(f"No models at {MODELS_DIR}: the posing benchmark needs ../shared beside the checkout.")
     if args.poses < 1 or args.jobs < 1:
@@ -527,7 +532,7 @@ def main(argv=None):
     context = multiprocessing.get_context("spawn")  # bpy in each worker of its own, never forked
     with concurrent.futures.ProcessPoolExecutor(args.jobs, mp_context=context) as pool:
         largest_first = sorted(folders, key=obj_size, reverse=True)  # the long pole starts first
-        futures = [pool.submit(measured, folder, seeds, args.poses, args.max_angle) for folder in largest_first]
+        futures = [pool.submit(measured, folder, seeds, args.poses, args.max_angle, params) for folder in largest_first]
         for future in concurrent.futures.as_completed(futures):
             record = future.result()
             records.append(record)
