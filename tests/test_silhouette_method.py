@@ -682,3 +682,17 @@ def test_a_cat_s_stubby_front_legs_seen_from_the_side_get_bones():
         bones = [i for i, name in enumerate(skeleton.names) if name.endswith(side)]
         gaps = segment_distances(np.array([ankle]), skeleton.heads[bones], skeleton.tails[bones])
         assert gaps.min() < 0.04 * size
+
+
+def test_ears_seen_edge_on_get_bones_from_the_end_on_view():
+    """Quaternius_Alpaca seen from the side: its ears are one stubby bump over the head, pruned; seen end-on they
+    are a pair beside the head's chain, off the mirror plane, so they are limbs the skeleton lacks (a point off the
+    plane is covered only by chains on its side): a ``.L`` and a ``.R`` bone reach each ear tip (the artist's
+    Ear4)."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_Alpaca", "Quaternius_Alpaca.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    size = np.ptp(vertices, axis=0).max()
+    for side, tip in ((".L", (0.229464, 5.169129, 1.641474)), (".R", (-0.229464, 5.169129, 1.641474))):
+        bones = [i for i, name in enumerate(skeleton.names) if name.endswith(side)]
+        gaps = segment_distances(np.array([tip]), skeleton.heads[bones], skeleton.tails[bones])
+        assert gaps.min() < 0.03 * size

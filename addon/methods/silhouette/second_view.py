@@ -25,7 +25,8 @@ def hidden_limbs(sil, view, lines, rules):
     view_graph, alive, _, kept = pruned_tree(view.axis_graph, params.merge, pruning)
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]
-    cover = Cover(lines, view.sil.direction, tuning.hidden_reach * rules.unit)
+    across = rules.plane is not None and abs(view.sil.direction[rules.plane[0]]) <= tuning.along_plane
+    cover = Cover(lines, view.sil.direction, tuning.hidden_reach * rules.unit, rules.symmetry if across else None)
     if cover.covered(view.sil.lift(tips, 0.0)).all():
         return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
     view.sil.share_parts(sil)  # the mesh's welded parts, found once for the primary view, give the view's layers
@@ -40,22 +41,48 @@ def hidden_limbs(sil, view, lines, rules):
 
 class Cover:
     """The primary skeleton as a perpendicular view sees it: its chains flattened along the view ``direction`` once,
-    and which points they cover (come within ``reach`` of, both projected along the direction)."""
+    and which points they cover (come within ``reach`` of, both projected along the direction). With a ``symmetry``
+    the view looks across (its plane seen edge-on), a point off the plane is covered only by chains on its side:
+    ears beside the head's chain, seen end-on, are limbs the skeleton lacks."""
 
-    def __init__(self, primary_lines, direction, reach):
-        self.direction, self.reach = direction, reach
+    def __init__(self, primary_lines, direction, reach, symmetry=None):
+        self.direction, self.reach, self.symmetry = direction, reach, symmetry
         self.starts, self.ends = _segments(primary_lines, direction)
         self.low = np.minimum(self.starts, self.ends) - reach  # each segment's box, grown by the reach
         self.high = np.maximum(self.starts, self.ends) + reach
+        if symmetry is not None:
+            self.sides = np.concatenate([np.full(len(line) - 1, symmetry.side(line, by_tip=True))
+                                         for line in primary_lines if len(line) > 1] or [np.zeros(0, int)])
 
-    def covered(self, points):
+    def covered(self, points, sided=True):
         """Whether each of the 3D ``points`` lies within ``reach`` of a primary chain, seen along the direction
-        (segments whose grown box misses the points' box cannot cover any of them, and are not measured)."""
+        (segments whose grown box misses the points' box cannot cover any of them, and are not measured); without
+        ``sided``, of any chain whatever its side."""
         flat = _flattened(points, self.direction)
         if not len(flat):
             return np.zeros(0, bool)
         near = ((self.low <= flat.max(axis=0)) & (self.high >= flat.min(axis=0))).all(axis=1)
-        return _distance_to_segments(flat, self.starts[near], self.ends[near]) <= self.reach
+        if self.symmetry is None or not sided:
+            return _distance_to_segments(flat, self.starts[near], self.ends[near]) <= self.reach
+        sides = self._sides(points)
+        covered = np.zeros(len(points), bool)
+        for side in np.unique(sides):
+            on = sides == side
+            by = near & ((self.sides == side) if side else True)
+            covered[on] = _distance_to_segments(flat[on], self.starts[by], self.ends[by]) <= self.reach
+        return covered
+
+    def beside(self, points, tip):
+        """Whether each of the 3D ``points`` lies on the same side of the plane as ``tip`` (all, without a plane):
+        an ear's chain off the plane begins where it leaves the head's middle."""
+        if self.symmetry is None:
+            return np.ones(len(points), bool)
+        return self._sides(points) == self._sides(tip)[0]
+
+    def _sides(self, points):
+        axis, offset = self.symmetry.plane
+        off = points[:, axis] - offset
+        return np.where(np.abs(off) > self.symmetry.side_tolerance, np.sign(off), 0).astype(int)
 
 
 def uncovered_limbs(placed, cover, primary_sil, min_length, tuning):
@@ -83,12 +110,29 @@ def uncovered_limbs(placed, cover, primary_sil, min_length, tuning):
         width = 2 * tuning.occlusion_ratio * float(np.median(widths))
         if cover.covered(tip)[0] or not hidden(primary_sil, tip, width)[0]:
             continue
-        covered = np.flatnonzero(cover.covered(line))
-        first = int(covered[-1]) + 1 if len(covered) else 0  # not the covered node: its depth is the body's
+        first = _first_uncovered(line, widths, tip, cover)
         part = line[first:]
         if len(part) >= 2 and length(part) >= min_length:
             limbs.append((part, widths[first:]))
     return limbs
+
+
+def _first_uncovered(line, widths, tip, cover):
+    """Where a limb ending at ``tip`` begins on its ``line``: past the last node the primary skeleton covers (not
+    the covered node: its depth is the body's). Across a mirror plane, a tip off it is covered only on its own side
+    (``Cover``): an ear beside the head's chain begins where it leaves the head's middle, so long as its nodes'
+    depths run on without a leap of more than the part's width (into the body behind the head)."""
+    def after(mask):
+        nodes = np.flatnonzero(mask)
+        return int(nodes[-1]) + 1 if len(nodes) else 0
+
+    first = after(cover.covered(line, sided=False))
+    if cover.symmetry is None:
+        return first
+    sided = after(cover.covered(line) | ~cover.beside(line, tip))
+    depth = line @ cover.direction
+    leaps = np.abs(np.diff(depth)) > 2 * np.maximum(widths[1:], widths[:-1])  # between node k and k + 1
+    return max(sided, after(leaps[:first])) if sided < first else first
 
 
 def hidden(sil, points, width):
