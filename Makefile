@@ -9,7 +9,7 @@ BPY42_VENV := $(VENV)/bpy42
 BPY42_STAMP := $(BPY42_VENV)/.installed
 
 .PHONY: test build demo addon bpy42 bench bench-quality bench-silhouette bench-skinning bench-posing \
-	bench-rig-time regress regress-baseline clean
+	bench-rig-time regress regress-baseline defects clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -65,6 +65,10 @@ regress: build
 
 regress-baseline: build
 	$(PY) tools/regress.py --baseline
+
+# Issue 28's defect characters rigged, measured against their true skeletons and drawn: out/defects/.
+defects: build
+	$(PY) tools/defects.py
 
 clean:
 	rm -rf build dist out *.egg-info addon/*.so ext/cdt.c ext/silhouette_binding.c ext/skin_weights_binding.c

@@ -393,26 +393,36 @@ def limb_recall(joint_positions, joint_parents, heads, tails, parents, size, tol
     A chain is followed when its points (every ``step`` * ``size``) lie within ``tolerance`` * ``size`` on average of
     one path of bones from a leaf bone up to its root. Returns (share followed, list of (chain, followed) pairs).
     """
-    heads, tails, parents = (np.asarray(a) for a in (heads, tails, parents))
     chains = [chain for chain in leaf_chains(joint_positions, joint_parents) if len(chain) > 1]
     if not chains:
         return float("nan"), []
-    is_leaf = np.ones(len(heads), dtype=bool)
+    outcome = [(chain, closest_path(chain_points(joint_positions, chain, step * size), heads, tails, parents)[0]
+                <= tolerance * size) for chain in chains]
+    return float(np.mean([followed for _, followed in outcome])), outcome
+
+
+def bone_paths(parents):
+    """The paths of a bone forest from each leaf bone up to its root: lists of bone indices, leaf first."""
+    parents = np.asarray(parents)
+    is_leaf = np.ones(len(parents), dtype=bool)
     is_leaf[parents[parents >= 0]] = False
     paths = []
     for leaf in np.flatnonzero(is_leaf):
-        path, bone = np.zeros(len(heads), dtype=bool), leaf
+        path, bone = [], int(leaf)
         while bone >= 0:
-            path[bone] = True
-            bone = parents[bone]
+            path.append(bone)
+            bone = int(parents[bone])
         paths.append(path)
-    outcome = []
-    for chain in chains:
-        points = chain_points(joint_positions, chain, step * size)
-        distances = segment_distances(points, heads, tails)
-        best = min(float(np.where(path, distances, np.inf).min(axis=1).mean()) for path in paths)
-        outcome.append((chain, best <= tolerance * size))
-    return float(np.mean([followed for _, followed in outcome])), outcome
+    return paths
+
+
+def closest_path(points, heads, tails, parents):
+    """(mean distance, path) of the path of bones (see :func:`bone_paths`) that ``points`` lie closest to on
+    average, each point measured to its nearest bone on the path."""
+    heads, tails = np.asarray(heads, dtype=np.float64), np.asarray(tails, dtype=np.float64)
+    distances = segment_distances(points, heads, tails)
+    return min(((float(distances[:, path].min(axis=1).mean()), path) for path in bone_paths(parents)),
+               key=lambda pair: pair[0])
 
 
 @dataclass(frozen=True)

@@ -73,7 +73,7 @@ def render(bpy, overlays, obj, skeleton, path):
     scene = bpy.context.scene
     for overlay in bpy.data.collections[overlays.COLLECTION_NAME].objects:
         overlay.hide_render = overlay[overlays.KIND_KEY] in HIDDEN_IN_PICTURE
-    bones = bpy.data.objects.new("bones", _bone_mesh(bpy, skeleton))
+    bones = bpy.data.objects.new("bones", bone_mesh(bpy, skeleton))
     material = bpy.data.materials.new("bones")
     material.diffuse_color = BONE_COLOUR
     bones.data.materials.append(material)
@@ -102,14 +102,15 @@ def render(bpy, overlays, obj, skeleton, path):
     bpy.ops.render.render(write_still=True)
 
 
-def _bone_mesh(bpy, skeleton):
-    """Blender's octahedral bone shape for every bone: a point at head and tail, a square a tenth of the way up."""
+def bone_mesh(bpy, skeleton, width=BONE_WIDTH):
+    """Blender's octahedral bone shape for every bone of ``skeleton`` (its ``heads`` and ``tails``): a point at head
+    and tail, a square a tenth of the way up, ``width`` bone lengths from the axis."""
     vertices, faces = [], []
     for head, tail in zip(skeleton.heads, skeleton.tails):
         along = tail - head
         length = np.linalg.norm(along)
         side = np.cross(along, [0.0, 0.0, 1.0] if abs(along[2]) < 0.9 * length else [1.0, 0.0, 0.0])
-        side *= BONE_WIDTH * length / np.linalg.norm(side)
+        side *= width * length / np.linalg.norm(side)
         other = np.cross(along / length, side)
         ring = head + 0.1 * along
         start = len(vertices)

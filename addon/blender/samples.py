@@ -6,8 +6,9 @@ beyond every end rounds the tip over it, so every true joint lies inside the mes
 
 The Skin modifier's hull is fragile: it leaves holes where a limb leaves a branch point steeply or two branch points
 sit close together along a thick trunk. The characters' data avoids both (tests/test_samples.py checks every mesh is
-closed). Before subdivision, the zero-length edges it leaves at some branch points are collapsed, and the faces it
-sometimes winds inwards (at a root with a single child) are turned outwards.
+closed). Before subdivision, the zero-length edges it leaves at some branch points are collapsed, the vertices it
+sometimes leaves without a face (beside a shoulder) removed, and the faces it sometimes winds inwards (at a root with
+a single child) turned outwards.
 """
 import bpy  # before bmesh: Blender's own modules import only once bpy has
 import bmesh
@@ -86,10 +87,12 @@ def _applied_modifiers(obj):
 
 
 def _tidy_hull(mesh):
-    """Collapse the Skin modifier's zero-length edges and make its faces wind consistently outwards, in place."""
+    """Collapse the Skin modifier's zero-length edges, drop its loose vertices and make its faces wind consistently
+    outwards, in place."""
     hull = bmesh.new()
     hull.from_mesh(mesh)
     bmesh.ops.dissolve_degenerate(hull, edges=hull.edges[:], dist=ZERO_LENGTH)
+    bmesh.ops.delete(hull, geom=[vertex for vertex in hull.verts if not vertex.link_faces], context='VERTS')
     bmesh.ops.recalc_face_normals(hull, faces=hull.faces[:])
     hull.to_mesh(mesh)
     hull.free()
