@@ -15,6 +15,7 @@ from rigger.core.mirror import Symmetry
 from rigger.methods.silhouette.bones import BoneBuilder
 from rigger.methods.silhouette.tuning import Tuning
 
+import rig_checks
 from conftest import shared_path
 from rigdata import chamfer_distance, load_obj
 
@@ -696,3 +697,14 @@ def test_ears_seen_edge_on_get_bones_from_the_end_on_view():
         bones = [i for i, name in enumerate(skeleton.names) if name.endswith(side)]
         gaps = segment_distances(np.array([tip]), skeleton.heads[bones], skeleton.tails[bones])
         assert gaps.min() < 0.03 * size
+
+
+def test_a_bear_s_stubby_back_legs_get_chains():
+    """The generated bear seen from the side: each back leg is about as long as it is thick, a bump by the prune
+    rule, and the foot's corners that stood on the ground are pruned first; the leg still stands where the kept front
+    legs stand, so both back legs get chains down to their paws (defect 6)."""
+    vertices, triangles = load_character("bear")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    size = rig_checks.mesh_size(vertices)
+    followed = rig_checks.limbs(samples.ground_truth_bones("bear"), skeleton, size)
+    assert followed["back_paw.L"].distance < 0.03 and followed["back_paw.R"].distance < 0.03

@@ -18,7 +18,7 @@ class JointTuning(TuningTable):
     disc_exit: float = tuned(0.3, "the joint where a chain leaves its branch point's disc is this far along at least")
     disc_exit_rest: float = tuned(0.5, "... and this much of the chain lies beyond it")
     corner_tolerance: float = tuned(0.25, "corners are measured on the chain simplified within this: no jitter stubs")
-    narrowing: float = tuned(0.8, "spare bones go first to where a part narrows to this share of its width on both "
+    narrowing: float = tuned(0.9, "spare bones go first to where a part narrows to this share of its width on both "
                                   "sides within a bone length (a knee, an elbow, a wrist)")
     spare_bend: float = tuned(0.5, "spare bones go to bends a straight bone would leave the part's middle at, this "
                                    "share of the half-width off")

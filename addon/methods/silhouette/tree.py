@@ -139,6 +139,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
     tuning = pruning.tuning
     chains = [list(c) for c in chains]
     dropped = []  # with local_pairs, the pairable spurs removed so far (``pairable`` entries below)
+    stood = {}  # node -> the sides of the outline its removed spurs stood on (a leg keeps its foot's footing)
     while True:
         degree = {}
         for chain in chains:
@@ -172,7 +173,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
         if spurs and pruning.mirror is not None:
             spurs = _unmirrored(spurs, pairable, leaves, points, radius, pruning.mirror)
         if spurs and pruning.ground is not None:
-            spurs = _standing(spurs, pairable, leaves, chains, points, radius, pruning.ground)
+            spurs = _standing(spurs, pairable, leaves, chains, points, radius, pruning.ground, stood)
         if not spurs:
             links = links_of(chains)
             if not dropped:
@@ -180,6 +181,10 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
             return np.vstack([links, links_of(_local_pairs(dropped, links, points, tuning.local_pair))])
         if pruning.local_pairs:
             dropped += [pairable[i] for i in spurs if i in pairable]
+        if pruning.ground is not None:
+            for base, tip in spurs.values():
+                stood[base] = stood.get(base, set()) | stood.get(tip, set()) | _sides(tip, points, radius,
+                                                                                        pruning.ground)
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
         kept = [c for i, c in enumerate(chains) if i not in spurs]
         if not kept:
@@ -187,29 +192,38 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
         _, chains = chains_of(sorted({n for c in kept for n in c}), links_of(kept))
 
 
-def _standing(spurs, pairable, leaves, chains, points, radius, ground):
-    """The ``spurs`` (chain -> (base, tip)) without the ``pairable`` ones whose tip stands on a side of the view's
-    outline (``ground``: its low and high corner and a tolerance) that a kept leaf's tip stands on too, farther from
-    it than either is wide: legs reach the ground together, however stubby (a foot's toe beside its own leg's foot
-    is no leg)."""
+def _sides(node, points, radius, ground):
+    """The sides ((axis, 0 for low or 1 for high)) of the view's outline (``ground``: its low and high corner and a
+    tolerance) that ``node``'s disc reaches."""
     low, high, tolerance = ground
+    reach = points[node] + radius[node], points[node] - radius[node]
+    return {(axis, end) for axis in range(2) for end, touches in
+            ((1, reach[0][axis] >= high[axis] - tolerance), (0, reach[1][axis] <= low[axis] + tolerance))
+            if touches}
 
-    def sides(node):
-        reach = points[node] + radius[node], points[node] - radius[node]
-        return {(axis, end) for axis in range(2) for end, touches in
-                ((1, reach[0][axis] >= high[axis] - tolerance), (0, reach[1][axis] <= low[axis] + tolerance))
-                if touches}
 
-    kept_tips = [(chains[i][-1] if chains[i][0] == base else chains[i][0]) for i, base, _ in leaves if i not in spurs]
-    standing = [(sides(tip), tip) for tip in kept_tips]
+def _standing(spurs, pairable, leaves, chains, points, radius, ground, stood):
+    """The ``spurs`` (chain -> (base, tip)) without the ``pairable`` ones that stand on a side of the view's outline
+    (``ground``: its low and high corner and a tolerance), with a node or through spurs already removed from one
+    (``stood``: a leg whose foot's corners went), that a kept leaf stands on too, their tips farther apart than
+    either is wide: legs reach the ground together, however stubby (a foot's toe beside its own leg's foot is no
+    leg)."""
+    def sides(chain, base):
+        nodes = [node for node in chains[chain] if node != base]
+        return set().union(*(_sides(node, points, radius, ground) | stood.get(node, set()) for node in nodes))
+
+    def tip(chain, base):
+        return chains[chain][-1] if chains[chain][0] == base else chains[chain][0]
+
+    standing = [(sides(i, base), tip(i, base)) for i, base, _ in leaves if i not in spurs]
     result = {}
-    for i, (base, tip) in spurs.items():
+    for i, (base, end) in spurs.items():
         width = pairable[i][3] if i in pairable else None
         stands = width is not None and any(
-            sides(tip) & on and np.linalg.norm(points[tip] - points[other]) > max(width, 2 * radius[other])
+            sides(i, base) & on and np.linalg.norm(points[end] - points[other]) > max(width, 2 * radius[other])
             for on, other in standing)
         if not stands:
-            result[i] = base, tip
+            result[i] = base, end
     return result
 
 
