@@ -1,0 +1,356 @@
+"""Bone roles: what each bone of a skeleton is in its body plan (a thigh, the second spine bone, the left index finger's
+first bone), given the plan's layout of the body (``core.bodyplan``). Bones keep their names; roles sit beside them.
+
+Along the spine, from the tail end to the head end: tail (or root, a bone rising from the ground to the hips),
+hips, spine, chest up to where the arms, wings or front legs hang, then neck up to the spine's thinnest joint above
+them and head beyond (a fish: head, spine and tail by length). A leg: hips (the bones that run out from the body
+before it turns down; shoulder for a front leg), thigh, shin, foot (its last bones running flat near the ground, or
+its last bone) and toe (the last of those when there are two or more); a front leg: shoulder, upper_arm, forearm,
+hand. An arm: shoulder, upper_arm, forearm, hand and fingers, the joints nearest the shares of its length where
+artists put a shoulder, an elbow and a wrist (a bend there wins); each branch beyond the hand is a finger, the one
+that leaves earliest and points most away the thumb, the others index, middle, ring and pinky in order across the
+hand. Wings, fins, ears, tails and jaws take their part's role for every bone. A body plan that is ``other`` gives
+every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when a limb's bones have them, else the side of the
+mirror plane, left being the character's left when its front is known (Blender's +X for a character facing -Y).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .stages import Labels, Stage
+from .tuning import TuningTable, tuned
+
+ROLES = ("root", "hips", "spine", "chest", "neck", "head", "jaw", "shoulder", "upper_arm", "forearm", "hand", "finger",
+         "thigh", "shin", "foot", "toe", "tail", "ear", "wing", "fin", "other")
+DIGITS = ("thumb", "index", "middle", "ring", "pinky")
+SIDES = ("L", "R", None)
+
+
+@dataclass(frozen=True)
+class BoneRole:
+    """A bone's ``role`` (one of ``ROLES``), ``side`` ("L", "R" or None), ``index`` (its place among the bones of
+    that role and side along its chain, from the body outwards: spine 0, 1, 2; a finger's segments) and, for a
+    finger, its ``digit`` (one of ``DIGITS``, or None when the hand shows no clear thumb)."""
+
+    role: str
+    side: str = None
+    index: int = 0
+    digit: str = None
+
+    def __post_init__(self):
+        if self.role not in ROLES:
+            raise ValueError(f"unknown bone role {self.role!r}; roles are {', '.join(ROLES)}")
+        if self.side not in SIDES:
+            raise ValueError(f"a bone's side is 'L', 'R' or None, got {self.side!r}")
+        if not isinstance(self.index, int) or isinstance(self.index, bool) or self.index < 0:
+            raise ValueError(f"a bone role's index is a whole number >= 0, got {self.index!r}")
+        if self.digit is not None and (self.role != "finger" or self.digit not in DIGITS):
+            raise ValueError(f"only fingers have a digit ({', '.join(DIGITS)}), got {self.digit!r} on a "
+                             f"{self.role}")
+
+    @property
+    def label(self):
+        """Short text: ``thigh.L``, ``spine.2``, ``finger.index.1.R``."""
+        words = [self.role] + ([self.digit] if self.digit else []) + ([str(self.index)] if self.index else [])
+        return ".".join(words) + (f".{self.side}" if self.side else "")
+
+    def to_dict(self):
+        return {"role": self.role, "side": self.side, "index": self.index, "digit": self.digit}
+
+
+@dataclass(frozen=True)
+class RoleTuning(TuningTable):
+    """The tuned numbers of giving bones their roles."""
+
+    thigh_drop: float = tuned(0.8, "a leg's thigh starts at its first joint from which it runs this steeply down "
+                                   "(cosine of the angle from down); the bones before run out from the body: hips")
+    foot_flat: float = tuned(0.5, "a leg's last bones running flatter than this (cosine of the angle from down) ...")
+    foot_height: float = tuned(0.15, "... and starting this low (a share of the mesh's height) are its foot")
+    bend: float = tuned(25.0, "degrees: a limb joint turning this much near where an elbow or a knee belongs is one")
+    bend_window: float = tuned(0.2, "a bend counts within this share of the limb's length of where the joint belongs")
+    knee_at: float = tuned(0.5, "a knee's share of the way from the hip to the ankle")
+    shoulder_at: float = tuned(0.15, "an arm's shoulder joint: its share of the way from where the arm hangs to its "
+                                     "tip (Mixamo T-poses: 0.13 to 0.18)")
+    elbow_at: float = tuned(0.5, "an elbow's share of the same way (0.45 to 0.52)")
+    wrist_at: float = tuned(0.8, "a wrist's share (0.74 to 0.82)")
+    head_share: float = tuned(0.25, "a fish's head: this share of its spine's length from the head end")
+    tail_share: float = tuned(0.35, "a fish's tail: this share from the tail end")
+    tail_length: float = tuned(0.08, "spine behind the hips this long (a share of the size) is a tail, not hips")
+
+
+def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
+    """One :class:`BoneRole` per bone of ``skeleton`` (see the module docstring), from its ``body``
+    (``core.body.Body``) and ``layout`` (``core.bodyplan.Layout``)."""
+    graph = body.graph
+    segment_bone = {}
+    for a, links in enumerate(graph.neighbours):
+        for b, bone in links:
+            if bone >= 0:
+                segment_bone[(a, b)] = bone
+    roles = [None] * len(skeleton)
+
+    def put(nodes, names, side=None):
+        counts = {}
+        for (a, b), name in zip(zip(nodes, nodes[1:]), names):
+            bone = segment_bone.get((a, b))
+            if bone is None or roles[bone] is not None or name is None:
+                continue
+            role, digit = name if isinstance(name, tuple) else (name, None)
+            key = (role, digit)
+            roles[bone] = BoneRole(role, side, counts.get(key, 0), digit)
+            counts[key] = counts.get(key, 0) + 1
+
+    kind = layout.plan.kind
+    left = _left_sign(body, layout)
+    spine_names = _spine_roles(body, layout, tuning)
+    below = [index for index, name in enumerate(spine_names) if name in ("tail", "root")]
+    spine = list(layout.spine)
+    if below:  # tail and root bones count from the body outwards
+        cut = below[-1] + 1
+        put(spine[:cut + 1][::-1], spine_names[:cut][::-1])
+    put(spine, spine_names)
+    for node, base in body.connectors.items():
+        for other, bone in graph.neighbours[node]:
+            if bone >= 0 and roles[bone] is None:
+                roles[bone] = BoneRole(_connector_role(spine, spine_names, base) if kind != "other" else "other")
+    for k, limb in enumerate(body.limbs):
+        side = _limb_side(skeleton, graph, limb, left)
+        part = layout.parts[k]
+        if part == "leg":
+            _leg(body, limb, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
+        elif part == "arm":
+            _arm(body, limb, tuning, lambda nodes, names: put(nodes, names, side))
+        for nodes in _paths(limb):
+            put(nodes, [part] * (len(nodes) - 1), side)
+    for bone in range(len(skeleton)):
+        if roles[bone] is None:
+            parent = skeleton.parents[bone]
+            roles[bone] = BoneRole("other", roles[parent].side if parent >= 0 and roles[parent] else None) \
+                if kind == "other" or parent < 0 or roles[parent] is None else roles[parent]
+    return tuple(roles)
+
+
+def _paths(limb):
+    """Every path of ``limb`` from where it hangs to one of its leaves, the main one first."""
+    children = {}
+    for node, before in limb.before.items():
+        children.setdefault(before, []).append(node)
+    leaves = [node for node in limb.before if node not in children]
+    paths = [list(limb.main)]
+    for leaf in leaves:
+        if leaf == limb.main[-1]:
+            continue
+        path = [leaf]
+        while path[-1] != limb.attach:
+            path.append(limb.before[path[-1]])
+        paths.append(path[::-1])
+    return paths
+
+
+# The spine.
+
+def _spine_roles(body, layout, tuning):
+    """Roles of the spine's bones, from its tail end to its head end."""
+    spine = list(layout.spine)
+    count = len(spine) - 1
+    if count <= 0:
+        return []
+    kind = layout.plan.kind
+    if kind == "other":
+        return ["other"] * count
+    points = body.graph.points[spine]
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    middle = 0.5 * (arc[1:] + arc[:-1]) / max(arc[-1], 1e-300)
+    if kind == "fish":
+        return ["tail" if at < tuning.tail_share else "head" if at > 1 - tuning.head_share else "spine"
+                for at in middle]
+    hips = max(layout.hips, 0)
+    chest = layout.chest if layout.chest > hips else min(count, hips + max(1, round(0.65 * (count - hips))))
+    names = []
+    behind = arc[hips]
+    if hips > 0:
+        lowest = spine[0]
+        grounded = body.touches(lowest, 0.05) and body.height(points[0]) < body.height(points[hips])
+        name = "root" if grounded else "tail" if behind >= tuning.tail_length * body.size else "hips"
+        names += [name] * hips
+    torso = chest - hips
+    names += (["hips"] + ["spine"] * (torso - 2) + ["chest"]) if torso >= 2 else ["hips"] * torso
+    above = count - chest
+    if above >= 3:
+        thinnest = chest + 1 + int(np.argmin(body.radius[spine[chest + 1:count]]))
+        names += ["neck"] * (thinnest - chest) + ["head"] * (count - thinnest)
+    else:
+        names += ["neck", "head"][-above:] if above else []
+    return names
+
+
+def _connector_role(spine, names, base):
+    """The role of a midline bone off the spine hanging from spine joint ``base``: that of the spine bone leaving
+    it towards the head (or arriving, at the head end)."""
+    if not names:
+        return "other"
+    at = spine.index(base) if base in spine else 0
+    return names[min(at, len(names) - 1)]
+
+
+# Limbs.
+
+def _leg(body, limb, front, tuning, put):
+    """Roles along a leg's main path: hips (or shoulder), thigh, shin, foot, toe (front legs: shoulder, upper_arm,
+    forearm, hand)."""
+    nodes = list(limb.main)
+    points = body.graph.points[nodes]
+    steps = np.diff(points, axis=0)
+    lengths = np.maximum(np.linalg.norm(steps, axis=1), 1e-300)
+    down = -(steps @ body.up) / lengths
+    last = len(nodes) - 1
+    thigh = next((i for i in range(last) if down[i] >= tuning.thigh_drop), 0)
+    ankle = last
+    while ankle - 1 > thigh and down[ankle - 1] < tuning.foot_flat \
+            and body.height(points[ankle - 1]) <= tuning.foot_height:
+        ankle -= 1
+    if ankle == last and last - thigh >= 3:
+        ankle = last - 1
+    toe = last - 1 if last - ankle >= 2 else last
+    knee = _pick(points, thigh, ankle, tuning.knee_at, tuning) if ankle - thigh >= 2 else ankle
+    names = (["shoulder", "upper_arm", "forearm", "hand", "hand"] if front else
+             ["hips", "thigh", "shin", "foot", "toe"])
+    cuts = [thigh, knee, ankle, toe, last]
+    roles, start = [], 0
+    for name, end in zip(names, cuts):
+        roles += [name] * (end - start)
+        start = max(start, end)
+    put(nodes, roles)
+    for path in _paths(limb)[1:]:  # toes and spurs: a branch past the ankle is a toe
+        split = next(i for i, node in enumerate(path) if i + 1 >= len(path) or path[i + 1] not in nodes)
+        at = nodes.index(path[split])
+        put(path[split:], ["toe" if at >= ankle else roles[min(at, len(roles) - 1)] if roles else "other"]
+            * (len(path) - 1 - split))
+
+
+def _arm(body, limb, tuning, put):
+    """Roles along an arm: shoulder, upper_arm, forearm, hand, and the fingers beyond the hand."""
+    nodes = list(limb.main)
+    points = body.graph.points[nodes]
+    last = len(nodes) - 1
+    branches = [path for path in _paths(limb)[1:]]
+    forks = sorted({_fork(path, nodes) for path in branches})
+    reach = forks[0] if forks else last
+    if last >= 4:
+        elbow = _pick(points, 2, max(2, min(reach, last) - 1), tuning.elbow_at, tuning)
+        shoulder = _pick(points, 1, elbow - 1, tuning.shoulder_at, tuning)
+        wrist = _pick(points, elbow + 1, max(elbow + 1, min(reach, last - 1)), tuning.wrist_at, tuning)
+    elif last == 3:
+        shoulder, elbow, wrist = 0, 1, 2
+    else:
+        shoulder, elbow, wrist = 0, min(1, last), last
+    fingers_from = forks[0] if forks else last
+    fingers_from = max(fingers_from, wrist)
+    roles = (["shoulder"] * shoulder + ["upper_arm"] * (elbow - shoulder) + ["forearm"] * (wrist - elbow)
+             + ["hand"] * (fingers_from - wrist))
+    put(nodes[:fingers_from + 1], roles)
+    if fingers_from >= last and not branches:
+        return
+    fingers = [nodes[fingers_from:]] if fingers_from < last else []
+    fingers += [path[_fork(path, nodes):] for path in branches]
+    for finger, digit in zip(fingers, _digits(body, fingers, points[wrist], points[min(fingers_from, last)])):
+        put(finger, [("finger", digit)] * (len(finger) - 1))
+
+
+def _fork(path, nodes):
+    """Where ``path`` leaves the main path ``nodes`` (its index in both)."""
+    return next(i for i, node in enumerate(path) if i + 1 >= len(path) or path[i + 1] not in nodes)
+
+
+def _digits(body, fingers, wrist, palm):
+    """Digit names for the finger paths: with three or more, the one leaving the hand earliest and pointing most
+    away from it is the thumb, the others index, middle, ring, pinky by their tips' distance from the thumb's;
+    otherwise none."""
+    if len(fingers) < 3:
+        return [None] * len(fingers)
+    points = body.graph.points
+    hand = palm - wrist
+    hand = hand / np.linalg.norm(hand) if np.linalg.norm(hand) > 0 else hand
+
+    def away(finger):
+        direction = points[finger[-1]] - points[finger[0]]
+        norm = np.linalg.norm(direction)
+        start = np.linalg.norm(points[finger[0]] - wrist)
+        return (1 - (direction @ hand) / norm if norm > 0 else 0) - start / max(np.linalg.norm(palm - wrist), 1e-300)
+
+    thumb = max(range(len(fingers)), key=lambda k: away(fingers[k]))
+    order = sorted((k for k in range(len(fingers)) if k != thumb),
+                   key=lambda k: np.linalg.norm(points[fingers[k][-1]] - points[fingers[thumb][-1]]))
+    names = [None] * len(fingers)
+    names[thumb] = "thumb"
+    for name, k in zip(DIGITS[1:], order):
+        names[k] = name
+    return names
+
+
+def _pick(points, low, high, share, tuning):
+    """Index of the joint in [low, high] for a joint at ``share`` of the way from ``points[low]`` to
+    ``points[high]``... of the whole path's length: the sharpest bend within ``bend_window`` of it when one turns by
+    ``bend`` or more, else the nearest."""
+    low, high = int(low), int(max(low, high))
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    at = arc / max(arc[-1], 1e-300)
+    candidates = np.arange(low, high + 1)
+    turns = np.array([_turn(points, i) for i in candidates])
+    near = np.abs(at[candidates] - share) <= tuning.bend_window
+    bent = near & (turns >= tuning.bend)
+    if bent.any():
+        return int(candidates[bent][np.argmax(turns[bent])])
+    return int(candidates[np.argmin(np.abs(at[candidates] - share))])
+
+
+def _turn(points, i):
+    """Degrees the path turns at joint ``i`` (0 at its ends)."""
+    if i <= 0 or i >= len(points) - 1:
+        return 0.0
+    a, b = points[i] - points[i - 1], points[i + 1] - points[i]
+    norms = np.linalg.norm(a) * np.linalg.norm(b)
+    return float(np.degrees(np.arccos(np.clip(a @ b / norms, -1, 1)))) if norms > 0 else 0.0
+
+
+# Sides.
+
+def _left_sign(body, layout):
+    """+1 when the mirror plane's positive side is the character's left, -1 when it is its right: up x forward
+    (the character's left) when its front is known, else +1 (Blender's +X left for a character facing -Y)."""
+    if body.plane is None or layout.forward is None or layout.plan.kind not in ("quadruped", "bird", "fish"):
+        return 1
+    return 1 if np.cross(body.up, layout.forward) @ body.plane.normal >= 0 else -1
+
+
+def _limb_side(skeleton, graph, limb, left):
+    """"L", "R" or None: from the limb's bone names when they all end in one of .L / .R, else its side of the plane."""
+    suffixes = {skeleton.names[bone][-2:] for node, before in limb.before.items()
+                for bone in [graph.bone_between(node, before)] if bone >= 0}
+    if suffixes in ({".L"}, {".R"}):
+        return suffixes.pop()[1]
+    if limb.side == 0:
+        return None
+    return "L" if limb.side * left > 0 else "R"
+
+
+@dataclass(frozen=True, eq=False)
+class Roles(Stage):
+    """Each bone's role as a label at its middle: ``points`` (B, 3) and ``texts`` (B,)."""
+
+    points: np.ndarray
+    texts: tuple
+
+    label = "Bone Roles"
+    colour = (1.0, 0.55, 0.1)
+
+    def __post_init__(self):
+        self.drawing()  # Labels checks the arrays
+
+    @classmethod
+    def of(cls, skeleton, roles):
+        """The stage labelling ``skeleton``'s bones with ``roles``."""
+        return cls(0.5 * (skeleton.heads + skeleton.tails), tuple(role.label for role in roles))
+
+    def drawing(self):
+        return Labels(np.asarray(self.points, dtype=np.float64), tuple(self.texts)) if len(self.texts) else None
