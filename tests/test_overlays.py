@@ -18,7 +18,8 @@ from rigger.core.registry import discover  # noqa: E402
 from rigger.core.stages import (ISOLATED, JUNCTION, SLEEVE, TERMINAL, AxisGraph, Frame, MirrorPlane,  # noqa: E402
                                 Stage, Triangulation)
 
-KINDS = ["silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints"]  # the silhouette method's drawn stages
+KINDS = ["silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints", "roles"]  # the drawn stages (roles:
+# rig_mesh's bone roles)
 LINE_KINDS = ("silhouette", "axis", "merged", "pruned", "chains")
 TEST_METHODS = pathlib.Path(__file__).parent / "methods"
 ICO_VERTICES = 42  # an ico sphere of SPHERE_SUBDIVISIONS = 2
@@ -218,13 +219,13 @@ def test_rebuilding_replaces_the_owners_objects_and_shares_groups_and_materials(
 
     overlays.build_overlays(stages, "Other")
     twice = data_counts()
-    assert twice["objects"] == once["objects"] + len(KINDS)
+    assert twice["objects"] == once["objects"] + len(KINDS) + len(stages["roles"].texts)  # a text per role label
     assert twice["meshes"] == once["meshes"] + len(KINDS)
     assert {key: twice[key] for key in ("node_groups", "materials", "collections")} == \
         {key: once[key] for key in ("node_groups", "materials", "collections")}
 
     without_joints = {key: value for key, value in stages.items() if key != "joints"}
-    assert list(overlays.build_overlays(without_joints, "Body")) == KINDS[:-1]
+    assert list(overlays.build_overlays(without_joints, "Body")) == [kind for kind in KINDS if kind != "joints"]
     assert "Rigger joints: Body" not in bpy.data.objects and "Rigger joints: Other" in bpy.data.objects
 
 
@@ -295,7 +296,7 @@ def test_what_is_not_a_stage_or_fails_to_draw_is_skipped_with_a_warning(humanoid
     assert sorted(str(warning.message) for warning in record) == [
         "Rigger overlay 'broken' skipped: drawing its Broken failed: KeyError: 'points'",
         "Rigger overlay 'raw' skipped: a ndarray, not a rigger.core.stages.Stage",
-        "Rigger overlay 'sketchy' skipped: its drawing is a ndarray, not Lines, Points or ClassedFaces"]
+        "Rigger overlay 'sketchy' skipped: its drawing is a ndarray, not Lines, Points, ClassedFaces or Labels"]
 
 
 def test_a_test_only_package_method_s_own_stage_type_gets_its_overlay():
@@ -307,7 +308,7 @@ def test_a_test_only_package_method_s_own_stage_type_gets_its_overlay():
     vertices, triangles = samples.character_arrays("snake", subdivisions=0)
     skeleton = rigger.rig_mesh(vertices, triangles, method=method, slabs=5)
     objects = overlays.build_overlays(skeleton.stages, "Snake", scale=0.01)
-    assert list(objects) == ["rings", "centres"]
+    assert list(objects) == ["rings", "centres", "roles"]
     rings = skeleton.stages["rings"]
     drawn, materials = evaluated(objects["rings"])
     assert set(materials) == {"Rigger rings"}
