@@ -30,7 +30,9 @@ AXES = np.eye(3)
 class BodyTuning(TuningTable):
     """The tuned numbers of reading a body (shares of the mesh size unless said otherwise)."""
 
-    joint_merge: float = tuned(1e-3, "bone ends this close are one joint (exporters round positions)")
+    joint_merge: float = tuned(0.01, "a bone shorter than this is one joint: exporters repeat joints a hair apart "
+                                     "(RigNet's _dup joints up to 0.0099 off), real bones are longer (Mixamo's "
+                                     "finger bones 0.013)")
     plane_fit: float = tuned(0.08, "when the plane is fitted to the skeleton, twin joints mirror within this (a "
                                    "posed or hand-made figure is not symmetric within 1%)")
     plane_pairs: int = tuned(4, "a plane fitted to the skeleton pairs at least this many joints (two twin limbs of "
@@ -116,33 +118,61 @@ class JointGraph:
 
 
 def joint_graph(skeleton, tolerance):
-    """The :class:`JointGraph` of ``skeleton``; bone ends within ``tolerance`` are one joint."""
+    """The :class:`JointGraph` of ``skeleton``. A bone's head is its parent's tail (or head), and the head of a
+    sibling (or of another root), when they lie within ``tolerance`` / 100 (exporters round); the two ends of a bone
+    shorter than ``tolerance`` are one joint."""
     count = len(skeleton)
-    ends = np.concatenate([skeleton.heads, skeleton.tails])
-    node_of, points = _clusters(ends, tolerance)
+    heads, tails, parents = skeleton.heads, skeleton.tails, skeleton.parents
+    same = tolerance / 100
+    left, right = [], []
+    for bone, parent in enumerate(parents.tolist()):
+        if np.linalg.norm(tails[bone] - heads[bone]) < tolerance:
+            left.append(bone), right.append(count + bone)
+        if parent >= 0 and np.linalg.norm(heads[bone] - tails[parent]) <= same:
+            left.append(bone), right.append(count + parent)
+        elif parent >= 0 and np.linalg.norm(heads[bone] - heads[parent]) <= same:
+            left.append(bone), right.append(parent)  # a branch from the parent's head
+    for group in _sibling_groups(parents):
+        for bone in group[1:]:
+            if np.linalg.norm(heads[bone] - heads[group[0]]) <= same:
+                left.append(bone), right.append(group[0])
+    _, node_of = np.unique(_joined(np.arange(2 * count), np.array(left, dtype=np.int64),
+                                   np.array(right, dtype=np.int64)), return_inverse=True)
+    node_of = node_of.reshape(-1)
+    points = np.zeros((node_of.max() + 1, 3))
+    points[node_of] = np.concatenate([heads, tails])  # a collapsed bone's joint sits at one of its ends
     head_node, tail_node = node_of[:count], node_of[count:]
     links = [(int(head_node[b]), int(tail_node[b]), b) for b in range(count) if head_node[b] != tail_node[b]]
-    for bone, parent in enumerate(skeleton.parents.tolist()):
+    for bone, parent in enumerate(parents.tolist()):
         if parent >= 0 and tail_node[parent] != head_node[bone] and head_node[parent] != head_node[bone]:
             links.append((int(tail_node[parent]), int(head_node[bone]), -1))
     neighbours = _spanning_tree(points, links)
     return JointGraph(points, neighbours, head_node, tail_node)
 
 
-def _clusters(points, tolerance):
-    """Each point's cluster (points within ``tolerance`` of a cluster's first point join it) and the clusters'
-    first points."""
-    firsts, node_of = [], np.empty(len(points), dtype=np.int64)
-    for index, point in enumerate(points):
-        if firsts:
-            gaps = np.linalg.norm(np.array(firsts) - point, axis=1)
-            nearest = int(np.argmin(gaps))
-            if gaps[nearest] <= tolerance:
-                node_of[index] = nearest
-                continue
-        node_of[index] = len(firsts)
-        firsts.append(point)
-    return node_of, np.array(firsts)
+def _sibling_groups(parents):
+    """Bones grouped by parent (roots together)."""
+    groups = {}
+    for bone, parent in enumerate(parents.tolist()):
+        groups.setdefault(parent, []).append(bone)
+    return list(groups.values())
+
+
+def _joined(labels, left, right):
+    """``labels`` with each pair ``left[k]``, ``right[k]`` made one (the smaller label), transitively."""
+    parent = np.arange(labels.max() + 1)
+    if not len(left):
+        return labels
+
+    def root(label):
+        while parent[label] != label:
+            label = parent[label]
+        return label
+
+    for a, b in zip(left.tolist(), right.tolist()):
+        a, b = root(a), root(b)
+        parent[max(a, b)] = min(a, b)
+    return np.array([root(label) for label in labels.tolist()])
 
 
 def _spanning_tree(points, links):
@@ -230,7 +260,7 @@ class Limb:
 @dataclass(frozen=True)
 class Body:
     """A skeleton read as a body: its ``graph``, the mesh ``size`` (largest extent) and the mesh's ``low`` and
-    ``high`` extent along ``up``, the mirror ``plane`` (or None), the ``spine`` (joints along the midline's longest
+    ``high`` extent along ``up``, the mirror ``plane`` (or None), a sample of the mesh's ``vertices``, the ``spine`` (joints along the midline's longest
     path), the ``limbs`` with the spine joint each hangs from (``bases``; through ``connectors``, midline joints off
     the spine, each with the spine joint it leaves), the ``radius`` (local half-thickness of the mesh) at each joint, each limb's ``flatness``
     (the mesh around it: thin across over wide across, 1 for a round limb, near 0 for a wing or a fin; 1 on a flat
@@ -242,6 +272,7 @@ class Body:
     low: float
     high: float
     plane: Plane
+    vertices: np.ndarray
     spine: tuple
     limbs: tuple
     bases: tuple
@@ -286,7 +317,7 @@ def read_body(skeleton, mesh, tuning=BodyTuning(), plane=None, prefer_up=AXES[2]
     segments, nearest = _nearest_links(graph, vertices)
     flatness = tuple(1.0 for _ in limbs) if mesh.flat_normal is not None else tuple(_flatness(limb, graph, vertices, segments, nearest, (tuning.blade_from, tuning.blade_to))
                      for limb in limbs)
-    return Body(graph, size, up, float(heights.min()), float(heights.max()), found, tuple(spine), tuple(limbs),
+    return Body(graph, size, up, float(heights.min()), float(heights.max()), found, vertices, tuple(spine), tuple(limbs),
                 bases, connectors, radius, flatness, up_evidence, up_note)
 
 

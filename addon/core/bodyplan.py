@@ -8,7 +8,7 @@ The rules, in order (``Body`` gives the up axis, the mirror plane, the spine and
 - more than four legs, or legs standing in more than two rows along the body, make no known plan (``other``), nor
   do three or more pairs of long limbs (an octopus);
 - legs in two rows, front and back (``front_back`` apart), make a quadruped;
-- legs in one row (two, or one on a body with a mirror plane: its twin hidden) make a biped: a humanoid when its
+- two legs in one row, hanging from ``biped_lift`` or higher, make a biped: a humanoid when its
   torso, from the hips to the spine's upper end, leans less than ``upright`` from up, or leans more but has round
   arms (a hunched monster); a bird when it leans forward with flat wings (``wing_flat``) or no arms;
 - without legs: one pair of long limbs on a small body is a bird in flight (wings); an upright body with long limbs
@@ -141,8 +141,8 @@ def lay_out(body, tuning=BodyPlanTuning()):
     forward = _forward_axis(body, legs)
     rows = _rows(body, legs, forward, tuning)
     if len(rows) == 1 and (min(body.height(body.graph.points[body.limbs[k].attach]) for k in legs) < tuning.biped_lift
-                           or (len(legs) < 2 and body.plane is None)):
-        legs, rows = [], []  # fins or stubs, or one branch of a body without sides: not legs it stands on
+                           or len(legs) < 2):
+        legs, rows = [], []  # fins, stubs or a lone leg: not legs a biped stands on
     long_pairs = _long_pairs(body, lengths, legs, tuning)
     spine_points = body.graph.points[list(body.spine)]
     spine_length = _length(spine_points)

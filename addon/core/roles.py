@@ -116,18 +116,49 @@ def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
     for k, limb in enumerate(body.limbs):
         side = _limb_side(skeleton, graph, limb, left)
         part = layout.parts[k]
+        points = _twin_points(body, limb)
         if part == "leg":
-            _leg(body, limb, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
+            _leg(body, limb, points, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
         elif part == "arm":
-            _arm(body, limb, tuning, lambda nodes, names: put(nodes, names, side))
+            _arm(body, limb, points, tuning, lambda nodes, names: put(nodes, names, side))
         for nodes in _paths(limb):
             put(nodes, [part] * (len(nodes) - 1), side)
-    for bone in range(len(skeleton)):
-        if roles[bone] is None:
-            parent = skeleton.parents[bone]
-            roles[bone] = BoneRole("other", roles[parent].side if parent >= 0 and roles[parent] else None) \
-                if kind == "other" or parent < 0 or roles[parent] is None else roles[parent]
+    return _filled(roles, skeleton, kind)
+
+
+def _filled(roles, skeleton, kind):
+    """``roles`` with the bones the body left out (a bone shorter than a joint, a link closing a loop) given the
+    role of the first child bone that has one (a collapsed bone sits at its start), else their parent's, else
+    ``other``."""
+    parents = skeleton.parents.tolist()
+    children = {}
+    for bone, parent in enumerate(parents):
+        children.setdefault(parent, []).append(bone)
+    roles = list(roles)
+    for _ in range(len(roles)):
+        missing = [bone for bone, role in enumerate(roles) if role is None]
+        if not missing:
+            break
+        for bone in missing:
+            given = [roles[child] for child in children.get(bone, ()) if roles[child] is not None]
+            if given:
+                roles[bone] = given[0]
+    for bone, role in enumerate(roles):
+        if role is None:
+            parent = parents[bone]
+            roles[bone] = roles[parent] if kind != "other" and parent >= 0 and roles[parent] is not None \
+                else BoneRole("other")
     return tuple(roles)
+
+
+def _twin_points(body, limb):
+    """The joints along ``limb``'s main path, averaged with its twin's mirror image when both have as many: twins
+    get their roles cut at the same joints."""
+    points = body.graph.points[list(limb.main)]
+    twin = body.limbs[limb.twin] if limb.twin >= 0 else None
+    if twin is not None and len(twin.main) == len(limb.main) and body.plane is not None:
+        points = 0.5 * (points + body.plane.reflect(body.graph.points[list(twin.main)]))
+    return points
 
 
 def _paths(limb):
@@ -195,11 +226,10 @@ def _connector_role(spine, names, base):
 
 # Limbs.
 
-def _leg(body, limb, front, tuning, put):
-    """Roles along a leg's main path: hips (or shoulder), thigh, shin, foot, toe (front legs: shoulder, upper_arm,
-    forearm, hand)."""
+def _leg(body, limb, points, front, tuning, put):
+    """Roles along a leg's main path (``points``): hips (or shoulder), thigh, shin, foot, toe (front legs: shoulder,
+    upper_arm, forearm, hand)."""
     nodes = list(limb.main)
-    points = body.graph.points[nodes]
     steps = np.diff(points, axis=0)
     lengths = np.maximum(np.linalg.norm(steps, axis=1), 1e-300)
     down = -(steps @ body.up) / lengths
@@ -212,42 +242,47 @@ def _leg(body, limb, front, tuning, put):
     if ankle == last and last - thigh >= 3:
         ankle = last - 1
     toe = last - 1 if last - ankle >= 2 else last
-    knee = _pick(points, thigh, ankle, tuning.knee_at, tuning) if ankle - thigh >= 2 else ankle
+    knee = _pick(points, thigh + 1, ankle - 1, tuning.knee_at, tuning, thigh, ankle) if ankle - thigh >= 2 \
+        else ankle
     names = (["shoulder", "upper_arm", "forearm", "hand", "hand"] if front else
              ["hips", "thigh", "shin", "foot", "toe"])
-    cuts = [thigh, knee, ankle, toe, last]
+    roles = _segments(names, [thigh, knee, ankle, toe, last])
+    put(nodes, roles)
+    for path in _paths(limb)[1:]:  # toes and spurs: a branch past the ankle is a toe
+        split = _fork(path, nodes)
+        put(path[split:], ["toe" if split >= ankle else roles[min(split, len(roles) - 1)] if roles else "other"]
+            * (len(path) - 1 - split))
+
+
+def _segments(names, cuts):
+    """Role per bone: ``names[k]`` for the bones before joint ``cuts[k]`` (and after the cut before it)."""
     roles, start = [], 0
     for name, end in zip(names, cuts):
         roles += [name] * (end - start)
         start = max(start, end)
-    put(nodes, roles)
-    for path in _paths(limb)[1:]:  # toes and spurs: a branch past the ankle is a toe
-        split = next(i for i, node in enumerate(path) if i + 1 >= len(path) or path[i + 1] not in nodes)
-        at = nodes.index(path[split])
-        put(path[split:], ["toe" if at >= ankle else roles[min(at, len(roles) - 1)] if roles else "other"]
-            * (len(path) - 1 - split))
+    return roles
 
 
-def _arm(body, limb, tuning, put):
-    """Roles along an arm: shoulder, upper_arm, forearm, hand, and the fingers beyond the hand."""
+def _arm(body, limb, points, tuning, put):
+    """Roles along an arm: shoulder, upper_arm, forearm and hand by where each bone's middle lies along the arm
+    (shares ``shoulder_at``, ``elbow_at``, ``wrist_at`` of the way from where it hangs to its reach, the mesh beyond
+    its last joint included: an artist's arm may end at the wrist), the elbow at a bend near its share; the fingers
+    beyond the hand."""
     nodes = list(limb.main)
-    points = body.graph.points[nodes]
     last = len(nodes) - 1
-    branches = [path for path in _paths(limb)[1:]]
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    total = arc[-1] + _reach(body, points)
+    middle = 0.5 * (arc[1:] + arc[:-1]) / max(total, 1e-300)
+    shoulder, elbow, wrist = (int(np.searchsorted(middle, share)) for share in
+                              (tuning.shoulder_at, tuning.elbow_at, tuning.wrist_at))
+    bent = _pick(points, shoulder + 1, wrist - 1, tuning.elbow_at, tuning, 0, last, total, bends_only=True)
+    elbow = elbow if bent is None else bent
+    branches = _paths(limb)[1:]
     forks = sorted({_fork(path, nodes) for path in branches})
-    reach = forks[0] if forks else last
-    if last >= 4:
-        elbow = _pick(points, 2, max(2, min(reach, last) - 1), tuning.elbow_at, tuning)
-        shoulder = _pick(points, 1, elbow - 1, tuning.shoulder_at, tuning)
-        wrist = _pick(points, elbow + 1, max(elbow + 1, min(reach, last - 1)), tuning.wrist_at, tuning)
-    elif last == 3:
-        shoulder, elbow, wrist = 0, 1, 2
-    else:
-        shoulder, elbow, wrist = 0, min(1, last), last
     fingers_from = forks[0] if forks else last
+    wrist = min(wrist, fingers_from) if fingers_from > elbow else wrist
     fingers_from = max(fingers_from, wrist)
-    roles = (["shoulder"] * shoulder + ["upper_arm"] * (elbow - shoulder) + ["forearm"] * (wrist - elbow)
-             + ["hand"] * (fingers_from - wrist))
+    roles = _segments(["shoulder", "upper_arm", "forearm", "hand"], [shoulder, elbow, wrist, fingers_from])
     put(nodes[:fingers_from + 1], roles)
     if fingers_from >= last and not branches:
         return
@@ -255,6 +290,22 @@ def _arm(body, limb, tuning, put):
     fingers += [path[_fork(path, nodes):] for path in branches]
     for finger, digit in zip(fingers, _digits(body, fingers, points[wrist], points[min(fingers_from, last)])):
         put(finger, [("finger", digit)] * (len(finger) - 1))
+
+
+def _reach(body, points):
+    """How far the mesh goes on beyond the last of ``points``, along the last bone's direction (within a tube of
+    the radius there)."""
+    direction = points[-1] - points[-2]
+    norm = np.linalg.norm(direction)
+    if not norm > 0:
+        return 0.0
+    direction /= norm
+    offsets = body.vertices - points[-1]
+    along = offsets @ direction
+    across = np.linalg.norm(offsets - np.outer(along, direction), axis=1)
+    tube = max(2 * float(np.min(np.linalg.norm(body.vertices - points[-1], axis=1))), 0.02 * body.size)
+    beyond = along[(along > 0) & (across <= tube) & (along <= 0.25 * body.size)]
+    return float(beyond.max()) if len(beyond) else 0.0
 
 
 def _fork(path, nodes):
@@ -288,20 +339,23 @@ def _digits(body, fingers, wrist, palm):
     return names
 
 
-def _pick(points, low, high, share, tuning):
-    """Index of the joint in [low, high] for a joint at ``share`` of the way from ``points[low]`` to
-    ``points[high]``... of the whole path's length: the sharpest bend within ``bend_window`` of it when one turns by
-    ``bend`` or more, else the nearest."""
-    low, high = int(low), int(max(low, high))
+def _pick(points, low, high, share, tuning, start=0, end=None, total=None, bends_only=False):
+    """The joint in [low, high] for a joint at ``share`` of the way (by length) from joint ``start`` to joint ``end``
+    (or to ``total`` past ``start``): the sharpest bend within ``bend_window`` of it when one turns by ``bend`` or
+    more, else the nearest (None with ``bends_only``)."""
+    end = len(points) - 1 if end is None else end
     arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
-    at = arc / max(arc[-1], 1e-300)
-    candidates = np.arange(low, high + 1)
+    span = (arc[end] - arc[start]) if total is None else total
+    at = (arc - arc[start]) / max(span, 1e-300)
+    candidates = np.arange(int(low), int(max(low, high)) + 1)
+    candidates = candidates[(candidates > 0) & (candidates < len(points))]
+    if not len(candidates):
+        return None if bends_only else int(low)
     turns = np.array([_turn(points, i) for i in candidates])
-    near = np.abs(at[candidates] - share) <= tuning.bend_window
-    bent = near & (turns >= tuning.bend)
+    bent = (np.abs(at[candidates] - share) <= tuning.bend_window) & (turns >= tuning.bend)
     if bent.any():
         return int(candidates[bent][np.argmax(turns[bent])])
-    return int(candidates[np.argmin(np.abs(at[candidates] - share))])
+    return None if bends_only else int(candidates[np.argmin(np.abs(at[candidates] - share))])
 
 
 def _turn(points, i):
