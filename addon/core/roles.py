@@ -3,9 +3,9 @@ first bone), given the plan's layout of the body (``core.bodyplan``). Bones keep
 
 Along the spine, from the tail end to the head end: tail (or root, a bone rising from the ground to the hips),
 hips, spine, chest up to where the arms, wings or front legs hang, then neck up to the spine's thinnest joint above
-them and head beyond (a fish: head, spine and tail by length). A leg: hips (the bones that run out from the body
-before it turns down; shoulder for a front leg), thigh, shin, foot (its last bones running flat near the ground, or
-its last bone) and toe (the last of those when there are two or more); a front leg: shoulder, upper_arm, forearm,
+them and head beyond (a fish: head, spine and tail by length). A leg: hips (the bones that run out from the body, from
+the mirror plane until it turns down; shoulder for a front leg), thigh, shin, foot (from its joint nearest an ankle's height) and toe
+(the last of those when there are two or more); a front leg: shoulder, upper_arm, forearm,
 hand. An arm: shoulder, upper_arm, forearm, hand and fingers, the joints nearest the shares of its length where
 artists put a shoulder, an elbow and a wrist (a bend there wins); each branch beyond the hand is a finger, the one
 that leaves earliest and points most away the thumb, the others index, middle, ring and pinky in order across the
@@ -62,17 +62,23 @@ class BoneRole:
 class RoleTuning(TuningTable):
     """The tuned numbers of giving bones their roles."""
 
-    thigh_drop: float = tuned(0.8, "a leg's thigh starts at its first joint from which it runs this steeply down "
-                                   "(cosine of the angle from down); the bones before run out from the body: hips")
-    foot_flat: float = tuned(0.5, "a leg's last bones running flatter than this (cosine of the angle from down) ...")
-    foot_height: float = tuned(0.15, "... and starting this low (a share of the mesh's height) are its foot")
+    thigh_drop: float = tuned(0.8, "a leg's thigh starts at its first joint off the mirror plane from which it runs "
+                                   "this steeply down (cosine of the angle from down); the bones before run out from "
+                                   "the body: hips")
+    plane_exit: float = tuned(0.01, "a leg leaves the mirror plane at its first joint this far off it (legs close "
+                                    "together stand 0.035 off it)")
+    ankle_height: float = tuned(0.065, "a leg's ankle is its joint nearest this height (a share of the mesh's; the "
+                                       "artists' humanoids: 0.036 to 0.08, median 0.064)")
+    foot_height: float = tuned(0.15, "... among its joints this low or lower")
     bend: float = tuned(25.0, "degrees: a limb joint turning this much near where an elbow or a knee belongs is one")
     bend_window: float = tuned(0.2, "a bend counts within this share of the limb's length of where the joint belongs")
-    knee_at: float = tuned(0.5, "a knee's share of the way from the hip to the ankle")
-    shoulder_at: float = tuned(0.15, "an arm's shoulder joint: its share of the way from where the arm hangs to its "
-                                     "tip (Mixamo T-poses: 0.13 to 0.18)")
-    elbow_at: float = tuned(0.5, "an elbow's share of the same way (0.45 to 0.52)")
-    wrist_at: float = tuned(0.8, "a wrist's share (0.74 to 0.82)")
+    knee_at: float = tuned(0.47, "a knee's share of the way from the hip to the ankle (the artists' humanoids: 0.38 "
+                                 "to 0.49, median 0.47)")
+    shoulder_at: float = tuned(0.22, "an arm's shoulder joint: its share of the way from where the arm hangs to the "
+                                     "end of its hand (the artists' humanoids: 0.18 to 0.31, median 0.23)")
+    elbow_at: float = tuned(0.39, "an elbow's share of the way from the shoulder joint to the end of the hand (the "
+                                  "artists' humanoids: 0.37 to 0.42)")
+    wrist_at: float = tuned(0.73, "a wrist's share of that way (0.65 to 0.79, median 0.74)")
     head_share: float = tuned(0.25, "a fish's head: this share of its spine's length from the head end")
     tail_share: float = tuned(0.35, "a fish's tail: this share from the tail end")
     tail_length: float = tuned(0.08, "spine behind the hips this long (a share of the size) is a tail, not hips")
@@ -205,7 +211,7 @@ def _spine_roles(body, layout, tuning):
         name = "root" if grounded else "tail" if behind >= tuning.tail_length * body.size else "hips"
         names += [name] * hips
     torso = chest - hips
-    names += (["hips"] + ["spine"] * (torso - 2) + ["chest"]) if torso >= 2 else ["hips"] * torso
+    names += (["hips"] + ["spine"] * (torso - 2) + ["chest"]) if torso >= 3 else ["hips", "spine"][:torso]
     above = count - chest
     if above >= 3:
         thinnest = chest + 1 + int(np.argmin(body.radius[spine[chest + 1:count]]))
@@ -234,13 +240,12 @@ def _leg(body, limb, points, front, tuning, put):
     lengths = np.maximum(np.linalg.norm(steps, axis=1), 1e-300)
     down = -(steps @ body.up) / lengths
     last = len(nodes) - 1
-    thigh = next((i for i in range(last) if down[i] >= tuning.thigh_drop), 0)
-    ankle = last
-    while ankle - 1 > thigh and down[ankle - 1] < tuning.foot_flat \
-            and body.height(points[ankle - 1]) <= tuning.foot_height:
-        ankle -= 1
-    if ankle == last and last - thigh >= 3:
-        ankle = last - 1
+    off = 0 if body.plane is None else next(
+        (i for i in range(last + 1) if abs(body.plane.distance(points[i])) > tuning.plane_exit * body.size), last)
+    thigh = next((i for i in range(off, last) if down[i] >= tuning.thigh_drop), off if off < last else 0)
+    heights = body.height(points)
+    low = [i for i in range(thigh + 2, last + 1) if heights[i] <= tuning.foot_height]
+    ankle = min(low, key=lambda i: abs(heights[i] - tuning.ankle_height)) if low else last
     toe = last - 1 if last - ankle >= 2 else last
     knee = _pick(points, thigh + 1, ankle - 1, tuning.knee_at, tuning, thigh, ankle) if ankle - thigh >= 2 \
         else ankle
@@ -264,18 +269,21 @@ def _segments(names, cuts):
 
 
 def _arm(body, limb, points, tuning, put):
-    """Roles along an arm: shoulder, upper_arm, forearm and hand by where each bone's middle lies along the arm
-    (shares ``shoulder_at``, ``elbow_at``, ``wrist_at`` of the way from where it hangs to its reach, the mesh beyond
-    its last joint included: an artist's arm may end at the wrist), the elbow at a bend near its share; the fingers
-    beyond the hand."""
+    """Roles along an arm by where each bone's middle lies: shoulder up to ``shoulder_at`` of the way from where it
+    hangs to the end of its reach (the mesh beyond its last joint included: an artist's arm may end at the wrist),
+    then upper_arm, forearm and hand at ``elbow_at`` and ``wrist_at`` of the way from that shoulder joint on, the
+    elbow at a bend near its share; the fingers beyond the hand."""
     nodes = list(limb.main)
     last = len(nodes) - 1
     arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
     total = arc[-1] + _reach(body, points)
-    middle = 0.5 * (arc[1:] + arc[:-1]) / max(total, 1e-300)
-    shoulder, elbow, wrist = (int(np.searchsorted(middle, share)) for share in
-                              (tuning.shoulder_at, tuning.elbow_at, tuning.wrist_at))
-    bent = _pick(points, shoulder + 1, wrist - 1, tuning.elbow_at, tuning, 0, last, total, bends_only=True)
+    middle = 0.5 * (arc[1:] + arc[:-1])
+    shoulder = int(np.searchsorted(middle, tuning.shoulder_at * total))
+    rest = total - arc[min(shoulder, last)]  # from the shoulder joint on
+    elbow, wrist = (int(np.searchsorted(middle, arc[min(shoulder, last)] + share * rest))
+                    for share in (tuning.elbow_at, tuning.wrist_at))
+    bent = _pick(points, shoulder + 1, wrist - 1, tuning.elbow_at, tuning, min(shoulder, last), last, rest,
+                 bends_only=True)
     elbow = elbow if bent is None else bent
     branches = _paths(limb)[1:]
     forks = sorted({_fork(path, nodes) for path in branches})
@@ -386,6 +394,42 @@ def _limb_side(skeleton, graph, limb, left):
     if limb.side == 0:
         return None
     return "L" if limb.side * left > 0 else "R"
+
+
+CHAINS = (("hips", "spine", "chest", "neck", "head"), ("shoulder", "upper_arm", "forearm", "hand"),
+          ("hips", "thigh", "shin", "foot", "toe"))  # roles that follow each other along a chain
+
+
+def named_joints(skeleton, roles=None):
+    """{(role, side, digit): point}: where each role begins on ``skeleton`` (with ``roles``, default its own) — the
+    end of the bones of the role before it in its chain (a knee where the thigh ends, a hip joint where a leg's hips
+    bone ends; a leg's thigh follows its own side's hips, else the body's), else the start of its first bone (a
+    finger's base); and where a chain's role has no bone, after a last bone with nothing beyond it, that bone's end
+    (the wrist of an arm whose forearm ends there). Roles ``other`` have none."""
+    roles = skeleton.roles if roles is None else roles
+    if roles is None or len(roles) != len(skeleton):
+        raise ValueError("named_joints needs one role per bone (recognise the body plan first)")
+    first, last = {}, {}  # (role, side, digit) -> bone
+    for bone, role in enumerate(roles):
+        if role.role == "other":
+            continue
+        key = (role.role, role.side, role.digit)
+        if key not in first or role.index < roles[first[key]].index:
+            first[key] = bone
+        if key not in last or role.index >= roles[last[key]].index:
+            last[key] = bone
+    is_leaf = np.ones(len(skeleton), dtype=bool)
+    is_leaf[skeleton.parents[skeleton.parents >= 0]] = False
+    joints = {key: skeleton.heads[bone] for key, bone in first.items()}
+    for chain in CHAINS:
+        for side in ("L", "R", None):
+            for before, role in zip(chain, chain[1:]):
+                previous = next((key for key in ((before, side, None), (before, None, None)) if key in last), None)
+                if previous is None:
+                    continue
+                if (role, side, None) in first or is_leaf[last[previous]]:
+                    joints[(role, side, None)] = skeleton.tails[last[previous]]
+    return joints
 
 
 @dataclass(frozen=True, eq=False)
