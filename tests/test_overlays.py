@@ -334,3 +334,22 @@ def test_bad_arguments_raise(humanoid, arguments):
     with pytest.raises(ValueError):
         overlays.build_overlays(call.pop("stages"), call.pop("owner"), **call)
     assert not [obj for obj in bpy.data.objects if obj.name.startswith("Rigger")]
+
+
+def test_role_labels_are_text_objects_beside_each_bone(humanoid):
+    """The roles stage draws a sphere per bone and a text object with its role beside it, a child of the stage's
+    object, shown and hidden with it; clearing removes the texts' curves too."""
+    stages = humanoid[2]
+    curves_before = len(bpy.data.curves)
+    roles = overlays.build_overlays(stages, "Body")["roles"]
+    texts = sorted((obj for obj in bpy.data.objects if obj.parent == roles), key=lambda obj: obj.name)
+    assert [text.data.body for text in texts] == list(stages["roles"].texts)
+    assert all(text.type == 'FONT' and text[overlays.KIND_KEY] == "roles" and text.hide_select for text in texts)
+    bpy.context.view_layer.update()
+    beside = np.array([text.matrix_world.translation for text in texts]) - stages["roles"].points
+    assert (beside[:, 0] > 0).all() and np.abs(beside[:, 1:]).max() < 1e-6  # just right of each bone's middle
+    assert len(evaluated(roles)[1]) > 0  # the spheres
+    assert overlays.set_overlay_visible("roles", False) == 1 + len(texts)
+    assert not any(text.visible_get() for text in texts)
+    overlays.clear_overlays()
+    assert len(bpy.data.curves) == curves_before

@@ -24,6 +24,7 @@ import numpy as np
 
 from .body import AXES, BodyTuning, read_body
 from .roles import RoleTuning, assign_roles
+from .stages import MirrorPlane
 from .tuning import tuned
 
 KINDS = ("humanoid", "quadruped", "bird", "fish", "other")
@@ -128,7 +129,11 @@ def recognise(skeleton, mesh, *, plane=None, prefer_up=AXES[2], tuning=BodyPlanT
     prefer_up = np.asarray(prefer_up, dtype=np.float64)
     if prefer_up.shape != (3,) or not np.isfinite(prefer_up).all() or not np.linalg.norm(prefer_up) > 0:
         raise ValueError(f"prefer_up must be a non-zero 3D vector, got {prefer_up.tolist()}")
-    body = read_body(skeleton, mesh, tuning, plane, prefer_up / np.linalg.norm(prefer_up))
+    factor = mesh.unit_factor  # read at unit size (a power of two: exact), as the methods rig
+    at_unit_size = Skeleton(skeleton.names, skeleton.heads * factor, skeleton.tails * factor, skeleton.parents)
+    if plane is not None:
+        plane = MirrorPlane(plane.axis, plane.offset * factor, plane.normal)
+    body = read_body(at_unit_size, mesh.at_unit_size(), tuning, plane, prefer_up / np.linalg.norm(prefer_up))
     layout = lay_out(body, tuning)
     return layout.plan, assign_roles(skeleton, body, layout, tuning)
 
