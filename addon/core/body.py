@@ -43,8 +43,8 @@ class BodyTuning(TuningTable):
                                         "point touches the ground")
     contact_apart: float = tuned(0.25, "leaf tips this close along the skeleton touch the ground as one limb (a "
                                        "hand's fingers, a hoof's two toes; two feet are a whole leg length apart)")
-    leg_weight: float = tuned(2.0, "the up score of two or more limbs touching the ground: more than a flat bottom "
-                                   "and the extent together (a flat back or flat wings are no ground)")
+    leg_weight: float = tuned(2.0, "the up score of two or more limbs touching the ground: more than the best flat "
+                                   "bottom (a flat back or flat wings are no ground)")
     prefer_weight: float = tuned(0.05, "the up score of the preferred up (the convention of the mesh's source): it "
                                        "only breaks ties")
     flat_bottom: float = tuned(0.02, "the mesh's bottom slab, where flat faces facing down count as ground area")

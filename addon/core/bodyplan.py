@@ -36,16 +36,16 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
     """The tuned numbers of recognising a body plan and giving bones their roles (shares of the mesh size unless
     said otherwise)."""
 
-    leg_lift: float = tuned(0.15, "a limb touching the ground is a leg when it hangs from this share of the mesh's "
-                                  "height or higher (a cartoon cow's stubby legs from 0.2)")
+    leg_lift: float = tuned(0.15, "a limb off the mirror plane is a leg when it hangs from this share of the mesh's "
+                                  "height or higher (a cartoon cow's stubby legs from 0.2) ...")
     leg_drop: float = tuned(0.45, "... and its tip lies below where it hangs by this share of its length (a leg runs "
                                   "down; an arm reaching down and out, a blade in its hand, does not)")
+    leg_reach: float = tuned(0.2, "... and reaches this low (a share of the height, the mesh around its tip "
+                                  "included): the skeleton may stop short of the feet (a cartoon cow's at 0.17)")
     biped_lift: float = tuned(0.3, "legs in one row hang from this share of the height or higher (a bird's from "
                                    "0.42); lower ones are fins or stubs (a fish's fins hang from 0.2)")
     wing_flat: float = tuned(0.45, "a limb whose blade is this flat (thin across over wide across) or flatter is a "
                                    "wing or a fin (a bird's wings 0.2 to 0.35, arms 0.55 or rounder)")
-    leg_reach: float = tuned(0.2, "... and reaches this low (a share of the height, the mesh around its tip "
-                                  "included): the skeleton may stop short of the feet (a cartoon cow's at 0.17)")
     front_back: float = tuned(0.15, "feet this far apart along the body stand in two rows, front and back")
     upright: float = tuned(45.0, "degrees: a biped whose torso leans less than this from up is a humanoid")
     long_limb: float = tuned(0.2, "limbs at least this long are arms, wings or legs; shorter ones ears, fins or stubs")
