@@ -12,8 +12,9 @@ The rules, in order (``Body`` gives the up axis, the mirror plane, the spine and
   torso, from the hips to the spine's upper end, leans less than ``upright`` from up, or leans more but has round
   arms (a hunched monster); a bird when it leans forward with flat wings (``wing_flat``) or no arms;
 - without legs: one pair of long limbs on a small body is a bird in flight (wings); an upright body with long limbs
-  high on it is a humanoid without legs; a long body lying down whose limbs are short beside it (fins, or none) and
-  that tapers, curves or has fins is a fish or a serpent (not a plain log or column); anything else is ``other``.
+  high on it is a humanoid without legs; a long body lying down (the mesh lower than it is long) whose limbs are
+  short beside it (fins, or none) and that tapers, curves or has fins is a fish or a serpent (not a plain log or
+  column); anything else is ``other``.
 
 The confidence multiplies how the up axis was found (legs on the ground, a flat bottom, or only the preferred up),
 where the mirror plane came from and how clearly the deciding rule held.
@@ -54,6 +55,8 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
                                "octopus; a humanoid has two arms and maybe two long ears)")
     fish_body: float = tuned(0.45, "a legless body with a spine at least this long may be a fish or a serpent")
     lying: float = tuned(55.0, "degrees: a fish's or serpent's spine, end to end, is at least this far from up")
+    low_body: float = tuned(0.8, "... and the mesh is at most this many times as high as its spine is long (a fish "
+                                 "with its fins 0.68, a snake 0.07; ears on a tall body are no fish)")
     fin_share: float = tuned(0.7, "a fish's limbs are shorter than this share of its spine (fins)")
     taper: float = tuned(1.3, "a body whose head end is this many times as thick as its tail end tapers")
     curve: float = tuned(1.15, "a spine this many times as long as its ends are apart curves")
@@ -220,7 +223,7 @@ def _legless(body, parts, front, lengths, long_pairs, spine_length, forward, con
                            parts, front, spine, 0, chest, forward)
     longest = max(lengths, default=0.0)
     if spine_length >= tuning.fish_body * size and rise >= tuning.lying and 180 - rise >= tuning.lying \
-            and longest < tuning.fin_share * spine_length:
+            and longest < tuning.fin_share * spine_length and body.high - body.low <= tuning.low_body * spine_length:
         spine = _thick_end_last(body, spine, tuning)
         thickness = _end_thickness(body, spine, tuning)
         tapers = thickness[1] >= tuning.taper * max(thickness[0], 1e-300)
