@@ -3,15 +3,17 @@ first bone), given the plan's layout of the body (``core.bodyplan``). Bones keep
 
 Along the spine, from the tail end to the head end: tail (or root, a bone rising from the ground to the hips),
 hips, spine, chest up to where the arms, wings or front legs hang, then neck up to the spine's thinnest joint above
-them and head beyond (a fish: head, spine and tail by length). A leg: hips (the bones that run out from the body, from
-the mirror plane until it turns down; shoulder for a front leg), thigh, shin, foot (from its joint nearest an ankle's height) and toe
-(the last of those when there are two or more); a front leg: shoulder, upper_arm, forearm,
-hand. An arm: shoulder, upper_arm, forearm, hand and fingers, the joints nearest the shares of its length where
-artists put a shoulder, an elbow and a wrist (a bend there wins); each branch beyond the hand is a finger, the one
-that leaves earliest and points most away the thumb, the others index, middle, ring and pinky in order across the
-hand. Wings, fins, ears, tails and jaws take their part's role for every bone. A body plan that is ``other`` gives
-every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when a limb's bones have them, else the side of the
-mirror plane, left being the character's left when its front is known (Blender's +X for a character facing -Y).
+them and head beyond (a fish: head, spine and tail by length). A leg: hips (its bones from the mirror plane until it
+leaves it and turns down; shoulder for a front leg), thigh, shin from the knee (a bend near ``knee_at``, else the
+joint nearest it), foot from the joint nearest an ankle's height, and toe (the last bone when the foot has two or
+more); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up to where it leaves the torso, then
+upper_arm, forearm and hand by shares of the rest of its reach where the artists' humanoids have an elbow and a
+wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the one that leaves earliest
+and points most away the thumb, the others index, middle, ring and pinky in order across the hand. Twins are cut at
+the same joints (on their mirror-averaged points). Wings, fins, ears, tails and jaws take their part's role for
+every bone. A body plan that is ``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when
+a limb's bones have them, else the side of the mirror plane, left being the character's left when its front is known
+(Blender's +X for a character facing -Y).
 """
 from dataclasses import dataclass
 
@@ -74,7 +76,12 @@ class RoleTuning(TuningTable):
     bend_window: float = tuned(0.2, "a bend counts within this share of the limb's length of where the joint belongs")
     knee_at: float = tuned(0.47, "a knee's share of the way from the hip to the ankle (the artists' humanoids: 0.38 "
                                  "to 0.49, median 0.47)")
-    shoulder_at: float = tuned(0.22, "an arm's shoulder joint: its share of the way from where the arm hangs to the "
+    shoulder_thickness: float = tuned(1.3, "an arm's shoulder joint is its first joint where the mesh is at most this "
+                                           "many times as thick as along the arm (the torso is thicker) ...")
+    arm_from: float = tuned(0.3, "... the arm's thickness being the median at its joints from this share of its "
+                                 "reach ...")
+    arm_to: float = tuned(0.8, "... to this share (the upper arm and forearm, not the torso or the hand)")
+    shoulder_at: float = tuned(0.22, "else the shoulder joint's share of the way from where the arm hangs to the "
                                      "end of its hand (the artists' humanoids: 0.18 to 0.31, median 0.23)")
     elbow_at: float = tuned(0.39, "an elbow's share of the way from the shoulder joint to the end of the hand (the "
                                   "artists' humanoids: 0.37 to 0.42)")
@@ -269,16 +276,16 @@ def _segments(names, cuts):
 
 
 def _arm(body, limb, points, tuning, put):
-    """Roles along an arm by where each bone's middle lies: shoulder up to ``shoulder_at`` of the way from where it
-    hangs to the end of its reach (the mesh beyond its last joint included: an artist's arm may end at the wrist),
-    then upper_arm, forearm and hand at ``elbow_at`` and ``wrist_at`` of the way from that shoulder joint on, the
-    elbow at a bend near its share; the fingers beyond the hand."""
+    """Roles along an arm: shoulder up to the shoulder joint (where the arm leaves the torso, :func:`_shoulder`),
+    then upper_arm, forearm and hand by where each bone's middle lies, at ``elbow_at`` and ``wrist_at`` of the way
+    from that joint to the end of the arm's reach (the mesh beyond its last joint included: an artist's arm may end
+    at the wrist), the elbow at a bend near its share; the fingers beyond the hand."""
     nodes = list(limb.main)
     last = len(nodes) - 1
     arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
     total = arc[-1] + _reach(body, points)
     middle = 0.5 * (arc[1:] + arc[:-1])
-    shoulder = int(np.searchsorted(middle, tuning.shoulder_at * total))
+    shoulder = _shoulder(body, nodes, arc, total, tuning)
     rest = total - arc[min(shoulder, last)]  # from the shoulder joint on
     elbow, wrist = (int(np.searchsorted(middle, arc[min(shoulder, last)] + share * rest))
                     for share in (tuning.elbow_at, tuning.wrist_at))
@@ -298,6 +305,21 @@ def _arm(body, limb, points, tuning, put):
     fingers += [path[_fork(path, nodes):] for path in branches]
     for finger, digit in zip(fingers, _digits(body, fingers, points[wrist], points[min(fingers_from, last)])):
         put(finger, [("finger", digit)] * (len(finger) - 1))
+
+
+def _shoulder(body, nodes, arc, total, tuning):
+    """Index of an arm's shoulder joint: its first joint where the mesh is about as thin as along the arm
+    (``shoulder_thickness`` times the median half-thickness of its joints between ``arm_from`` and ``arm_to`` of
+    its reach): the arm has left the torso there. Else the joint where the bones pass ``shoulder_at`` of the reach."""
+    middle = 0.5 * (arc[1:] + arc[:-1])
+    radius = body.radius[nodes]
+    share = arc / max(total, 1e-300)
+    along = radius[(share >= tuning.arm_from) & (share <= tuning.arm_to)]
+    if len(along):
+        thin = np.flatnonzero(radius[1:] <= tuning.shoulder_thickness * np.median(along)) + 1
+        if len(thin) and share[thin[0]] < tuning.elbow_at:
+            return int(thin[0])
+    return int(np.searchsorted(middle, tuning.shoulder_at * total))
 
 
 def _reach(body, points):
