@@ -268,23 +268,20 @@ def nearest_joints(skeleton, truth, size):
 
 
 def role_agreement(artist, head_joint, rig, names, middle, size):
-    """Per named artist joint: whether the recogniser gave the bone starting there the hand map's role (side by
-    geometry); joints ending a chain start no bone and are not scored."""
+    """Per named artist joint: whether the recogniser gave a bone starting there the hand map's role (side by
+    geometry; a joint may start several bones: the hips start the spine and both legs' hips bones); joints ending a
+    chain start no bone and are not scored."""
     sides = side_of(rig.positions, middle, size)
     given = {}
-    for bone, joint in enumerate(head_joint):  # of the bones starting at a joint, the longest says its role
-        length = float(np.linalg.norm(artist.tails[bone] - artist.heads[bone]))
-        if length > given.get(int(joint), (0.0, None))[0]:
-            given[int(joint)] = (length, artist.roles[bone])
-    given = {joint: role for joint, (_, role) in given.items()}
+    for bone, joint in enumerate(head_joint):
+        given.setdefault(int(joint), []).append(artist.roles[bone])
     result = {}
     for name, role in names.items():
         joint = rig.names.index(name)
         if joint in given:
-            found = given[joint]
-            same_side = {"L": 1, "R": -1, None: 0}[found.side] == sides[joint] or found.side is None
-            result[name] = {"wanted": role, "given": role_key(found),
-                            "right": bool(role_key(found) == role and same_side)}
+            fits = [found for found in given[joint] if role_key(found) == role
+                    and (found.side is None or {"L": 1, "R": -1}[found.side] == sides[joint])]
+            result[name] = {"wanted": role, "given": role_key((fits or given[joint])[0]), "right": bool(fits)}
     return result
 
 
@@ -338,12 +335,15 @@ def summarise(records):
     return summary
 
 
-def per_role(records):
-    """{role: [errors]} over the models (sides together; fingers as "finger")."""
+def per_role(records, source="rigger"):
+    """{role: [errors]} over the models (sides together; fingers as "finger") of Rigger's named joints, or with
+    ``source`` "nearest" of the nearest joints to the same artist joints."""
     roles = {}
-    for _, joint, error in error_rows(records):
-        if error is not None:
-            roles.setdefault(joint.split(".")[0].split(":")[0], []).append(error)
+    for record in records:
+        named = record.get("named", {})
+        for joint, error in named.get("rigger", {}).items():
+            if error is not None:
+                roles.setdefault(joint.split(".")[0].split(":")[0], []).append(named[source][joint])
     return roles
 
 
@@ -393,11 +393,15 @@ def report(records, summary, run):
                   [record["model"], record["label"], mark(record, "rigger"), f"{record['rigger']['confidence']:.2f}",
                    record["rigger"]["reason"], mark(record, "artist"), mark(record, "file_frame")]
                   for record in records]), ""]
-    roles = per_role(records)
+    roles, nearest = per_role(records), per_role(records, "nearest")
     lines += ["## Named-joint error by role (Rigger's skeletons, in mesh sizes)", "",
-              *markdown_table(["role", "joints", "mean", "max", f"above {TARGET_MAX_ERROR}"], [
+              "Nearest: the distance from the same artist joints to the nearest joint of Rigger's skeleton, whatever "
+              "its role.", "",
+              *markdown_table(["role", "joints", "mean", "max", f"above {TARGET_MAX_ERROR}", "nearest: mean",
+                               f"nearest above {TARGET_MAX_ERROR}"], [
                   [role, len(errors), f"{np.mean(errors):.4f}", f"{np.max(errors):.4f}",
-                   sum(error > TARGET_MAX_ERROR for error in errors)]
+                   sum(error > TARGET_MAX_ERROR for error in errors), f"{np.mean(nearest[role]):.4f}",
+                   sum(error > TARGET_MAX_ERROR for error in nearest[role])]
                   for role, errors in sorted(roles.items(), key=lambda item: -np.mean(item[1]))], numeric=True), ""]
     lines += ["## Named-joint error by model", "",
               *markdown_table(["model", "named", "Rigger names", "mean", "max", "worst joint", "artist roles right"], [
@@ -428,9 +432,16 @@ def failure_notes(records, summary):
         if record["rigger"]["kind"] != record["label"]:
             notes.append(f"- {record['model']} ({record['what']}): recognised as {record['rigger']['kind']} — "
                          f"{record['rigger']['reason']}.")
+    nearest = {(record["model"], joint): error for record in records
+               for joint, error in record.get("named", {}).get("nearest", {}).items()}
+    far = [row for row in summary["over_max"] if nearest[row[:2]] > TARGET_MAX_ERROR]
+    notes.append(f"- {len(summary['over_max'])} named joints lie more than {TARGET_MAX_ERROR} from the artist's; for "
+                 f"{len(far)} of them no joint of Rigger's skeleton lies within {TARGET_MAX_ERROR} (the skeleton has "
+                 f"no joint there), for the others a joint does but the roles begin elsewhere:")
     for model, joint, error in summary["over_max"]:
-        notes.append(f"- {model} {joint}: {error:.3f} of the size from the artist's joint.")
-    return notes or ["- nothing"]
+        notes.append(f"  - {model} {joint}: {error:.3f} of the size from the artist's joint; Rigger's nearest joint "
+                     f"{nearest[(model, joint)]:.3f}.")
+    return notes
 
 
 def plot(records, path):

@@ -3,7 +3,8 @@ first bone), given the plan's layout of the body (``core.bodyplan``). Bones keep
 
 Along the spine, from the tail end to the head end: tail (or root, a bone rising from the ground to the hips),
 hips, spine, chest up to where the arms, wings or front legs hang, then neck up to the spine's thinnest joint above
-them and head beyond (a fish: head, spine and tail by length). A leg: hips (its bones from the mirror plane until it
+them and head beyond (one bone there is the neck: it pivots where a neck does; a fish: head, spine and tail by
+length). A leg: hips (its bones from the mirror plane until it
 leaves it and turns down; shoulder for a front leg), thigh, shin from the knee (a bend near ``knee_at``, else the
 joint nearest it), foot from the joint nearest an ankle's height, and toe (the last bone when the foot has two or
 more); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up to where it leaves the torso, then
@@ -224,7 +225,7 @@ def _spine_roles(body, layout, tuning):
         thinnest = chest + 1 + int(np.argmin(body.radius[spine[chest + 1:count]]))
         names += ["neck"] * (thinnest - chest) + ["head"] * (count - thinnest)
     else:
-        names += ["neck", "head"][-above:] if above else []
+        names += ["neck", "head"][:above]  # one bone into the head pivots at the neck
     return names
 
 
@@ -303,7 +304,8 @@ def _arm(body, limb, points, tuning, put):
         return
     fingers = [nodes[fingers_from:]] if fingers_from < last else []
     fingers += [path[_fork(path, nodes):] for path in branches]
-    for finger, digit in zip(fingers, _digits(body, fingers, points[wrist], points[min(fingers_from, last)])):
+    raw = body.graph.points[nodes]
+    for finger, digit in zip(fingers, _digits(body, fingers, raw[wrist], raw[min(fingers_from, last)], raw[elbow])):
         put(finger, [("finger", digit)] * (len(finger) - 1))
 
 
@@ -343,21 +345,22 @@ def _fork(path, nodes):
     return next(i for i, node in enumerate(path) if i + 1 >= len(path) or path[i + 1] not in nodes)
 
 
-def _digits(body, fingers, wrist, palm):
+def _digits(body, fingers, wrist, palm, elbow):
     """Digit names for the finger paths: with three or more, the one leaving the hand earliest and pointing most
-    away from it is the thumb, the others index, middle, ring, pinky by their tips' distance from the thumb's;
-    otherwise none."""
+    away from it (the forearm's way when the fingers leave from the wrist) is the thumb, the others index, middle,
+    ring, pinky by their tips' distance from the thumb's; otherwise none."""
     if len(fingers) < 3:
         return [None] * len(fingers)
     points = body.graph.points
-    hand = palm - wrist
-    hand = hand / np.linalg.norm(hand) if np.linalg.norm(hand) > 0 else hand
+    span = float(np.linalg.norm(palm - wrist))
+    hand = palm - wrist if span > 0 else wrist - elbow
+    hand = hand / max(np.linalg.norm(hand), 1e-300)
 
     def away(finger):
         direction = points[finger[-1]] - points[finger[0]]
         norm = np.linalg.norm(direction)
-        start = np.linalg.norm(points[finger[0]] - wrist)
-        return (1 - (direction @ hand) / norm if norm > 0 else 0) - start / max(np.linalg.norm(palm - wrist), 1e-300)
+        later = np.linalg.norm(points[finger[0]] - wrist) / span if span > 0 else 0.0
+        return (1 - (direction @ hand) / norm if norm > 0 else 0) - later
 
     thumb = max(range(len(fingers)), key=lambda k: away(fingers[k]))
     order = sorted((k for k in range(len(fingers)) if k != thumb),
