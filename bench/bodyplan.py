@@ -501,7 +501,8 @@ def main(argv=None):
             raise SystemExit(f"No model name contains any of {wanted}.")
     out = args.out or (REPO / "out" / "bodyplan" if args.models else RESULTS_DIR)
     out.mkdir(parents=True, exist_ok=True)
-    run = {"command": "python bench/bodyplan.py" + (" " + " ".join(argv if argv is not None else sys.argv[1:])).rstrip(),
+    arguments = " ".join(argv if argv is not None else sys.argv[1:])
+    run = {"command": f"python bench/bodyplan.py {arguments}".rstrip(),
            "started": datetime.datetime.now(datetime.timezone.utc), "load": os.getloadavg(), "cpu": cpu_model(),
            "commit": described_commit()}
     started = time.perf_counter()

@@ -77,14 +77,6 @@ class JointGraph:
     def leaves(self):
         return [k for k in range(len(self.points)) if len(self.neighbours[k]) == 1]
 
-    def path(self, start, end):
-        """Joints from ``start`` to ``end`` along the tree."""
-        before = self.search(start)[1]
-        nodes = [end]
-        while nodes[-1] != start:
-            nodes.append(before[nodes[-1]])
-        return nodes[::-1]
-
     def search(self, start, allowed=None):
         """Distances (along the bones) from ``start`` to every joint reached within ``allowed`` (all when None), and
         the joint each was reached from."""
@@ -260,11 +252,12 @@ class Limb:
 @dataclass(frozen=True)
 class Body:
     """A skeleton read as a body: its ``graph``, the mesh ``size`` (largest extent) and the mesh's ``low`` and
-    ``high`` extent along ``up``, the mirror ``plane`` (or None), a sample of the mesh's ``vertices``, the ``spine`` (joints along the midline's longest
-    path), the ``limbs`` with the spine joint each hangs from (``bases``; through ``connectors``, midline joints off
-    the spine, each with the spine joint it leaves), the ``radius`` (local half-thickness of the mesh) at each joint, each limb's ``flatness``
-    (the mesh around it: thin across over wide across, 1 for a round limb, near 0 for a wing or a fin; 1 on a flat
-    mesh) and how up was found (``up_evidence``: "legs", "flat" or "preferred"; ``up_note`` in words)."""
+    ``high`` extent along ``up``, the mirror ``plane`` (or None), a sample of the mesh's ``vertices``, the ``spine``
+    (joints along the midline's longest path), the ``limbs`` with the spine joint each hangs from (``bases``; through
+    ``connectors``, midline joints off the spine, each with the spine joint it leaves), the ``radius`` (local
+    half-thickness of the mesh) at each joint, each limb's ``flatness`` (the mesh around it: thin across over wide
+    across, 1 for a round limb, near 0 for a wing or a fin; 1 on a flat mesh) and how up was found
+    (``up_evidence``: "legs", "flat" or "preferred"; ``up_note`` in words)."""
 
     graph: JointGraph
     size: float
@@ -312,13 +305,17 @@ def read_body(skeleton, mesh, tuning=BodyTuning(), plane=None, prefer_up=AXES[2]
     spine, limbs, bases, connectors = _midline_and_limbs(graph, found, size, tuning)
     limbs = _paired(limbs, graph, skeleton, found, size, tuning)
     tips = sorted({node for limb in limbs for node in limb.before if graph.degree(node) == 1})
-    up, up_evidence, up_note = _up_axis(graph, tips, radius, mesh, found, size, tuning, np.asarray(prefer_up, dtype=np.float64))
+    up, up_evidence, up_note = _up_axis(graph, tips, radius, mesh, found, size, tuning,
+                                        np.asarray(prefer_up, dtype=np.float64))
     heights = mesh.used_vertices @ up
-    segments, nearest = _nearest_links(graph, vertices)
-    flatness = tuple(1.0 for _ in limbs) if mesh.flat_normal is not None else tuple(_flatness(limb, graph, vertices, segments, nearest, (tuning.blade_from, tuning.blade_to))
-                     for limb in limbs)
-    return Body(graph, size, up, float(heights.min()), float(heights.max()), found, vertices, tuple(spine), tuple(limbs),
-                bases, connectors, radius, flatness, up_evidence, up_note)
+    if mesh.flat_normal is not None:
+        flatness = tuple(1.0 for _ in limbs)  # a cut-out's limbs are all flat: no telling wings by it
+    else:
+        segments, nearest = _nearest_links(graph, vertices)
+        flatness = tuple(_flatness(limb, graph, vertices, segments, nearest, (tuning.blade_from, tuning.blade_to))
+                         for limb in limbs)
+    return Body(graph, size, up, float(heights.min()), float(heights.max()), found, vertices, tuple(spine),
+                tuple(limbs), bases, connectors, radius, flatness, up_evidence, up_note)
 
 
 def _sampled(rows, count):
