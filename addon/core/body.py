@@ -56,7 +56,7 @@ class BodyTuning(TuningTable):
     blade_from: float = tuned(0.25, "a limb's flatness is measured from this share of its length ...")
     blade_to: float = tuned(0.8, "... to this one: its blade (a wing's, a fin's) or its thigh and shin, not the body "
                                  "it leaves nor a flat foot")
-    sample_vertices: int = tuned(3000, "mesh vertices sampled for thickness and flatness (at most): enough to find "
+    sample_vertices: int = tuned(2000, "mesh vertices sampled for thickness and flatness (at most): enough to find "
                                        "a limb's surface, few enough to stay a few milliseconds")
     sample_triangles: int = tuned(40000, "triangles sampled for the flat bottom (at most)")
 
@@ -392,14 +392,15 @@ def _up_axis(graph, tips, radius, mesh, plane, size, tuning, prefer_up):
     normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     areas = np.linalg.norm(normals, axis=1)
     total_area = max(float(areas.sum()), 1e-300)
-    measures = []
-    for up in candidates:
-        heights = mesh.used_vertices @ up
-        low, high = float(heights.min()), float(heights.max())
-        contacts = _contacts(graph, radius, tips, up, low, high, size, tuning)
-        bottom = (corners @ up).max(axis=1) <= low + tuning.flat_bottom * size
-        facing = -(normals @ up) >= 0.7 * areas
-        measures.append((contacts, float(areas[bottom & facing].sum()) / total_area, high - low))
+    ups = np.array(candidates)
+    heights = mesh.used_vertices @ ups.T  # (N, C)
+    lows, highs = heights.min(axis=0), heights.max(axis=0)
+    tops = (corners @ ups.T).max(axis=1)  # (T, C): each triangle's highest corner along each candidate
+    facing = -(normals @ ups.T) >= 0.7 * areas[:, None]
+    bottom = tops <= lows + tuning.flat_bottom * size
+    flats = (areas[:, None] * (bottom & facing)).sum(axis=0) / total_area
+    measures = [(_contacts(graph, radius, tips, up, low, high, size, tuning), float(flat), high - low)
+                for up, low, high, flat in zip(candidates, lows, highs, flats)]
     best_flat = max(max(flat for _, flat, _ in measures), tuning.flat_area)
     scores = [tuning.leg_weight * (contacts >= 2) + flat / best_flat + tuning.prefer_weight * float(up @ prefer_up)
               for up, (contacts, flat, _) in zip(candidates, measures)]
