@@ -9,7 +9,7 @@ BPY42_VENV := $(VENV)/bpy42
 BPY42_STAMP := $(BPY42_VENV)/.installed
 
 .PHONY: test build demo addon bpy42 bench bench-quality bench-silhouette bench-skinning bench-posing \
-	bench-rig-time regress regress-baseline defects clean
+	bench-bodyplan bench-rig-time regress regress-baseline defects clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -54,6 +54,10 @@ bench-skinning: build
 # Posing over ../shared/models/gt: random artist poses reproduced by each rig; bench/results/posing.{md,png,json}.
 bench-posing: build
 	$(PY) bench/posing.py
+
+# Body plan of every ../shared model against a hand label, named-joint error of the humanoids: bodyplan.{md,png,json}.
+bench-bodyplan: build
+	$(PY) bench/bodyplan.py
 
 bench-rig-time: build
 	$(PY) bench/rig_time.py

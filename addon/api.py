@@ -1,9 +1,11 @@
 """``rig_mesh``: the one call scripts, the CLI and the Blender layer use to turn a mesh into a skeleton."""
 import time
 
+from .core.bodyplan import recognise
 from .core.mesh import Mesh
 from .core.params import resolve
 from .core.registry import RigMethod, check_method, discover
+from .core.roles import Roles
 from .core.skeleton import Skeleton
 
 _registry = None
@@ -32,8 +34,10 @@ def rig_mesh(vertices, triangles, method="silhouette", **params):
         **params: the method's parameters by name; values may be strings as typed on a command line.
 
     Raises ValueError for an unknown method (naming the available ones and any that failed to load), unknown or
-    out-of-range parameters, and bad meshes. The skeleton's ``params`` are the resolved values and its
-    ``timings["total"]`` the seconds for this whole call.
+    out-of-range parameters, and bad meshes. The skeleton's ``params`` are the resolved values, its ``body_plan``
+    and ``roles`` what ``rigger.core.bodyplan.recognise`` makes of it on this mesh (Z up preferred, as in Blender;
+    the method's mirror plane when it has one; also drawn as the "roles" stage), and its ``timings["total"]`` the
+    seconds for this whole call.
     """
     start = time.perf_counter()
     rigging = _method(method)
@@ -43,6 +47,10 @@ def rig_mesh(vertices, triangles, method="silhouette", **params):
     if not isinstance(skeleton, Skeleton):
         raise TypeError(f"method {rigging.name!r} returned {type(skeleton).__name__}, not a Skeleton")
     skeleton.params = values
+    recognised = time.perf_counter()
+    skeleton.body_plan, skeleton.roles = recognise(skeleton, mesh, plane=skeleton.stages.get("mirror_plane"))
+    skeleton.stages["roles"] = Roles.of(skeleton, skeleton.roles)
+    skeleton.timings["body_plan"] = time.perf_counter() - recognised
     skeleton.timings["total"] = time.perf_counter() - start
     return skeleton
 

@@ -116,12 +116,21 @@ def _run_methods(args):
             choices = f" {{{', '.join(param.items)}}}" if param.items else ""
             print(f"  --set {param.name}=VALUE  ({param.type}{choices}, default {param.default}) {param.description}")
         if args.tuning and method.tuning_type is not None:
-            print(f"  tuning ({method.tuning_type.__module__}.{method.tuning_type.__name__}):")
-            for field, value, why, owner in method.tuning_type.rows():
-                print(f"    {field} = {value!r}  {why}  [{owner.__module__}.{owner.__name__}]")
+            _print_tuning(method.tuning_type)
+    if args.tuning:
+        from .core.bodyplan import BodyPlanTuning
+
+        print("body plan and bone roles (after every method):")
+        _print_tuning(BodyPlanTuning)
     for where, error in registry.failures.items():
         print(f"failed to load {where}: {error}", file=sys.stderr)
     return 0
+
+
+def _print_tuning(table):
+    print(f"  tuning ({table.__module__}.{table.__name__}):")
+    for field, value, why, owner in table.rows():
+        print(f"    {field} = {value!r}  {why}  [{owner.__module__}.{owner.__name__}]")
 
 
 def _run_rig(args):

@@ -247,7 +247,7 @@ def test_rig_builds_the_overlays_the_panel_toggles_and_clear_removes(scene):
     toggle.name, toggle.shown = "cdt", False
     assert bpy.ops.rigger.rig() == {'FINISHED'}
     made = {o[KIND_KEY]: o for o in bpy.data.collections[COLLECTION_NAME].objects}
-    assert set(made) == {"silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints"}
+    assert set(made) == {"silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints", "roles"}
     toggles = scene.rigger.overlays
     assert set(toggles.keys()) == set(made)  # one toggle per stage drawn, labelled after its stage type
     labels = [toggles[name].label for name in ("axis", "merged", "cdt")]
@@ -265,7 +265,7 @@ def test_rig_builds_the_overlays_the_panel_toggles_and_clear_removes(scene):
     assert not made["cdt"].hide_get()
     assert bpy.ops.rigger.rig() == {'FINISHED'}  # rigging again keeps the toggles as they are
     made = {o[KIND_KEY]: o for o in bpy.data.collections[COLLECTION_NAME].objects}
-    assert made["joints"].hide_get() and not made["cdt"].hide_get() and len(toggles) == 7
+    assert made["joints"].hide_get() and not made["cdt"].hide_get() and len(toggles) == 8
     assert bpy.ops.rigger.clear_overlays() == {'FINISHED'}
     assert COLLECTION_NAME not in bpy.data.collections
     assert not [o for o in bpy.data.objects if KIND_KEY in o] and len(toggles) == 0

@@ -70,6 +70,9 @@ def test_rig_an_obj_to_glb_with_a_report_in_the_obj_frame(humanoid_obj, rigged_g
     expected = rigger.rig_mesh(in_file @ Y_UP_TO_Z_UP.T, triangles, bone_length=0.12)
     assert names == list(expected.names)
     np.testing.assert_allclose(heads, expected.heads @ Y_UP_TO_Z_UP, atol=1e-4)
+    # ... with the body plan and every bone's role and side
+    assert report["body_plan"] == expected.body_plan.to_dict() and report["body_plan"]["kind"] == "humanoid"
+    assert [(bone["role"], bone["side"]) for bone in bones] == [(role.role, role.side) for role in expected.roles]
 
 
 def glb_document(path):

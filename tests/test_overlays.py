@@ -18,7 +18,8 @@ from rigger.core.registry import discover  # noqa: E402
 from rigger.core.stages import (ISOLATED, JUNCTION, SLEEVE, TERMINAL, AxisGraph, Frame, MirrorPlane,  # noqa: E402
                                 Stage, Triangulation)
 
-KINDS = ["silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints"]  # the silhouette method's drawn stages
+KINDS = ["silhouette", "cdt", "axis", "merged", "pruned", "chains", "joints", "roles"]  # the drawn stages (roles:
+# rig_mesh's bone roles)
 LINE_KINDS = ("silhouette", "axis", "merged", "pruned", "chains")
 TEST_METHODS = pathlib.Path(__file__).parent / "methods"
 ICO_VERTICES = 42  # an ico sphere of SPHERE_SUBDIVISIONS = 2
@@ -218,13 +219,13 @@ def test_rebuilding_replaces_the_owners_objects_and_shares_groups_and_materials(
 
     overlays.build_overlays(stages, "Other")
     twice = data_counts()
-    assert twice["objects"] == once["objects"] + len(KINDS)
+    assert twice["objects"] == once["objects"] + len(KINDS) + len(stages["roles"].texts)  # a text per role label
     assert twice["meshes"] == once["meshes"] + len(KINDS)
     assert {key: twice[key] for key in ("node_groups", "materials", "collections")} == \
         {key: once[key] for key in ("node_groups", "materials", "collections")}
 
     without_joints = {key: value for key, value in stages.items() if key != "joints"}
-    assert list(overlays.build_overlays(without_joints, "Body")) == KINDS[:-1]
+    assert list(overlays.build_overlays(without_joints, "Body")) == [kind for kind in KINDS if kind != "joints"]
     assert "Rigger joints: Body" not in bpy.data.objects and "Rigger joints: Other" in bpy.data.objects
 
 
@@ -295,7 +296,7 @@ def test_what_is_not_a_stage_or_fails_to_draw_is_skipped_with_a_warning(humanoid
     assert sorted(str(warning.message) for warning in record) == [
         "Rigger overlay 'broken' skipped: drawing its Broken failed: KeyError: 'points'",
         "Rigger overlay 'raw' skipped: a ndarray, not a rigger.core.stages.Stage",
-        "Rigger overlay 'sketchy' skipped: its drawing is a ndarray, not Lines, Points or ClassedFaces"]
+        "Rigger overlay 'sketchy' skipped: its drawing is a ndarray, not Lines, Points, ClassedFaces or Labels"]
 
 
 def test_a_test_only_package_method_s_own_stage_type_gets_its_overlay():
@@ -307,7 +308,7 @@ def test_a_test_only_package_method_s_own_stage_type_gets_its_overlay():
     vertices, triangles = samples.character_arrays("snake", subdivisions=0)
     skeleton = rigger.rig_mesh(vertices, triangles, method=method, slabs=5)
     objects = overlays.build_overlays(skeleton.stages, "Snake", scale=0.01)
-    assert list(objects) == ["rings", "centres"]
+    assert list(objects) == ["rings", "centres", "roles"]
     rings = skeleton.stages["rings"]
     drawn, materials = evaluated(objects["rings"])
     assert set(materials) == {"Rigger rings"}
@@ -333,3 +334,22 @@ def test_bad_arguments_raise(humanoid, arguments):
     with pytest.raises(ValueError):
         overlays.build_overlays(call.pop("stages"), call.pop("owner"), **call)
     assert not [obj for obj in bpy.data.objects if obj.name.startswith("Rigger")]
+
+
+def test_role_labels_are_text_objects_beside_each_bone(humanoid):
+    """The roles stage draws a sphere per bone and a text object with its role beside it, a child of the stage's
+    object, shown and hidden with it; clearing removes the texts' curves too."""
+    stages = humanoid[2]
+    curves_before = len(bpy.data.curves)
+    roles = overlays.build_overlays(stages, "Body")["roles"]
+    texts = sorted((obj for obj in bpy.data.objects if obj.parent == roles), key=lambda obj: obj.name)
+    assert [text.data.body for text in texts] == list(stages["roles"].texts)
+    assert all(text.type == 'FONT' and text[overlays.KIND_KEY] == "roles" and text.hide_select for text in texts)
+    bpy.context.view_layer.update()
+    beside = np.array([text.matrix_world.translation for text in texts]) - stages["roles"].points
+    assert (beside[:, 0] > 0).all() and np.abs(beside[:, 1:]).max() < 1e-6  # just right of each bone's middle
+    assert len(evaluated(roles)[1]) > 0  # the spheres
+    assert overlays.set_overlay_visible("roles", False) == 1 + len(texts)
+    assert not any(text.visible_get() for text in texts)
+    overlays.clear_overlays()
+    assert len(bpy.data.curves) == curves_before

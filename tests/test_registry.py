@@ -222,7 +222,7 @@ def test_the_template_method_rigs_a_chain_along_the_main_axis():
     ends = sorted([skeleton.heads[0][1], skeleton.tails[-1][1]])
     np.testing.assert_allclose(ends, [0, 4])
     np.testing.assert_allclose(skeleton.heads[:, [0, 2]], 0.5)
-    assert set(skeleton.timings) == {"axis", "chain", "total"}
+    assert set(skeleton.timings) == {"axis", "chain", "body_plan", "total"}  # rig_mesh adds the last two
     along_z = rigger.rig_mesh(BOX_VERTICES, BOX_TRIANGLES, method=TemplateMethod, axis="z")
     np.testing.assert_allclose(along_z.heads[0], [0.5, 2, 0])
     assert len(along_z) == 3

@@ -87,8 +87,10 @@ class _RiggerOperator:
         seconds = sum(result.timings.values())
         names = ", ".join(mesh.name for mesh in meshes)
         replaced = " (replaced the previous rig)" if result.replaced else ""
-        self.report({'INFO'}, f"Rigged {names} with {method.label or method.name}: "
-                              f"{len(result.skeleton)} bones in {seconds:.2f} s{replaced}")
+        plan = result.skeleton.body_plan
+        self.report({'WARNING'} if plan is not None and plan.warning else {'INFO'},
+                    f"Rigged {names} with {method.label or method.name}: {len(result.skeleton)} bones in "
+                    f"{seconds:.2f} s{replaced}" + ("" if plan is None else f"; {plan.warning or plan.summary()}"))
         return meshes, result.armature
 
     def skin(self, meshes, armature, progress):

@@ -1,8 +1,10 @@
 """Stage overlays: every intermediate result of a rigging method drawn in the viewport, so each step can be inspected.
 
-Each stage of a skeleton (``rigger.core.stages``) says how it is drawn: world-space lines, points or classed
-triangles. This module draws those three primitives, whatever the stage type, so a method's new stage types get their
-overlays without a change here. A drawing's raw data is stored as a plain mesh (vertices and edges; classed
+Each stage of a skeleton (``rigger.core.stages``) says how it is drawn: world-space lines, points, classed triangles
+or labels. This module draws those primitives, whatever the stage type, so a method's new stage types get their
+overlays without a change here. Labels are points drawn as spheres, each with a text object beside it (a child of
+the overlay object, standing upright to face the front view), since geometry nodes cannot give each point its own
+string. A drawing's raw data is stored as a plain mesh (vertices and edges; classed
 triangles also keep their faces) and a geometry-node modifier makes it visible: edges become tubes (Mesh to Curve,
 Curve to Mesh with a circle profile) and points small spheres. Curve to Mesh drops the mesh's colour attributes, so
 colour comes from materials, one per stage or triangle class, with a viewport ``diffuse_color`` for Workbench and a
@@ -20,7 +22,7 @@ from collections.abc import Mapping
 import bpy
 import numpy as np
 
-from ..core.stages import ClassedFaces, Lines, Points, Stage
+from ..core.stages import ClassedFaces, Labels, Lines, Points, Stage
 
 COLLECTION_NAME = "Rigger Overlays"
 LINE_SCALE = 0.004  # default line radius, as a fraction of the largest extent of the drawn data
@@ -29,6 +31,8 @@ FACE_EDGE_SCALE = 0.5  # classed triangles' edge radius, in line radii: their ed
 TUBE_SIDES = 8  # vertices around a tube
 SPHERE_SUBDIVISIONS = 2  # ico sphere level of a point: 42 vertices
 FACE_ALPHA = 0.25  # classed faces are see-through (Workbench draws material alpha as transparency)
+LABEL_SCALE = 5.0  # label text height, in line radii
+LABEL_POINT_SCALE = 1.5  # label sphere radius, in line radii: smaller than a joint's
 
 TUBES_GROUP = "Rigger Tubes"
 CLASS_TUBES_GROUP = "Rigger Class Tubes"  # + the class names it draws
@@ -106,9 +110,9 @@ def _drawings(stages):
             warnings.warn(f"Rigger overlay {name!r} skipped: drawing its {type(stage).__name__} failed: "
                           f"{type(error).__name__}: {error}", RuntimeWarning, stacklevel=3)
             continue
-        if drawing is not None and not isinstance(drawing, (Lines, Points, ClassedFaces)):
+        if drawing is not None and not isinstance(drawing, (Lines, Points, ClassedFaces, Labels)):
             warnings.warn(f"Rigger overlay {name!r} skipped: its drawing is a {type(drawing).__name__}, not Lines, "
-                          f"Points or ClassedFaces", RuntimeWarning, stacklevel=3)
+                          f"Points, ClassedFaces or Labels", RuntimeWarning, stacklevel=3)
         elif drawing is not None:
             drawings[name] = stage, drawing
     return drawings
@@ -126,7 +130,7 @@ def _line_radius(drawings):
 def _fill(mesh, drawing):
     if isinstance(drawing, Lines):
         mesh.from_pydata(drawing.points.tolist(), drawing.edges.tolist(), [])
-    elif isinstance(drawing, Points):
+    elif isinstance(drawing, (Points, Labels)):
         mesh.from_pydata(drawing.points.tolist(), [], [])
     else:
         _fill_classed(mesh, drawing)
@@ -135,9 +139,9 @@ def _fill(mesh, drawing):
 def _modifier_inputs(name, stage, drawing, radius):
     if isinstance(drawing, Lines):
         return _tubes_group(), {"Radius": radius, "Material": _material(f"Rigger {name}", stage.colour)}
-    if isinstance(drawing, Points):
-        return _spheres_group(), {"Radius": JOINT_SCALE * radius,
-                                  "Material": _material(f"Rigger {name}", stage.colour)}
+    if isinstance(drawing, (Points, Labels)):
+        scale = LABEL_POINT_SCALE if isinstance(drawing, Labels) else JOINT_SCALE
+        return _spheres_group(), {"Radius": scale * radius, "Material": _material(f"Rigger {name}", stage.colour)}
     labels = [label for _, label, _ in drawing.palette]
     inputs = {label.title(): _material(f"Rigger {label}", colour) for _, label, colour in drawing.palette}
     return _class_tubes_group(labels), {"Radius": FACE_EDGE_SCALE * radius, **inputs}
@@ -181,13 +185,9 @@ def _overlay_object(name, owner, stage, drawing, radius, collection):
     label = f"Rigger {name}: {owner}"
     mesh = bpy.data.meshes.new(label)
     _fill(mesh, drawing)
-    obj = bpy.data.objects.new(label, mesh)
-    obj[KIND_KEY] = name
-    obj[OWNER_KEY] = owner
-    obj.hide_select = True
-    obj.hide_render = True
-    obj.show_in_front = True
-    collection.objects.link(obj)
+    obj = _helper_object(label, mesh, name, owner, collection)
+    if isinstance(drawing, Labels):
+        _texts(obj, name, owner, stage, drawing, radius, collection)
     group, values = _modifier_inputs(name, stage, drawing, radius)
     modifier = obj.modifiers.new(MODIFIER_NAME, 'NODES')
     modifier.node_group = group
@@ -196,6 +196,34 @@ def _overlay_object(name, owner, stage, drawing, radius, collection):
             modifier[item.identifier] = values[item.name]
     obj.update_tag()
     return obj
+
+
+def _helper_object(label, data, name, owner, collection):
+    """An overlay object of stage ``name`` for ``owner``: marked, not selectable, not rendered, drawn in front."""
+    obj = bpy.data.objects.new(label, data)
+    obj[KIND_KEY] = name
+    obj[OWNER_KEY] = owner
+    obj.hide_select = True
+    obj.hide_render = True
+    obj.show_in_front = True
+    collection.objects.link(obj)
+    return obj
+
+
+def _texts(parent, name, owner, stage, drawing, radius, collection):
+    """A text object per label beside its point, children of ``parent``: upright (readable from the front, -Y),
+    ``LABEL_SCALE`` line radii high, in the stage's colour."""
+    material = _material(f"Rigger {name}", stage.colour)
+    for index, (point, text) in enumerate(zip(drawing.points, drawing.texts)):
+        curve = bpy.data.curves.new(f"{parent.name} {index:03d}", 'FONT')
+        curve.body = text
+        curve.size = LABEL_SCALE * radius
+        curve.materials.append(material)
+        curve[MADE_KEY] = True
+        label = _helper_object(curve.name, curve, name, owner, collection)
+        label.parent = parent
+        label.location = (point[0] + 2 * LABEL_POINT_SCALE * radius, point[1], point[2])
+        label.rotation_euler = (math.pi / 2, 0.0, 0.0)
 
 
 def _show(obj, visible):
@@ -207,12 +235,12 @@ def _show(obj, visible):
 
 
 def _remove_objects(chosen):
-    """Remove the overlay objects ``chosen`` accepts, and their meshes unless something else uses them."""
+    """Remove the overlay objects ``chosen`` accepts, and their meshes and texts unless something else uses them."""
     for obj in [obj for obj in bpy.data.objects if KIND_KEY in obj and chosen(obj)]:
-        mesh = obj.data
+        data = obj.data
         bpy.data.objects.remove(obj)
-        if mesh is not None and mesh.users == 0:
-            bpy.data.meshes.remove(mesh)
+        if data is not None and data.users == 0:
+            (bpy.data.meshes if isinstance(data, bpy.types.Mesh) else bpy.data.curves).remove(data)
 
 
 def _collection():

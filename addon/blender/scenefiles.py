@@ -90,10 +90,11 @@ def blender_message(error):
 
 
 def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warnings=(), axes=None):
-    """The JSON-ready report of a rig: method, parameters, bones (mapped from Blender's world into the frame named
-    ``frame`` by the inverse of ``to_world``), the (up, forward) ``axes`` the file was read with (None: Blender's
-    importer chose), timings, the skinning outcome per mesh (``outcomes``: mesh name → skinning report, or None when
-    not skinned) and warnings (``warnings`` first).
+    """The JSON-ready report of a rig: method, parameters, the body plan (kind, confidence, reason, parts), bones
+    (with their roles and sides; mapped from Blender's world into the frame named ``frame`` by the inverse of
+    ``to_world``), the (up, forward) ``axes`` the file was read with (None: Blender's importer chose), timings, the
+    skinning outcome per mesh (``outcomes``: mesh name → skinning report, or None when not skinned) and warnings
+    (``warnings`` first, then one when the body plan was not recognised).
 
     Timings are plain floats whatever number type the method recorded (numpy scalars are not JSON).
     """
@@ -109,12 +110,16 @@ def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warn
                             "meshes": {name: report.as_dict() for name, report in outcomes.items()}}
         warnings += [warning for report in outcomes.values() for warning in report.warnings]
     skeleton = result.skeleton
+    plan = skeleton.body_plan
+    if plan is not None and plan.warning:
+        warnings.append(plan.warning)
     timings = {**result.timings, **{f"method.{k}": v for k, v in skeleton.timings.items()}}
     return {
         "frame": frame,
         "axes": None if axes is None else dict(zip(("up", "forward"), axes)),
         "method": result.armature.get(METHOD_PROPERTY),
         "params": skeleton.params,
+        "body_plan": None if plan is None else plan.to_dict(),
         "bones": skeleton.transformed(to_frame).to_dict()["bones"],
         "timings": {name: float(seconds) for name, seconds in timings.items()},
         "skinning": skinning_outcome,

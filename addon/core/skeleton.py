@@ -1,6 +1,7 @@
 """The skeleton a method returns: a validated tree of bones plus the intermediate results that produced it."""
 import numpy as np
 
+from .roles import BoneRole
 from .stages import Stage
 
 
@@ -17,9 +18,13 @@ class Skeleton:
             them as read-only.
         timings: seconds per step of the method; :func:`rigger.rig_mesh` adds ``"total"``.
         params: the parameter values the method ran with (:func:`rigger.rig_mesh` fills them in).
+        body_plan: the recognised ``rigger.core.bodyplan.BodyPlan`` (kind, confidence, reason), or None before
+            recognition (:func:`rigger.rig_mesh` fills it in).
+        roles: one ``rigger.core.roles.BoneRole`` (role, side, index, digit) per bone, or None before recognition.
     """
 
-    def __init__(self, names, heads, tails, parents, stages=None, timings=None, params=None):
+    def __init__(self, names, heads, tails, parents, stages=None, timings=None, params=None, roles=None,
+                 body_plan=None):
         self.names = _validated_names(names)
         count = len(self.names)
         self.heads = _validated_points(heads, count, "heads")
@@ -31,6 +36,34 @@ class Skeleton:
         self.stages = _validated_stages({} if stages is None else stages)
         self.timings = {} if timings is None else dict(timings)
         self.params = {} if params is None else dict(params)
+        self.roles = roles
+        self.body_plan = body_plan
+
+    @property
+    def roles(self):
+        """One ``BoneRole`` per bone, or None before the body plan was recognised."""
+        return self._roles
+
+    @roles.setter
+    def roles(self, roles):
+        if roles is not None:
+            roles = tuple(roles)
+            if len(roles) != len(self) or not all(isinstance(role, BoneRole) for role in roles):
+                raise ValueError(f"roles must be one rigger.core.roles.BoneRole per bone ({len(self)})")
+        self._roles = roles
+
+    @property
+    def body_plan(self):
+        """The recognised ``BodyPlan``, or None before recognition."""
+        return self._body_plan
+
+    @body_plan.setter
+    def body_plan(self, plan):
+        from .bodyplan import BodyPlan
+
+        if plan is not None and not isinstance(plan, BodyPlan):
+            raise ValueError(f"body_plan must be a rigger.core.bodyplan.BodyPlan, got {type(plan).__name__}")
+        self._body_plan = plan
 
     def __len__(self):
         return len(self.names)
@@ -59,7 +92,8 @@ class Skeleton:
     def transformed(self, matrix):
         """A copy with heads and tails mapped by the affine 4x4 ``matrix`` (e.g. world to armature-local frame).
 
-        ``stages``, ``timings`` and ``params`` are shared by reference: the stages stay in the world's frame.
+        ``stages``, ``timings``, ``params``, ``roles`` and ``body_plan`` are shared by reference: the stages and the
+        plan's up stay in the world's frame.
         """
         matrix = np.asarray(matrix, dtype=np.float64)
         if matrix.shape != (4, 4) or not np.isfinite(matrix).all():
@@ -70,13 +104,14 @@ class Skeleton:
             raise ValueError("transform is singular")
         linear, offset = matrix[:3, :3], matrix[:3, 3]
         moved = Skeleton(self.names, self.heads @ linear.T + offset, self.tails @ linear.T + offset, self.parents,
-                         self.stages)
+                         self.stages, roles=self.roles, body_plan=self.body_plan)
         moved.timings, moved.params = self.timings, self.params
         return moved
 
     def to_dict(self):
         """``{"bones": [{"name", "head", "tail", "parent"}, ...]}`` with plain floats and the parent's name (None
-        for a root): ready for JSON. Stages are not included."""
+        for a root): ready for JSON. With roles, each bone also has its ``role``, ``side``, ``role_index`` and
+        ``digit``; stages are not included."""
         bones = [
             {
                 "name": name,
@@ -87,6 +122,8 @@ class Skeleton:
             for name, head, tail, parent in zip(self.names, self.heads.tolist(), self.tails.tolist(),
                                                 self.parents.tolist())
         ]
+        for bone, role in zip(bones, self.roles or ()):
+            bone.update(role=role.role, side=role.side, role_index=role.index, digit=role.digit)
         return {"bones": bones}
 
     @classmethod

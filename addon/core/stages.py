@@ -2,8 +2,8 @@
 
 A stage checks its own arrays when it is made (ValueError naming the stage and what is wrong), maps itself from
 the frame a method worked in back to the world (``mapped``), and says how it is drawn (``drawing``: world-space
-``Lines``, ``Points`` or ``ClassedFaces``, or None for data that is not drawn). The Blender layer draws those three
-primitives and nothing else, so a new stage type, a subclass of :class:`Stage`, gets its overlay without a line
+``Lines``, ``Points``, ``ClassedFaces`` or ``Labels``, or None for data that is not drawn). The Blender layer draws
+those primitives and nothing else, so a new stage type, a subclass of :class:`Stage`, gets its overlay without a line
 changed there. Planar stages (an outline, a triangulation, a graph in a view's plane) hold the :class:`Frame` of
 their view, whose plane gives their 2D points a place in 3D.
 """
@@ -83,6 +83,21 @@ class ClassedFaces:
                              f"triangle")
         object.__setattr__(self, "triangles", triangles)
         object.__setattr__(self, "classes", classes.astype(np.int64))
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Labels:
+    """Short texts at points: ``points`` (K, 3) and one string per point (``texts``), drawn as text."""
+
+    points: np.ndarray
+    texts: tuple
+
+    def __post_init__(self):
+        _primitive_points(self)
+        texts = tuple(self.texts) if isinstance(self.texts, (list, tuple)) else None
+        if texts is None or len(texts) != len(self.points) or not all(isinstance(text, str) for text in texts):
+            raise ValueError(f"Labels: 'texts' must be one string per point ({len(self.points)})")
+        object.__setattr__(self, "texts", texts)
 
 
 class Stage:

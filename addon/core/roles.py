@@ -1,0 +1,479 @@
+"""Bone roles: what each bone of a skeleton is in its body plan (a thigh, the second spine bone, the left index finger's
+first bone), given the plan's layout of the body (``core.bodyplan``). Bones keep their names; roles sit beside them.
+
+Along the spine, from the tail end to the head end: tail (or root, a bone rising from the ground to the hips),
+hips, spine, chest up to where the arms, wings or front legs hang, then neck up to the spine's thinnest joint above
+them and head beyond (one bone there is the neck: it pivots where a neck does; a fish: head, spine and tail by
+length). A leg: hips (its bones from the mirror plane until it
+leaves it and turns down; shoulder for a front leg), thigh, shin from the knee (a bend near ``knee_at``, else the
+joint nearest it), foot from the joint nearest an ankle's height, and toe (the last bone when the foot has two or
+more); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up to where it leaves the torso, then
+upper_arm, forearm and hand by shares of the rest of its reach where the artists' humanoids have an elbow and a
+wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the one that leaves earliest
+and points most away the thumb, the others index, middle, ring and pinky in order across the hand. Twins are cut at
+the same joints (on their mirror-averaged points). Wings, fins, ears, tails and jaws take their part's role for
+every bone. A body plan that is ``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when
+a limb's bones have them, else the side of the mirror plane, left being the character's left when its front is known
+(Blender's +X for a character facing -Y).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .stages import Labels, Stage
+from .tuning import TuningTable, tuned
+
+ROLES = ("root", "hips", "spine", "chest", "neck", "head", "jaw", "shoulder", "upper_arm", "forearm", "hand", "finger",
+         "thigh", "shin", "foot", "toe", "tail", "ear", "wing", "fin", "other")
+DIGITS = ("thumb", "index", "middle", "ring", "pinky")
+SIDES = ("L", "R", None)
+
+
+@dataclass(frozen=True)
+class BoneRole:
+    """A bone's ``role`` (one of ``ROLES``), ``side`` ("L", "R" or None), ``index`` (its place among the bones of
+    that role and side along its chain, from the body outwards: spine 0, 1, 2; a finger's segments) and, for a
+    finger, its ``digit`` (one of ``DIGITS``, or None when the hand shows no clear thumb)."""
+
+    role: str
+    side: str = None
+    index: int = 0
+    digit: str = None
+
+    def __post_init__(self):
+        if self.role not in ROLES:
+            raise ValueError(f"unknown bone role {self.role!r}; roles are {', '.join(ROLES)}")
+        if self.side not in SIDES:
+            raise ValueError(f"a bone's side is 'L', 'R' or None, got {self.side!r}")
+        if not isinstance(self.index, int) or isinstance(self.index, bool) or self.index < 0:
+            raise ValueError(f"a bone role's index is a whole number >= 0, got {self.index!r}")
+        if self.digit is not None and (self.role != "finger" or self.digit not in DIGITS):
+            raise ValueError(f"only fingers have a digit ({', '.join(DIGITS)}), got {self.digit!r} on a "
+                             f"{self.role}")
+
+    @property
+    def label(self):
+        """Short text: ``thigh.L``, ``spine.2``, ``finger.index.1.R``."""
+        words = [self.role] + ([self.digit] if self.digit else []) + ([str(self.index)] if self.index else [])
+        return ".".join(words) + (f".{self.side}" if self.side else "")
+
+    def to_dict(self):
+        return {"role": self.role, "side": self.side, "index": self.index, "digit": self.digit}
+
+
+@dataclass(frozen=True)
+class RoleTuning(TuningTable):
+    """The tuned numbers of giving bones their roles."""
+
+    thigh_drop: float = tuned(0.8, "a leg's thigh starts at its first joint off the mirror plane from which it runs "
+                                   "this steeply down (cosine of the angle from down); the bones before run out from "
+                                   "the body: hips")
+    plane_exit: float = tuned(0.01, "a leg leaves the mirror plane at its first joint this far off it (legs close "
+                                    "together stand 0.035 off it)")
+    ankle_height: float = tuned(0.065, "a leg's ankle is its joint nearest this height (a share of the mesh's; the "
+                                       "artists' humanoids: 0.036 to 0.08, median 0.064)")
+    foot_height: float = tuned(0.15, "... among its joints this low or lower")
+    bend: float = tuned(25.0, "degrees: a limb joint turning this much near where an elbow or a knee belongs is one")
+    bend_window: float = tuned(0.2, "a bend counts within this share of the limb's length of where the joint belongs")
+    knee_at: float = tuned(0.47, "a knee's share of the way from the hip to the ankle (the artists' humanoids: 0.38 "
+                                 "to 0.49, median 0.47)")
+    shoulder_thickness: float = tuned(1.3, "an arm's shoulder joint is its first joint where the mesh is at most this "
+                                           "many times as thick as along the arm (the torso is thicker) ...")
+    arm_from: float = tuned(0.3, "... the arm's thickness being the median at its joints from this share of its "
+                                 "reach ...")
+    arm_to: float = tuned(0.8, "... to this share (the upper arm and forearm, not the torso or the hand)")
+    shoulder_at: float = tuned(0.22, "else the shoulder joint's share of the way from where the arm hangs to the "
+                                     "end of its hand (the artists' humanoids: 0.18 to 0.31, median 0.23)")
+    elbow_at: float = tuned(0.39, "an elbow's share of the way from the shoulder joint to the end of the hand (the "
+                                  "artists' humanoids: 0.37 to 0.42)")
+    wrist_at: float = tuned(0.73, "a wrist's share of that way (0.65 to 0.79, median 0.74)")
+    head_share: float = tuned(0.25, "a fish's head: this share of its spine's length from the head end")
+    tail_share: float = tuned(0.35, "a fish's tail: this share from the tail end")
+    tail_length: float = tuned(0.08, "spine behind the hips this long (a share of the size) is a tail, not hips")
+
+
+def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
+    """One :class:`BoneRole` per bone of ``skeleton`` (see the module docstring), from its ``body``
+    (``core.body.Body``) and ``layout`` (``core.bodyplan.Layout``)."""
+    graph = body.graph
+    segment_bone = {}
+    for a, links in enumerate(graph.neighbours):
+        for b, bone in links:
+            if bone >= 0:
+                segment_bone[(a, b)] = bone
+    roles = [None] * len(skeleton)
+
+    def put(nodes, names, side=None):
+        counts = {}
+        for (a, b), name in zip(zip(nodes, nodes[1:]), names):
+            bone = segment_bone.get((a, b))
+            if bone is None or roles[bone] is not None or name is None:
+                continue
+            role, digit = name if isinstance(name, tuple) else (name, None)
+            key = (role, digit)
+            roles[bone] = BoneRole(role, side, counts.get(key, 0), digit)
+            counts[key] = counts.get(key, 0) + 1
+
+    kind = layout.plan.kind
+    left = _left_sign(body, layout)
+    spine_names = _spine_roles(body, layout, tuning)
+    below = [index for index, name in enumerate(spine_names) if name in ("tail", "root")]
+    spine = list(layout.spine)
+    if below:  # tail and root bones count from the body outwards
+        cut = below[-1] + 1
+        put(spine[:cut + 1][::-1], spine_names[:cut][::-1])
+    put(spine, spine_names)
+    for node, base in body.connectors.items():
+        for other, bone in graph.neighbours[node]:
+            if bone >= 0 and roles[bone] is None:
+                roles[bone] = BoneRole(_connector_role(spine, spine_names, base) if kind != "other" else "other")
+    for k, limb in enumerate(body.limbs):
+        side = _limb_side(skeleton, graph, limb, left)
+        part = layout.parts[k]
+        points = _twin_points(body, limb)
+        if part == "leg":
+            _leg(body, limb, points, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
+        elif part == "arm":
+            _arm(body, limb, points, tuning, lambda nodes, names: put(nodes, names, side))
+        for nodes in _paths(limb):
+            put(nodes, [part] * (len(nodes) - 1), side)
+    return _filled(roles, skeleton, kind)
+
+
+def _filled(roles, skeleton, kind):
+    """``roles`` with the bones the body left out (a bone shorter than a joint, a link closing a loop) given the
+    role of the first child bone that has one (a collapsed bone sits at its start), else their parent's, else
+    ``other``."""
+    parents = skeleton.parents.tolist()
+    children = {}
+    for bone, parent in enumerate(parents):
+        children.setdefault(parent, []).append(bone)
+    roles = list(roles)
+    for _ in range(len(roles)):
+        missing = [bone for bone, role in enumerate(roles) if role is None]
+        if not missing:
+            break
+        for bone in missing:
+            given = [roles[child] for child in children.get(bone, ()) if roles[child] is not None]
+            if given:
+                roles[bone] = given[0]
+    for bone, role in enumerate(roles):
+        if role is None:
+            parent = parents[bone]
+            roles[bone] = roles[parent] if kind != "other" and parent >= 0 and roles[parent] is not None \
+                else BoneRole("other")
+    return tuple(roles)
+
+
+def _twin_points(body, limb):
+    """The joints along ``limb``'s main path, averaged with its twin's mirror image when both have as many: twins
+    get their roles cut at the same joints."""
+    points = body.graph.points[list(limb.main)]
+    twin = body.limbs[limb.twin] if limb.twin >= 0 else None
+    if twin is not None and len(twin.main) == len(limb.main) and body.plane is not None:
+        points = 0.5 * (points + body.plane.reflect(body.graph.points[list(twin.main)]))
+    return points
+
+
+def _paths(limb):
+    """Every path of ``limb`` from where it hangs to one of its leaves, the main one first."""
+    children = {}
+    for node, before in limb.before.items():
+        children.setdefault(before, []).append(node)
+    leaves = [node for node in limb.before if node not in children]
+    paths = [list(limb.main)]
+    for leaf in leaves:
+        if leaf == limb.main[-1]:
+            continue
+        path = [leaf]
+        while path[-1] != limb.attach:
+            path.append(limb.before[path[-1]])
+        paths.append(path[::-1])
+    return paths
+
+
+# The spine.
+
+def _spine_roles(body, layout, tuning):
+    """Roles of the spine's bones, from its tail end to its head end."""
+    spine = list(layout.spine)
+    count = len(spine) - 1
+    if count <= 0:
+        return []
+    kind = layout.plan.kind
+    if kind == "other":
+        return ["other"] * count
+    points = body.graph.points[spine]
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    middle = 0.5 * (arc[1:] + arc[:-1]) / max(arc[-1], 1e-300)
+    if kind == "fish":
+        return ["tail" if at < tuning.tail_share else "head" if at > 1 - tuning.head_share else "spine"
+                for at in middle]
+    hips = max(layout.hips, 0)
+    chest = layout.chest if layout.chest > hips else min(count, hips + max(1, round(0.65 * (count - hips))))
+    names = []
+    behind = arc[hips]
+    if hips > 0:
+        lowest = spine[0]
+        grounded = body.touches(lowest, 0.05) and body.height(points[0]) < body.height(points[hips])
+        name = "root" if grounded else "tail" if behind >= tuning.tail_length * body.size else "hips"
+        names += [name] * hips
+    torso = chest - hips
+    names += (["hips"] + ["spine"] * (torso - 2) + ["chest"]) if torso >= 3 else ["hips", "spine"][:torso]
+    above = count - chest
+    if above >= 3:
+        thinnest = chest + 1 + int(np.argmin(body.radius[spine[chest + 1:count]]))
+        names += ["neck"] * (thinnest - chest) + ["head"] * (count - thinnest)
+    else:
+        names += ["neck", "head"][:above]  # one bone into the head pivots at the neck
+    return names
+
+
+def _connector_role(spine, names, base):
+    """The role of a midline bone off the spine hanging from spine joint ``base``: that of the spine bone leaving
+    it towards the head (or arriving, at the head end)."""
+    if not names:
+        return "other"
+    at = spine.index(base) if base in spine else 0
+    return names[min(at, len(names) - 1)]
+
+
+# Limbs.
+
+def _leg(body, limb, points, front, tuning, put):
+    """Roles along a leg's main path (``points``): hips (or shoulder), thigh, shin, foot, toe (front legs: shoulder,
+    upper_arm, forearm, hand)."""
+    nodes = list(limb.main)
+    steps = np.diff(points, axis=0)
+    lengths = np.maximum(np.linalg.norm(steps, axis=1), 1e-300)
+    down = -(steps @ body.up) / lengths
+    last = len(nodes) - 1
+    off = 0 if body.plane is None else next(
+        (i for i in range(last + 1) if abs(body.plane.distance(points[i])) > tuning.plane_exit * body.size), last)
+    thigh = next((i for i in range(off, last) if down[i] >= tuning.thigh_drop), off if off < last else 0)
+    heights = body.height(points)
+    low = [i for i in range(thigh + 2, last + 1) if heights[i] <= tuning.foot_height]
+    ankle = min(low, key=lambda i: abs(heights[i] - tuning.ankle_height)) if low else last
+    toe = last - 1 if last - ankle >= 2 else last
+    knee = _pick(points, thigh + 1, ankle - 1, tuning.knee_at, tuning, thigh, ankle) if ankle - thigh >= 2 \
+        else ankle
+    names = (["shoulder", "upper_arm", "forearm", "hand", "hand"] if front else
+             ["hips", "thigh", "shin", "foot", "toe"])
+    roles = _segments(names, [thigh, knee, ankle, toe, last])
+    put(nodes, roles)
+    for path in _paths(limb)[1:]:  # toes and spurs: a branch past the ankle is a toe
+        split = _fork(path, nodes)
+        put(path[split:], ["toe" if split >= ankle else roles[min(split, len(roles) - 1)] if roles else "other"]
+            * (len(path) - 1 - split))
+
+
+def _segments(names, cuts):
+    """Role per bone: ``names[k]`` for the bones before joint ``cuts[k]`` (and after the cut before it)."""
+    roles, start = [], 0
+    for name, end in zip(names, cuts):
+        roles += [name] * (end - start)
+        start = max(start, end)
+    return roles
+
+
+def _arm(body, limb, points, tuning, put):
+    """Roles along an arm: shoulder up to the shoulder joint (where the arm leaves the torso, :func:`_shoulder`),
+    then upper_arm, forearm and hand by where each bone's middle lies, at ``elbow_at`` and ``wrist_at`` of the way
+    from that joint to the end of the arm's reach (the mesh beyond its last joint included: an artist's arm may end
+    at the wrist), the elbow at a bend near its share; the fingers beyond the hand."""
+    nodes = list(limb.main)
+    last = len(nodes) - 1
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    total = arc[-1] + _reach(body, points)
+    middle = 0.5 * (arc[1:] + arc[:-1])
+    shoulder = _shoulder(body, nodes, arc, total, tuning)
+    rest = total - arc[min(shoulder, last)]  # from the shoulder joint on
+    elbow, wrist = (int(np.searchsorted(middle, arc[min(shoulder, last)] + share * rest))
+                    for share in (tuning.elbow_at, tuning.wrist_at))
+    bent = _pick(points, shoulder + 1, wrist - 1, tuning.elbow_at, tuning, min(shoulder, last), last, rest,
+                 bends_only=True)
+    elbow = elbow if bent is None else bent
+    branches = _paths(limb)[1:]
+    forks = sorted({_fork(path, nodes) for path in branches})
+    fingers_from = forks[0] if forks else last
+    wrist = min(wrist, fingers_from) if fingers_from > elbow else wrist
+    fingers_from = max(fingers_from, wrist)
+    roles = _segments(["shoulder", "upper_arm", "forearm", "hand"], [shoulder, elbow, wrist, fingers_from])
+    put(nodes[:fingers_from + 1], roles)
+    if fingers_from >= last and not branches:
+        return
+    fingers = [nodes[fingers_from:]] if fingers_from < last else []
+    fingers += [path[_fork(path, nodes):] for path in branches]
+    raw = body.graph.points[nodes]
+    for finger, digit in zip(fingers, _digits(body, fingers, raw[wrist], raw[min(fingers_from, last)], raw[elbow])):
+        put(finger, [("finger", digit)] * (len(finger) - 1))
+
+
+def _shoulder(body, nodes, arc, total, tuning):
+    """Index of an arm's shoulder joint: its first joint where the mesh is about as thin as along the arm
+    (``shoulder_thickness`` times the median half-thickness of its joints between ``arm_from`` and ``arm_to`` of
+    its reach): the arm has left the torso there. Else the joint where the bones pass ``shoulder_at`` of the reach."""
+    middle = 0.5 * (arc[1:] + arc[:-1])
+    radius = body.radius[nodes]
+    share = arc / max(total, 1e-300)
+    along = radius[(share >= tuning.arm_from) & (share <= tuning.arm_to)]
+    if len(along):
+        thin = np.flatnonzero(radius[1:] <= tuning.shoulder_thickness * np.median(along)) + 1
+        if len(thin) and share[thin[0]] < tuning.elbow_at:
+            return int(thin[0])
+    return int(np.searchsorted(middle, tuning.shoulder_at * total))
+
+
+def _reach(body, points):
+    """How far the mesh goes on beyond the last of ``points``, along the last bone's direction (within a tube of
+    the radius there)."""
+    direction = points[-1] - points[-2]
+    norm = np.linalg.norm(direction)
+    if not norm > 0:
+        return 0.0
+    direction /= norm
+    offsets = body.vertices - points[-1]
+    along = offsets @ direction
+    across = np.linalg.norm(offsets - np.outer(along, direction), axis=1)
+    tube = max(2 * float(np.min(np.linalg.norm(body.vertices - points[-1], axis=1))), 0.02 * body.size)
+    beyond = along[(along > 0) & (across <= tube) & (along <= 0.25 * body.size)]
+    return float(beyond.max()) if len(beyond) else 0.0
+
+
+def _fork(path, nodes):
+    """Where ``path`` leaves the main path ``nodes`` (its index in both)."""
+    return next(i for i, node in enumerate(path) if i + 1 >= len(path) or path[i + 1] not in nodes)
+
+
+def _digits(body, fingers, wrist, palm, elbow):
+    """Digit names for the finger paths: with three or more, the one leaving the hand earliest and pointing most
+    away from it (the forearm's way when the fingers leave from the wrist) is the thumb, the others index, middle,
+    ring, pinky by their tips' distance from the thumb's; otherwise none."""
+    if len(fingers) < 3:
+        return [None] * len(fingers)
+    points = body.graph.points
+    span = float(np.linalg.norm(palm - wrist))
+    hand = palm - wrist if span > 0 else wrist - elbow
+    hand = hand / max(np.linalg.norm(hand), 1e-300)
+
+    def away(finger):
+        direction = points[finger[-1]] - points[finger[0]]
+        norm = np.linalg.norm(direction)
+        later = np.linalg.norm(points[finger[0]] - wrist) / span if span > 0 else 0.0
+        return (1 - (direction @ hand) / norm if norm > 0 else 0) - later
+
+    thumb = max(range(len(fingers)), key=lambda k: away(fingers[k]))
+    order = sorted((k for k in range(len(fingers)) if k != thumb),
+                   key=lambda k: np.linalg.norm(points[fingers[k][-1]] - points[fingers[thumb][-1]]))
+    names = [None] * len(fingers)
+    names[thumb] = "thumb"
+    for name, k in zip(DIGITS[1:], order):
+        names[k] = name
+    return names
+
+
+def _pick(points, low, high, share, tuning, start=0, end=None, total=None, bends_only=False):
+    """The joint in [low, high] for a joint at ``share`` of the way (by length) from joint ``start`` to joint ``end``
+    (or to ``total`` past ``start``): the sharpest bend within ``bend_window`` of it when one turns by ``bend`` or
+    more, else the nearest (None with ``bends_only``)."""
+    end = len(points) - 1 if end is None else end
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    span = (arc[end] - arc[start]) if total is None else total
+    at = (arc - arc[start]) / max(span, 1e-300)
+    candidates = np.arange(int(low), int(max(low, high)) + 1)
+    candidates = candidates[(candidates > 0) & (candidates < len(points))]
+    if not len(candidates):
+        return None if bends_only else int(low)
+    turns = np.array([_turn(points, i) for i in candidates])
+    bent = (np.abs(at[candidates] - share) <= tuning.bend_window) & (turns >= tuning.bend)
+    if bent.any():
+        return int(candidates[bent][np.argmax(turns[bent])])
+    return None if bends_only else int(candidates[np.argmin(np.abs(at[candidates] - share))])
+
+
+def _turn(points, i):
+    """Degrees the path turns at joint ``i`` (0 at its ends)."""
+    if i <= 0 or i >= len(points) - 1:
+        return 0.0
+    a, b = points[i] - points[i - 1], points[i + 1] - points[i]
+    norms = np.linalg.norm(a) * np.linalg.norm(b)
+    return float(np.degrees(np.arccos(np.clip(a @ b / norms, -1, 1)))) if norms > 0 else 0.0
+
+
+# Sides.
+
+def _left_sign(body, layout):
+    """+1 when the mirror plane's positive side is the character's left, -1 when it is its right: up x forward
+    (the character's left) when its front is known, else +1 (Blender's +X left for a character facing -Y)."""
+    if body.plane is None or layout.forward is None or layout.plan.kind not in ("quadruped", "bird", "fish"):
+        return 1
+    return 1 if np.cross(body.up, layout.forward) @ body.plane.normal >= 0 else -1
+
+
+def _limb_side(skeleton, graph, limb, left):
+    """"L", "R" or None: from the limb's bone names when they all end in one of .L / .R, else its side of the plane."""
+    suffixes = {skeleton.names[bone][-2:] for node, before in limb.before.items()
+                for bone in [graph.bone_between(node, before)] if bone >= 0}
+    if suffixes in ({".L"}, {".R"}):
+        return suffixes.pop()[1]
+    if limb.side == 0:
+        return None
+    return "L" if limb.side * left > 0 else "R"
+
+
+CHAINS = (("hips", "spine", "chest", "neck", "head"), ("shoulder", "upper_arm", "forearm", "hand"),
+          ("hips", "thigh", "shin", "foot", "toe"))  # roles that follow each other along a chain
+
+
+def named_joints(skeleton, roles=None):
+    """{(role, side, digit): point}: where each role begins on ``skeleton`` (with ``roles``, default its own) — the
+    end of the bones of the role before it in its chain (a knee where the thigh ends, a hip joint where a leg's hips
+    bone ends; a leg's thigh follows its own side's hips, else the body's), else the start of its first bone (a
+    finger's base); and where a chain's role has no bone, after a last bone with nothing beyond it, that bone's end
+    (the wrist of an arm whose forearm ends there). Roles ``other`` have none."""
+    roles = skeleton.roles if roles is None else roles
+    if roles is None or len(roles) != len(skeleton):
+        raise ValueError("named_joints needs one role per bone (recognise the body plan first)")
+    first, last = {}, {}  # (role, side, digit) -> bone
+    for bone, role in enumerate(roles):
+        if role.role == "other":
+            continue
+        key = (role.role, role.side, role.digit)
+        if key not in first or role.index < roles[first[key]].index:
+            first[key] = bone
+        if key not in last or role.index >= roles[last[key]].index:
+            last[key] = bone
+    is_leaf = np.ones(len(skeleton), dtype=bool)
+    is_leaf[skeleton.parents[skeleton.parents >= 0]] = False
+    joints = {key: skeleton.heads[bone] for key, bone in first.items()}
+    for chain in CHAINS:
+        for side in ("L", "R", None):
+            for before, role in zip(chain, chain[1:]):
+                previous = next((key for key in ((before, side, None), (before, None, None)) if key in last), None)
+                if previous is None:
+                    continue
+                if (role, side, None) in first or is_leaf[last[previous]]:
+                    joints[(role, side, None)] = skeleton.tails[last[previous]]
+    return joints
+
+
+@dataclass(frozen=True, eq=False)
+class Roles(Stage):
+    """Each bone's role as a label at its middle: ``points`` (B, 3) and ``texts`` (B,)."""
+
+    points: np.ndarray
+    texts: tuple
+
+    label = "Bone Roles"
+    colour = (1.0, 0.55, 0.1)
+
+    def __post_init__(self):
+        self.drawing()  # Labels checks the arrays
+
+    @classmethod
+    def of(cls, skeleton, roles):
+        """The stage labelling ``skeleton``'s bones with ``roles``."""
+        return cls(0.5 * (skeleton.heads + skeleton.tails), tuple(role.label for role in roles))
+
+    def drawing(self):
+        return Labels(np.asarray(self.points, dtype=np.float64), tuple(self.texts)) if len(self.texts) else None

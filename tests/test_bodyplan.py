@@ -1,0 +1,218 @@
+"""Body plan and bone roles (rigger.core.bodyplan, rigger.core.roles): the sample characters' true skeletons and
+Rigger's own get the right plan and sensible roles, twins get twin roles, and bad input gets a clear error."""
+from collections import Counter
+
+import numpy as np
+import pytest
+
+import rigger
+from characters import load_character
+from rigger import samples
+from rigger.core.bodyplan import KINDS, BodyPlan, recognise
+from rigger.core.mesh import Mesh
+from rigger.core.roles import ROLES, BoneRole, Roles, named_joints
+from rigger.core.skeleton import Skeleton
+from rigger.core.stages import Labels
+
+PLANS = {"humanoid": "humanoid", "humanoid_hips": "humanoid", "quadruped": "quadruped", "octopus": "other",
+         "tree": "other", "snake": "fish"}
+Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # Blender's world (Z up) to an OBJ's (Y up)
+
+
+@pytest.fixture(scope="module")
+def rigged():
+    """Rigger's skeleton of every sample character."""
+    return {name: rigger.rig_mesh(*load_character(name)) for name in PLANS}
+
+
+def truth(name):
+    """(plan, roles) of the sample's true skeleton on its mesh."""
+    return recognise(samples.ground_truth_bones(name), load_character(name))
+
+
+def counted(roles):
+    """How many bones have each (role, side)."""
+    return Counter((role.role, role.side) for role in roles)
+
+
+def has_sides(roles, *names):
+    """Whether ``roles`` hold each of ``names`` on both sides."""
+    found = counted(roles)
+    return all(found[(name, "L")] and found[(name, "R")] for name in names)
+
+
+@pytest.mark.parametrize("name", PLANS)
+def test_the_true_skeletons_get_the_right_plan(name):
+    plan, roles = truth(name)
+    assert plan.kind == PLANS[name], plan.reason
+    assert 0 < plan.confidence <= 1 and plan.reason
+    assert len(roles) == len(samples.ground_truth_bones(name)) and all(role.role in ROLES for role in roles)
+
+
+@pytest.mark.parametrize("name", PLANS)
+def test_rigger_s_skeletons_get_the_right_plan(rigged, name):
+    skeleton = rigged[name]
+    assert skeleton.body_plan.kind == PLANS[name], skeleton.body_plan.reason
+    assert len(skeleton.roles) == len(skeleton)
+
+
+@pytest.mark.parametrize("name", ["humanoid", "humanoid_hips"])
+def test_a_true_humanoid_has_two_legs_two_arms_and_a_head(name):
+    plan, roles = truth(name)
+    bones = dict(zip(samples.ground_truth_bones(name).names, roles))
+    assert has_sides(roles, "thigh", "shin", "foot", "upper_arm", "forearm", "hand")
+    assert plan.parts == {"legs": 2, "arms": 2}
+    for side in "LR":  # each true bone gets its own role: the sample names its bones after their roles
+        assert [bones[f"{bone}.{side}"].role for bone in ("thigh", "shin", "foot", "upper_arm", "forearm", "hand")] \
+            == ["thigh", "shin", "foot", "upper_arm", "forearm", "hand"]
+        assert bones[f"pelvis.{side}"].role == "hips" and bones[f"shoulder.{side}"].role == "shoulder"
+    assert {bones[bone].role for bone in ("head", "head_top")} == {"head"} and bones["neck"].role == "neck"
+    assert bones["spine"].role == "hips" and bones["chest"].role in ("spine", "chest")
+
+
+def test_rigger_s_humanoid_has_two_legs_two_arms_and_a_head(rigged):
+    roles = rigged["humanoid"].roles
+    assert has_sides(roles, "thigh", "shin", "foot", "upper_arm", "forearm", "hand")
+    assert counted(roles)[("head", None)] >= 1 and counted(roles)[("hips", None)] == 1
+
+
+def test_rigger_s_humanoid_with_hands_on_hips_keeps_its_legs_and_head(rigged):
+    """The method joins each hand to the hip it rests on, so an arm runs out from the hips; its legs, upper arms and
+    head are still named."""
+    roles = rigged["humanoid_hips"].roles
+    assert has_sides(roles, "thigh", "shin", "foot", "upper_arm")
+    assert counted(roles)[("head", None)] >= 1
+
+
+def test_a_quadruped_has_four_legs_a_tail_and_a_head(rigged):
+    for roles in (truth("quadruped")[1], rigged["quadruped"].roles):
+        assert has_sides(roles, "thigh", "shin", "upper_arm", "forearm")  # hind and front legs
+        assert counted(roles)[("head", None)] >= 1 and counted(roles)[("tail", None)] >= 1
+    bones = dict(zip(samples.ground_truth_bones("quadruped").names, truth("quadruped")[1]))
+    assert [bones[f"tail_0{k}"].role for k in (1, 2, 3)] == ["tail"] * 3
+    assert [bones[f"tail_0{k}"].index for k in (1, 2, 3)] == [0, 1, 2]  # counted from the body outwards
+    assert bones["thigh.L"].side == "L" and bones["upper_arm.R"].side == "R"
+
+
+def test_a_snake_is_a_head_a_spine_and_a_tail_from_its_thick_end(rigged):
+    for skeleton, roles in ((samples.ground_truth_bones("snake"), truth("snake")[1]),
+                            (rigged["snake"], rigged["snake"].roles)):
+        assert {role.role for role in roles} == {"head", "spine", "tail"}
+        heads = [bone for bone, role in enumerate(roles) if role.role == "head"]
+        tails = [bone for bone, role in enumerate(roles) if role.role == "tail"]
+        head_end = skeleton.heads[heads].mean(axis=0)
+        assert head_end[1] < skeleton.heads[tails].mean(axis=0)[1]  # the head lies at the -Y end
+
+
+@pytest.mark.parametrize("name", ["octopus", "tree"])
+def test_an_unknown_plan_keeps_plain_roles_and_says_why(rigged, name):
+    for plan, roles in (truth(name), (rigged[name].body_plan, rigged[name].roles)):
+        assert plan.kind == "other" and not plan.recognised
+        assert {role.role for role in roles} == {"other"}
+        assert plan.warning.startswith("body plan not recognised (") and plan.reason in plan.warning
+
+
+@pytest.mark.parametrize("name", ["humanoid", "quadruped", "octopus"])
+def test_twins_get_twin_roles(rigged, name):
+    """Every role on one side has its twin on the other, index for index."""
+    for roles in (truth(name)[1], rigged[name].roles):
+        left = Counter((role.role, role.index, role.digit) for role in roles if role.side == "L")
+        right = Counter((role.role, role.index, role.digit) for role in roles if role.side == "R")
+        assert left == right and left
+
+
+def test_sides_follow_the_bone_names_and_the_mirror_plane(rigged):
+    skeleton = rigged["humanoid"]
+    for name, role in zip(skeleton.names, skeleton.roles):
+        if name.endswith((".L", ".R")):
+            assert role.side == name[-1]
+    plan, roles = recognise(Skeleton(["b%02d" % k for k in range(len(skeleton))], skeleton.heads, skeleton.tails,
+                                     skeleton.parents), load_character("humanoid"))  # no names to go by
+    for role, head, tail in zip(roles, skeleton.heads, skeleton.tails):
+        if role.side:
+            assert np.sign((head + tail)[0]) == (1 if role.side == "L" else -1)  # Blender's +X is the left
+
+
+def test_named_joints_are_where_roles_begin():
+    skeleton = samples.ground_truth_bones("humanoid")
+    plan, roles = truth("humanoid")
+    joints = named_joints(skeleton, roles)
+    position = {joint.name: joint.position for joint in samples.character_joints("humanoid")}
+    np.testing.assert_allclose(joints[("shin", "L", None)], position["thigh.L"])  # the knee: where the thigh ends
+    np.testing.assert_allclose(joints[("thigh", "R", None)], position["pelvis.R"])
+    np.testing.assert_allclose(joints[("hips", None, None)], position["root"])
+    with pytest.raises(ValueError, match="one role per bone"):
+        named_joints(skeleton)  # a skeleton not recognised yet
+
+
+def test_the_plan_stands_in_an_obj_s_frame_and_at_any_scale():
+    """Turned Y up (an OBJ read as it is) and scaled, the humanoid keeps its plan and roles, up from its legs."""
+    skeleton = samples.ground_truth_bones("humanoid")
+    vertices, triangles = load_character("humanoid")
+    plan, roles = truth("humanoid")
+    for turn, scale in ((Y_UP, 1.0), (Y_UP, 1e-200), (np.eye(3), 1e200)):
+        moved = Skeleton(skeleton.names, skeleton.heads @ turn.T * scale, skeleton.tails @ turn.T * scale,
+                         skeleton.parents)
+        turned_plan, turned_roles = recognise(moved, (vertices @ turn.T * scale, triangles))
+        assert turned_plan.kind == "humanoid" and turned_roles == roles
+        np.testing.assert_allclose(turned_plan.up, turn @ [0, 0, 1], atol=1e-9)
+
+
+def test_rig_mesh_fills_in_the_plan_the_roles_and_their_labels(rigged):
+    skeleton = rigged["humanoid"]
+    assert isinstance(skeleton.body_plan, BodyPlan) and skeleton.timings["body_plan"] > 0
+    stage = skeleton.stages["roles"]
+    assert isinstance(stage, Roles) and stage.texts == tuple(role.label for role in skeleton.roles)
+    drawing = stage.drawing()
+    assert isinstance(drawing, Labels) and len(drawing.points) == len(skeleton)
+    np.testing.assert_allclose(drawing.points, 0.5 * (skeleton.heads + skeleton.tails))
+    bones = skeleton.to_dict()["bones"]
+    assert [(bone["role"], bone["side"], bone["role_index"], bone["digit"]) for bone in bones] == \
+        [(role.role, role.side, role.index, role.digit) for role in skeleton.roles]
+    assert set(skeleton.body_plan.to_dict()) == {"kind", "confidence", "reason", "parts"}
+    moved = skeleton.transformed(np.diag([2.0, 2.0, 2.0, 1.0]))
+    assert moved.roles == skeleton.roles and moved.body_plan is skeleton.body_plan
+
+
+def test_labels_read_well():
+    assert BoneRole("thigh", "L").label == "thigh.L"
+    assert BoneRole("spine", None, 2).label == "spine.2"
+    assert BoneRole("finger", "R", 1, "index").label == "finger.index.1.R"
+    assert BoneRole("finger", "R").to_dict() == {"role": "finger", "side": "R", "index": 0, "digit": None}
+
+
+def test_a_plain_stick_is_no_known_plan():
+    vertices = np.array([[x, y, z] for x in (0, 0.1) for y in (0, 0.1) for z in (0, 1)], dtype=float)
+    triangles = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1], [2, 3, 7], [2, 7, 6],
+                          [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    stick = Skeleton(["stick"], [[0.05, 0.05, 0.0]], [[0.05, 0.05, 1.0]], [-1])
+    plan, roles = recognise(stick, Mesh(vertices, triangles))
+    assert plan.kind == "other" and roles == (BoneRole("other"),) and plan.kind in KINDS
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (("not a skeleton", None), "needs a rigger Skeleton"),
+    ((samples.ground_truth_bones("snake"), "no mesh"), "Mesh or a \\(vertices, triangles\\) pair"),
+    ((samples.ground_truth_bones("snake"), (np.zeros((3, 3)), [[0, 1, 2]])), "zero size"),
+])
+def test_bad_input_gets_a_clear_error(arguments, message):
+    with pytest.raises(ValueError, match=message):
+        recognise(*arguments)
+
+
+def test_bad_settings_and_values_get_a_clear_error():
+    skeleton = samples.ground_truth_bones("snake")
+    with pytest.raises(ValueError, match="prefer_up must be a non-zero 3D vector"):
+        recognise(skeleton, load_character("snake"), prefer_up=(0, 0, 0))
+    with pytest.raises(ValueError, match="unknown bone role 'wing_tip'"):
+        BoneRole("wing_tip")
+    with pytest.raises(ValueError, match="side is 'L', 'R' or None"):
+        BoneRole("thigh", "left")
+    with pytest.raises(ValueError, match="only fingers have a digit"):
+        BoneRole("hand", "L", 0, "thumb")
+    with pytest.raises(ValueError, match="one rigger.core.roles.BoneRole per bone"):
+        skeleton.roles = [BoneRole("spine")]
+    with pytest.raises(ValueError, match="must be a rigger.core.bodyplan.BodyPlan"):
+        skeleton.body_plan = "humanoid"
+    with pytest.raises(ValueError, match="one string per point"):
+        Labels(np.zeros((2, 3)), ("only one",))
