@@ -17,6 +17,7 @@ import time
 
 from .axes import AXES, AXIS_SUFFIXES, file_axes
 from .core.files import remove_leftovers, replaced_on_success
+from .core.targets import TARGETS
 
 INPUTS = (".obj", ".glb", ".gltf", ".fbx", ".blend")
 OUTPUTS = (".blend", ".glb", ".fbx")
@@ -74,6 +75,10 @@ def _method_options(parser):
     parser.add_argument("--method", default="silhouette", help="rigging method (see `python -m rigger methods`)")
     parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
                         help="a method parameter, e.g. --set bone_length=0.08 (repeatable)")
+    parser.add_argument("--target", choices=list(TARGETS), default="plain",
+                        help="what the armature becomes: " + "; ".join(f"{name}: {target.description}"
+                                                                      for name, target in TARGETS.items())
+                        + " (default plain; a body plan that cannot fill a target falls back, with a warning)")
     parser.add_argument("--no-skin", action="store_true", help="make the armature only, do not skin the mesh")
 
 
@@ -158,8 +163,8 @@ def _run_rig(args):
 
     register()  # the properties the Blender layer keeps on scenes and objects
     try:
-        report = scenefiles.rig_file(source, output, method.name, params, skin=not args.no_skin, up=args.up,
-                                     forward=args.forward)
+        report = scenefiles.rig_file(source, output, method.name, params, target=args.target, skin=not args.no_skin,
+                                     up=args.up, forward=args.forward)
         if args.report is not None:
             with replaced_on_success(args.report) as path:
                 path.write_text(json.dumps(report, indent=2))
@@ -221,7 +226,7 @@ def _run_batch(args):
     axes = _batch_axes(args, sources)
     _check_folder(args.output, "the results")
     args.output.mkdir(parents=True, exist_ok=True)
-    extra = [f"--method={args.method}", *(f"--set={pair}" for pair in args.settings)]
+    extra = [f"--method={args.method}", f"--target={args.target}", *(f"--set={pair}" for pair in args.settings)]
     extra += ["--no-skin"] if args.no_skin else []
     stems = output_stems(sources, args.format, args.folder.resolve() == args.output.resolve())
     rows = []

@@ -393,6 +393,17 @@ def test_the_report_is_plain_json_whatever_numbers_a_method_records(scene):
     report = json.loads(json.dumps(rig_report(result, None)))
     assert report["timings"]["method.think"] == 0.5 and report["timings"]["method.count"] == 3.0
     assert report["method"] == "numpy_timed" and [bone["name"] for bone in report["bones"]] == ["spine"]
+    assert report["target"] == "plain"
+
+
+def test_an_unknown_target_is_refused_before_anything_is_made(scene):
+    from rigger.blender.pipeline import rig_object
+
+    obj = build_character("snake", subdivisions=0)
+    before = set(bpy.data.objects)
+    with pytest.raises(ValueError, match="unknown target 'nope'"):
+        rig_object(obj, target="nope")
+    assert set(bpy.data.objects) == before
 
 
 def test_operators_are_undoable_and_scriptable_by_name(registered):

@@ -70,7 +70,8 @@ def test_rig_an_obj_to_glb_with_a_report_in_the_obj_frame(humanoid_obj, rigged_g
     expected = rigger.rig_mesh(in_file @ Y_UP_TO_Z_UP.T, triangles, bone_length=0.12)
     assert names == list(expected.names)
     np.testing.assert_allclose(heads, expected.heads @ Y_UP_TO_Z_UP, atol=1e-4)
-    # ... with the body plan and every bone's role and side
+    # ... built as the default target, with the body plan and every bone's role and side
+    assert report["target"] == "plain"
     assert report["body_plan"] == expected.body_plan.to_dict() and report["body_plan"]["kind"] == "humanoid"
     assert [(bone["role"], bone["side"]) for bone in bones] == [(role.role, role.side) for role in expected.roles]
 
@@ -161,6 +162,7 @@ def leaves_nothing(folder):
     ("bad_set", "unknown parameter"),
     ("bad_value", "above the maximum"),
     ("bad_method", "unknown method"),
+    ("bad_target", "invalid choice: 'nope'"),
     ("bad_output", "cannot write"),
     ("unreadable", "Blender could not import it"),
 ])
@@ -183,6 +185,8 @@ def test_errors_exit_non_zero_with_a_message_and_write_nothing(case, message, hu
         extra = ["--set", "bone_length=7"]
     elif case == "bad_method":
         extra = ["--method", "nope"]
+    elif case == "bad_target":
+        extra = ["--target", "nope"]
     out = tmp_path / "out"
     out.mkdir()
     output = out / ("rig.txt" if case == "bad_output" else "rig.blend")

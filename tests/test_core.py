@@ -322,3 +322,13 @@ def test_concatenated_ranges_match_a_loop():
     expected = np.concatenate([np.arange(s, s + c) for s, c in zip(starts, counts)])
     np.testing.assert_array_equal(concatenated_ranges(starts, counts), expected)
     assert len(concatenated_ranges(np.zeros(0, int), np.zeros(0, int))) == 0
+
+
+def test_every_body_plan_fills_the_plain_target_and_unknown_targets_are_named():
+    from rigger.core.bodyplan import BodyPlan
+    from rigger.core.targets import TARGETS, check_target, choose_target
+
+    for plan in (None, BodyPlan("other", 0.5, "no legs"), BodyPlan("humanoid", 0.9, "2 legs")):
+        assert choose_target("plain", plan) == (TARGETS["plain"], None)
+    with pytest.raises(ValueError, match="unknown target 'mocap'; targets are plain"):
+        check_target("mocap")

@@ -81,16 +81,18 @@ class _RiggerOperator:
         settings, method = chosen_method(context)
         params = param_values(method, getattr(settings.methods, method.name))
         meshes, _ = rig_targets(context)
-        result = rig_object(meshes[0], method.name, params, parts=meshes[1:],
+        result = rig_object(meshes[0], method.name, params, target=settings.target, parts=meshes[1:],
                             show_overlays=overlay_visibility(settings), progress=progress)
         note_overlays(settings, result.skeleton.stages, result.overlays)
         seconds = sum(result.timings.values())
         names = ", ".join(mesh.name for mesh in meshes)
         replaced = " (replaced the previous rig)" if result.replaced else ""
         plan = result.skeleton.body_plan
-        self.report({'WARNING'} if plan is not None and plan.warning else {'INFO'},
-                    f"Rigged {names} with {method.label or method.name}: {len(result.skeleton)} bones in "
-                    f"{seconds:.2f} s{replaced}" + ("" if plan is None else f"; {plan.warning or plan.summary()}"))
+        notes = [*result.warnings, *([] if plan is None else [plan.warning or plan.summary()])]
+        warned = result.warnings or plan is not None and plan.warning
+        self.report({'WARNING'} if warned else {'INFO'},
+                    f"Rigged {names} with {method.label or method.name} as {result.target.label}: "
+                    f"{len(result.bones)} bones in {seconds:.2f} s{replaced}" + "".join(f"; {n}" for n in notes))
         return meshes, result.armature
 
     def skin(self, meshes, armature, progress):

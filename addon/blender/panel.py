@@ -1,4 +1,5 @@
-"""The Rigger panel in View3D > Sidebar > Rigger: method, its parameters, the actions and the overlay toggles."""
+"""The Rigger panel in View3D > Sidebar > Rigger: method, its parameters, the output target, the actions and the
+overlay toggles."""
 import bpy
 
 from ..api import method_registry
@@ -20,6 +21,7 @@ class RIGGER_PT_main(SidebarPanel, bpy.types.Panel):
         if registry.failures:
             draw_failures(layout.box(), registry.failures)
 
+        layout.prop(settings, "target")
         column = layout.column(align=True)
         column.operator(RIGGER_OT_rig.bl_idname, icon='ARMATURE_DATA')
         column.operator(RIGGER_OT_skin.bl_idname, icon='MOD_ARMATURE')

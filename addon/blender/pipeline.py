@@ -7,41 +7,51 @@ import bpy
 import numpy as np
 
 from ..api import rig_mesh
+from ..core.targets import check_target, choose_target
 from ..core.timing import StageClock
-from . import overlays, skinning
-from .armature import build_armature, delete_armature
+from . import overlays, skinning, targets
+from .armature import delete_armature
 from .meshdata import combined_arrays
 from .properties import ARMATURE_POINTER
 
 METHOD_PROPERTY = "rigger_method"  # custom property on the armature: the method that made it
+TARGET_PROPERTY = "rigger_target"  # ... and the output target it was built as
 
 
 @dataclass
 class RigResult:
-    """What :func:`rig_object` made: the armature object, the meshes it was made for, the skeleton (with its
-    stages), whether a previous Rigger armature was replaced, seconds per step, and the overlay objects by stage
-    name (none unless asked for)."""
+    """What :func:`rig_object` made: the armature object, the meshes it was made for, the method's skeleton (with
+    its stages and roles), the ``core.targets.Target`` built and the armature's deforming bones as a skeleton in
+    world space (the method's skeleton itself for ``plain``), whether a previous Rigger armature was replaced,
+    seconds per step, the overlay objects by stage name (none unless asked for) and warnings (a target that fell
+    back, say)."""
 
     armature: bpy.types.Object
     meshes: list
     skeleton: object
+    target: object
+    bones: object
     replaced: bool
     timings: dict
     overlays: dict
+    warnings: list
 
 
-def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays=None, progress=None):
+def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(), show_overlays=None,
+               progress=None):
     """Rig mesh object ``obj`` (together with the mesh objects ``parts``, e.g. a character's separate clothes) with
-    ``method`` and return a :class:`RigResult`.
+    ``method`` as output target ``target`` (a name in ``core.targets.TARGETS``) and return a :class:`RigResult`.
 
     The meshes are read as evaluated (modifiers applied, Rigger's previous armatures at rest) in world space. The new
     armature ("<mesh>_rig", identity world matrix, parented to ``obj``'s parent if it has one) goes into the first of
     the mesh's collections shown in the view layer and becomes ``rigger_armature`` of every mesh, replacing
     (deleting) the armatures Rigger made for them before. ``show_overlays`` maps stage names to whether their
     overlays start shown (None: build none; a stage it does not name starts as its type says);
-    ``progress(fraction)`` is called between steps. ValueError for bad meshes, methods or parameters; nothing is
-    created when rigging fails.
+    ``progress(fraction)`` is called between steps. A target the skeleton's body plan cannot fill falls back
+    (``core.targets.choose_target``) with a warning. ValueError for bad meshes, methods, parameters or targets;
+    nothing is created when rigging fails.
     """
+    check_target(target)
     report = progress or (lambda fraction: None)
     clock = StageClock()
     meshes = [obj, *(part for part in parts if part != obj)]
@@ -50,17 +60,20 @@ def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays
     clock.lap("read_mesh")
     report(0.1)
     skeleton = rig_mesh(vertices, triangles, method, **(params or {}))
+    chosen, fell_back = choose_target(target, skeleton.body_plan)
     clock.lap("rig")
     report(0.7)
     parent = _rig_parent(obj)
     replaced = any([remove_rig(mesh) for mesh in meshes])
     collection = shown_collection(obj, bpy.context.view_layer)
     frame = np.array(obj.matrix_world, dtype=np.float64)[:3, :3]
-    armature = build_armature(skeleton, f"{obj.name}_rig", collection, frame=frame)
+    built = targets.build(chosen, skeleton, f"{obj.name}_rig", collection, frame)
+    armature = built.armature
     if parent is not None:  # skinning makes the mesh the armature's child: the rig keeps following what moved it
         armature.parent = parent
         armature.matrix_parent_inverse = parent.matrix_world.inverted_safe()
     armature[METHOD_PROPERTY] = method if isinstance(method, str) else method.name
+    armature[TARGET_PROPERTY] = chosen.name
     for mesh in meshes:
         setattr(mesh, ARMATURE_POINTER, armature)
     clock.lap("armature")
@@ -70,7 +83,9 @@ def rig_object(obj, method="silhouette", params=None, *, parts=(), show_overlays
         drawn = overlays.build_overlays(skeleton.stages, obj.name, visible=show_overlays)
         clock.lap("overlays")
     report(1.0)
-    return RigResult(armature, meshes, skeleton, replaced, clock.laps, drawn)
+    warnings = [fell_back] if fell_back else []
+    return RigResult(armature, meshes, skeleton, chosen, built.bones, replaced, clock.laps, drawn,
+                     warnings + built.warnings)
 
 
 @contextlib.contextmanager

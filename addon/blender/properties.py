@@ -2,14 +2,15 @@
 ``scene.rigger``.
 
 Every discovered method gets a PropertyGroup with one property per :class:`~rigger.core.params.Param`, reachable as
-``scene.rigger.methods.<method name>.<param name>``; ``scene.rigger.method`` picks the method, and
-``scene.rigger.overlays`` holds a toggle per stage the rigs drew (``scene.rigger.overlays["cdt"].shown``), added
+``scene.rigger.methods.<method name>.<param name>``; ``scene.rigger.method`` picks the method,
+``scene.rigger.target`` the output target (``core.targets``), and ``scene.rigger.overlays`` holds a toggle per stage the rigs drew (``scene.rigger.overlays["cdt"].shown``), added
 as overlays of new stages are built. The classes are built at register time from the registry discovered then, so
 a method added to ``methods/`` appears after the add-on is enabled again.
 """
 import bpy
 import numpy as np
 
+from ..core.targets import TARGETS
 from . import overlays
 
 SETTINGS_ATTRIBUTE = "rigger"  # scene.rigger
@@ -86,6 +87,10 @@ def make_classes(registry):
     settings_annotations = {
         "method": bpy.props.EnumProperty(name="Method", description="Rigging method", items=items),
         "methods": bpy.props.PointerProperty(type=methods_group),
+        "target": bpy.props.EnumProperty(name="Target", description="What the armature becomes (a body plan that "
+                                         "cannot fill the target falls back, with a warning)",
+                                         items=[(name, target.label, target.description)
+                                                for name, target in TARGETS.items()]),
         "overlays": bpy.props.CollectionProperty(type=RIGGER_PG_overlay, name="Overlays"),
     }
     settings = type("RIGGER_PG_settings", (bpy.types.PropertyGroup,), {

@@ -10,14 +10,15 @@ from ..core.files import replaced_on_success
 from . import overlays, skinning
 from .armature import delete_armature
 from .headless import empty_scene
-from .pipeline import METHOD_PROPERTY, rig_object, skin_meshes, skin_summary
+from .pipeline import METHOD_PROPERTY, TARGET_PROPERTY, rig_object, skin_meshes, skin_summary
 from .properties import ARMATURE_POINTER
 
 
 
-def rig_file(source, output, method, params, *, skin=True, up=None, forward=None):
-    """Rig the meshes of model file ``source`` together, skin them, save them with their armature to ``output`` and
-    return the report (bones in the file's frame, the axes it was read with, timings, skinning outcome, warnings).
+def rig_file(source, output, method, params, *, target="plain", skin=True, up=None, forward=None):
+    """Rig the meshes of model file ``source`` together as output target ``target`` (``core.targets``), skin them,
+    save them with their armature to ``output`` and return the report (bones in the file's frame, the axes it was
+    read with, timings, skinning outcome, warnings).
 
     ``up`` and ``forward`` are the file axes that become Blender's +Z and +Y (``rigger.axes``: OBJ and FBX only; None
     takes the defaults, up Y and forward -Z for OBJ, the file's own axes for FBX).
@@ -40,7 +41,7 @@ def rig_file(source, output, method, params, *, skin=True, up=None, forward=None
         raise ValueError(f"{source}: the file holds no mesh with faces that its scene shows")
     meshes.sort(key=lambda obj: -len(obj.data.vertices))
     warnings = release_from_armatures(meshes)
-    result = rig_object(meshes[0], method, params, parts=meshes[1:])
+    result = rig_object(meshes[0], method, params, target=target, parts=meshes[1:])
     outcomes = None
     if skin:
         outcomes, skin_warnings = skin_meshes(meshes, result.armature)
@@ -90,18 +91,19 @@ def blender_message(error):
 
 
 def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warnings=(), axes=None):
-    """The JSON-ready report of a rig: method, parameters, the body plan (kind, confidence, reason, parts), bones
-    (with their roles and sides; mapped from Blender's world into the frame named ``frame`` by the inverse of
-    ``to_world``), the (up, forward) ``axes`` the file was read with (None: Blender's importer chose), timings, the
-    skinning outcome per mesh (``outcomes``: mesh name → skinning report, or None when not skinned) and warnings
-    (``warnings`` first, then one when the body plan was not recognised).
+    """The JSON-ready report of a rig: method, parameters, the output target built, the body plan (kind,
+    confidence, reason, parts), bones (the built armature's deforming bones, with their roles and sides where the
+    target keeps them; mapped from Blender's world into the frame named ``frame`` by the inverse of ``to_world``),
+    the (up, forward) ``axes`` the file was read with (None: Blender's importer chose), timings, the skinning outcome
+    per mesh (``outcomes``: mesh name → skinning report, or None when not skinned) and warnings (``warnings`` first,
+    then the rig's own, then one when the body plan was not recognised).
 
     Timings are plain floats whatever number type the method recorded (numpy scalars are not JSON).
     """
     to_frame = np.eye(4)
     to_frame[:3, :3] = np.linalg.inv(to_world)
     meshes = result.meshes
-    warnings = list(warnings)
+    warnings = [*warnings, *result.warnings]
     if len(meshes) > 1:
         warnings.append(f"rigged {len(meshes)} mesh objects together: {', '.join(m.name for m in meshes)}")
     skinning_outcome = {"summary": "not skinned", "meshes": {}}
@@ -119,8 +121,9 @@ def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warn
         "axes": None if axes is None else dict(zip(("up", "forward"), axes)),
         "method": result.armature.get(METHOD_PROPERTY),
         "params": skeleton.params,
+        "target": result.armature.get(TARGET_PROPERTY),
         "body_plan": None if plan is None else plan.to_dict(),
-        "bones": skeleton.transformed(to_frame).to_dict()["bones"],
+        "bones": result.bones.transformed(to_frame).to_dict()["bones"],
         "timings": {name: float(seconds) for name, seconds in timings.items()},
         "skinning": skinning_outcome,
         "warnings": warnings,

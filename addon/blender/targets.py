@@ -1,0 +1,33 @@
+"""A skeleton built as the armature of an output target (``rigger.core.targets`` says which target a body plan
+fills): one builder per target, each making the armature and saying which bones deform."""
+from dataclasses import dataclass, field
+
+import bpy
+
+from ..core.skeleton import Skeleton
+from .armature import build_armature
+
+
+@dataclass
+class Built:
+    """What a target's builder made: the ``armature`` object to skin to, its deforming ``bones`` as a skeleton in
+    world space (what reports list), the other ``objects`` it made and ``warnings``."""
+
+    armature: bpy.types.Object
+    bones: Skeleton
+    objects: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
+
+
+def build(target, skeleton, name, collection, frame):
+    """Build ``skeleton`` as ``target``'s armature (a ``core.targets.Target``) named ``name`` in ``collection``;
+    ``frame`` is the rigged object's rotation (``armature.build_armature``). A :class:`Built`."""
+    return BUILDERS[target.name](skeleton, name, collection, frame)
+
+
+def _plain(skeleton, name, collection, frame):
+    """The method's bones as they are."""
+    return Built(build_armature(skeleton, name, collection, frame=frame), skeleton)
+
+
+BUILDERS = {"plain": _plain}

@@ -1,0 +1,54 @@
+"""Output targets: what kind of armature a rig becomes, and which one a body plan can fill.
+
+Each target names the target to fall back to when a skeleton's body plan cannot fill it; ``plain`` (the method's
+bones as they are) fills every plan, so every chain of fallbacks ends there.
+"""
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Target:
+    """An output target: ``name`` (the CLI's ``--target`` value), a ``label`` and ``description`` for the panel, the
+    body plan kinds it can fill (None: every plan) and the target it falls back to otherwise."""
+
+    name: str
+    label: str
+    description: str
+    plans: tuple = None
+    fallback: str = None
+
+    def unfit(self, plan):
+        """Why ``plan`` (a ``core.bodyplan.BodyPlan``, or None when not recognised) cannot fill this target, or None
+        when it can."""
+        if self.plans is None:
+            return None
+        kind = "unknown" if plan is None else plan.kind
+        if kind in self.plans:
+            return None
+        return f"the {self.name} target needs a {' or '.join(self.plans)} body plan, and this one is {kind}"
+
+
+TARGETS = {target.name: target for target in (
+    Target("plain", "Plain", "The method's bones as they are, named by part (trunk, limbs, sides)"),
+)}
+
+
+def check_target(name):
+    """The :class:`Target` called ``name``; ValueError naming the targets there are otherwise."""
+    if name not in TARGETS:
+        raise ValueError(f"unknown target {name!r}; targets are {', '.join(TARGETS)}")
+    return TARGETS[name]
+
+
+def choose_target(name, plan):
+    """(the target to build for a skeleton with body plan ``plan`` when ``name`` is asked for, a warning or None):
+    ``name`` itself when the plan fills it, else the first target down its fallbacks that the plan fills, and a
+    warning saying why."""
+    target = check_target(name)
+    reasons = []
+    while (reason := target.unfit(plan)) is not None:
+        reasons.append(reason)
+        target = TARGETS[target.fallback]
+    if not reasons:
+        return target, None
+    return target, f"{'; '.join(reasons)}: built the {target.name} target instead"
