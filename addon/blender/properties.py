@@ -3,9 +3,10 @@
 
 Every discovered method gets a PropertyGroup with one property per :class:`~rigger.core.params.Param`, reachable as
 ``scene.rigger.methods.<method name>.<param name>``; ``scene.rigger.method`` picks the method,
-``scene.rigger.target`` the output target (``core.targets``), and ``scene.rigger.overlays`` holds a toggle per stage the rigs drew (``scene.rigger.overlays["cdt"].shown``), added
-as overlays of new stages are built. The classes are built at register time from the registry discovered then, so
-a method added to ``methods/`` appears after the add-on is enabled again.
+``scene.rigger.target`` the output target (``core.targets``), and ``scene.rigger.overlays`` holds a toggle per
+stage the rigs drew (``scene.rigger.overlays["cdt"].shown``), added as overlays of new stages are built. The
+classes are built at register time from the registry discovered then, so a method added to ``methods/`` appears
+after the add-on is enabled again.
 """
 import bpy
 import numpy as np
