@@ -708,3 +708,14 @@ def test_a_bear_s_stubby_back_legs_get_chains():
     size = rig_checks.mesh_size(vertices)
     followed = rig_checks.limbs(samples.ground_truth_bones("bear"), skeleton, size)
     assert followed["back_paw.L"].distance < 0.03 and followed["back_paw.R"].distance < 0.03
+
+
+def test_a_bear_s_ears_are_twins_though_its_front_view_prunes_one_ear_s_tip():
+    """Seen from the front, the bear's right ear keeps too short a tip to be a limb of its own; the left one is
+    kept, and on a mirror-symmetric mesh its mirror image stands in for the right ear."""
+    vertices, triangles = load_character("bear")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    size = rig_checks.mesh_size(vertices)
+    followed = rig_checks.limbs(samples.ground_truth_bones("bear"), skeleton, size)
+    assert followed["ear.L"].distance < 0.03 and followed["ear.R"].distance < 0.03
+    assert rig_checks.side_counts(skeleton)[0] == rig_checks.side_counts(skeleton)[1]

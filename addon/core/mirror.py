@@ -193,7 +193,9 @@ def mirror_completed(limbs, symmetry):
     """The (polyline, half-widths) ``limbs`` with each one that a longer mirror twin covers (``Symmetry.covers``)
     replaced by the twin's mirror image: a view's triangulation is not symmetric, and may prune one ear's tip but not
     the other's. A limb's twin is the one whose image fits it best, so a short limb beside a long one (a leg below an
-    antenna) keeps its own; each twin replaces one limb, the one it fits best."""
+    antenna) keeps its own; each twin replaces one limb, the one it fits best. A limb whose middle lies off the plane
+    and whose image no limb on the other side covers or fits into gets that image as a limb of its own: the view may
+    have pruned one ear's whole tip (the mesh is symmetric, so its skeleton is)."""
     lines = [line for line, _ in limbs]
     side = [symmetry.side(line, by_tip=True) for line in lines]
     images = [symmetry.reflect(line) for line in lines]
@@ -212,4 +214,10 @@ def mirror_completed(limbs, symmetry):
     result = list(limbs)
     for i, (_, j) in fits.items():
         result[j] = (images[i], limbs[i][1])
+    for j, line in enumerate(lines):
+        paired = any(side[i] == -side[j] and (symmetry.covers(covering_fit(images[j], lines[i]))
+                                              or symmetry.covers(covering_fit(lines[i], images[j])))
+                     for i in range(len(lines)))
+        if symmetry.side(line) != 0 and not paired:
+            result.append((images[j], limbs[j][1]))
     return result
