@@ -37,7 +37,8 @@ setup(
     license="GPL-3.0-or-later",
     python_requires=">=3.11",
     package_dir={"rigger": "addon"},
-    packages=["rigger", "rigger.blender", "rigger.core", "rigger.methods", "rigger.skeletonize"],
+    packages=["rigger", "rigger.batch", "rigger.blender", "rigger.core", "rigger.methods", "rigger.skeletonize"],
+    extras_require={"ray": ["ray==2.60.0"]},  # batch --engine ray; requirements-ray.txt pins it with its dependencies
     ext_modules=cythonize(
         EXTENSIONS,
         language_level=3,
