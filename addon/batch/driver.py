@@ -15,6 +15,7 @@ import dataclasses
 import json
 import pathlib
 import sys
+import time
 
 from ..core.files import remove_leftover_folders, remove_leftovers, replaced_on_success
 from .work import rigged_row
@@ -49,11 +50,13 @@ def run(sources, total, engine, output, fmt, settings, resume=False, progress=sy
     """Rig ``sources`` (``inputs.Source``; about ``total`` of them, for the progress bar) with ``engine`` into folder
     ``output`` as ``<stem>.<fmt>`` and ``<stem>.json``; write ``summary.json`` there and return its rows.
 
-    Folders a killed process left half-written in ``output`` are removed first. With ``resume``, a file whose model
-    and report are there and were made with these settings is not rigged again (its row says ``resumed``). A file
-    whose process died is retried once; a failed file leaves no results behind. When interrupted (Ctrl-C, or any
-    exception) the engine is stopped, the files in flight are cleaned up and the rows so far are written as the
-    summary before the exception goes on.
+    Rows of rigged and failed files hold ``seconds`` (wall time of the last attempt, from when a worker took the
+    file) and ``finished_at`` (when the driver got the result, seconds since the epoch). Folders a killed process
+    left half-written in ``output`` are removed first. With ``resume``, a file whose model and report are there and
+    were made with these settings is not rigged again (its row says ``resumed``). A file whose process died is
+    retried once; a failed file leaves no results behind. When interrupted (Ctrl-C, or any exception) the engine is
+    stopped, the files in flight are cleaned up and the rows so far are written as the summary before the exception
+    goes on.
     """
     remove_leftover_folders(output)
     rows, retries, running = [], collections.deque(), []
@@ -83,6 +86,7 @@ def run(sources, total, engine, output, fmt, settings, resume=False, progress=sy
             if not running:
                 break
             for job, row, crashed in engine.finished():
+                row["finished_at"] = round(time.time(), 3)
                 running.remove(job)
                 if row["status"] != "ok":
                     discard(job)

@@ -42,15 +42,16 @@ def sources(inputs, output, fmt, suffixes):
     BatchError for an input that is none of the forms, or a folder or list that cannot be read."""
     output = _absolute(output)
     stems = functools.lru_cache(LISTINGS_KEPT)(functools.partial(_model_stems, suffixes=suffixes))
-    claimed = {}
+    claimed = {}  # results' stem -> (the file that has it, its name): strings only, for lists of 10^5 files
     for text in inputs:
         for path, root, listed in _expand(text, output, suffixes):
             source = _source(path, root, listed, output, fmt, suffixes, stems)
-            first = claimed.setdefault(os.path.normcase(str(source.stem)), source)
-            if first is source:
+            key, file = os.path.normcase(str(source.stem)), os.path.normcase(str(path))
+            if key not in claimed:
+                claimed[key] = file, source.name
                 yield source
-            elif os.path.normcase(str(first.path)) != os.path.normcase(str(source.path)):
-                yield dataclasses.replace(source, problem=f"its results would overwrite those of {first.name}")
+            elif claimed[key][0] != file:  # another file; the same one named again is rigged once
+                yield dataclasses.replace(source, problem=f"its results would overwrite those of {claimed[key][1]}")
 
 
 def _expand(text, output, suffixes):
@@ -122,9 +123,10 @@ def _below(path, output, root):
 
 
 def _source(path, root, listed, output, fmt, suffixes, stems):
-    if path.is_relative_to(root):
-        relative, name = path.relative_to(root), path.relative_to(root).as_posix()
-    else:  # a listed file outside the list's folder
+    try:
+        relative = path.relative_to(root)
+        name = relative.as_posix()
+    except ValueError:  # a listed file outside the list's folder
         relative, name = pathlib.Path(*path.parts[1:]), str(path)
     problem = None
     if listed and path.suffix.lower() not in suffixes:
