@@ -137,7 +137,10 @@ def figures(run):
     work = [row["work_seconds"] for row in rows]
     span = max(row["finished_at"] for row in rows) - min(row["finished_at"] - row["seconds"] for row in rows)
     per_file = span * run["jobs"] / count
+    written = [(run["out"] / row["output"]).stat().st_size + (run["out"] / row["output"]).with_suffix(".json")
+               .stat().st_size for row in rows]
     return {"count": count, "wall": run["wall"], "whole": 60 * count / run["wall"], "steady": 60 * count / span,
+            "written_mb": statistics.mean(written) / 2 ** 20,
             "fixed": run["wall"] - span, "per_file": per_file, "mean_work": statistics.mean(work),
             "median_work": statistics.median(work), "overhead": per_file - statistics.mean(work)}
 
@@ -202,13 +205,14 @@ def markdown(runs, numbers, agreement, notes, meta):
         *markdown_table(
             ("engine", "jobs", "models", "wall", "fixed cost", "models/min", "steady models/min",
              "span per file and job", "mean / median own time", "per-file overhead", "driver CPU per file",
-             "memory per worker", "load before", "load after"),
+             "memory per worker", "written per file", "load before", "load after"),
             [(key[0], key[1], numbers[key]["count"], f"{numbers[key]['wall']:.1f} s", f"{numbers[key]['fixed']:.1f} s",
               f"{numbers[key]['whole']:.1f}", f"{numbers[key]['steady']:.1f}", f"{numbers[key]['per_file']:.2f} s",
               f"{numbers[key]['mean_work']:.2f} / {numbers[key]['median_work']:.2f} s",
               f"{numbers[key]['overhead']:.2f} s" if key[1] == 1 else "",
               f"{runs[key]['driver_cpu'] / numbers[key]['count'] * 1000:.0f} ms",
-              f"{worker_peak(runs[key]):.0f} MB", load(runs[key]["load_before"]), load(runs[key]["load_after"]))
+              f"{worker_peak(runs[key]):.0f} MB", f"{numbers[key]['written_mb']:.2f} MB",
+              load(runs[key]["load_before"]), load(runs[key]["load_after"]))
              for key in CONFIGS]),
         "",
         "## Memory",
