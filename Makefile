@@ -7,9 +7,11 @@ STAMP := $(VENV)/.installed
 # pip takes the wheel from its cache when it has it.
 BPY42_VENV := $(VENV)/bpy42
 BPY42_STAMP := $(BPY42_VENV)/.installed
+# Ray, the optional engine of `batch --engine ray`, into .venv for its tests and benchmark (not the default install).
+RAY_STAMP := $(VENV)/.ray-installed
 
-.PHONY: test build demo addon bpy42 bench bench-quality bench-silhouette bench-skinning bench-posing \
-	bench-bodyplan bench-rig-time regress regress-baseline defects clean
+.PHONY: test build demo addon bpy42 ray bench bench-quality bench-silhouette bench-skinning bench-posing \
+	bench-bodyplan bench-rig-time bench-batch regress regress-baseline defects clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -22,12 +24,18 @@ $(BPY42_STAMP): requirements-bpy42.txt
 	$(BPY42_VENV)/bin/python -m pip install --quiet -r requirements-bpy42.txt
 	touch $(BPY42_STAMP)
 
+$(RAY_STAMP): $(STAMP) requirements-ray.txt
+	$(PY) -m pip install --quiet -r requirements-ray.txt
+	touch $(RAY_STAMP)
+
 build: $(STAMP)
 	$(PY) -m pip install --quiet --no-build-isolation --no-deps -e .
 
 bpy42: $(BPY42_STAMP)
 
-test: build bpy42
+ray: $(RAY_STAMP)
+
+test: build bpy42 ray
 	$(PY) -m pytest -q tests
 
 demo: build
@@ -73,6 +81,10 @@ regress-baseline: build
 # Issue 28's defect characters rigged, measured against their true skeletons and drawn: out/defects/.
 defects: build
 	$(PY) tools/defects.py
+
+# Batch throughput, local engine against Ray, on generated characters: bench/results/batch.md and .png.
+bench-batch: build ray
+	$(PY) bench/batch.py
 
 clean:
 	rm -rf build dist out *.egg-info addon/*.so ext/cdt.c ext/silhouette_binding.c ext/skin_weights_binding.c

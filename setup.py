@@ -38,6 +38,7 @@ setup(
     python_requires=">=3.11",
     package_dir={"rigger": "addon"},
     packages=["rigger"] + [f"rigger.{package}" for package in find_packages("addon")],  # method packages too
+    extras_require={"ray": ["ray==2.60.0"]},  # batch --engine ray; requirements-ray.txt pins it with its dependencies
     ext_modules=cythonize(
         EXTENSIONS,
         language_level=3,

@@ -41,6 +41,11 @@ def file_axes(suffix, up=None, forward=None):
     return up, forward
 
 
+def axes_field(axes):
+    """``file_axes``' answer as reports give it: {"up": "Y", "forward": "-Z"}, or None."""
+    return None if axes is None else dict(zip(("up", "forward"), axes))
+
+
 def to_blender(up, forward):
     """The 3x3 rotation taking a file's coordinates, read with axes ``up`` and ``forward``, to Blender's world:
     ``forward`` to +Y, ``up`` to +Z, and so their cross product to +X."""

@@ -1,4 +1,5 @@
-"""``python -m rigger``: rig model files from the command line (``rig``), or whole folders in parallel (``batch``).
+"""``python -m rigger``: rig model files from the command line (``rig``), or whole libraries in parallel (``batch``,
+see :mod:`rigger.batch`).
 
 ``rig`` imports an OBJ, glTF/GLB, FBX or .blend file into an empty headless Blender (the ``bpy`` module), rigs its
 mesh, skins it and saves .blend, .glb or .fbx, plus an optional JSON report. Outputs are written to temporary
@@ -6,23 +7,18 @@ files and renamed into place only when everything succeeded (``rigger.core.files
 behind.
 """
 import argparse
-import collections
-import concurrent.futures
-import json
+import contextlib
 import os
 import pathlib
-import subprocess
 import sys
-import time
 
 from .axes import AXES, AXIS_SUFFIXES, file_axes
-from .core.files import remove_leftovers, replaced_on_success
 from .core.targets import TARGETS
 
 INPUTS = (".obj", ".glb", ".gltf", ".fbx", ".blend")
 OUTPUTS = (".blend", ".glb", ".fbx")
-SUMMARY = "summary.json"  # batch: the summary table as JSON, beside the results
 EXIT_FAILED = 1
+EXIT_INTERRUPTED = 130  # as a shell reports a command ended by Ctrl-C
 
 
 class CliError(Exception):
@@ -52,14 +48,24 @@ def _parser():
     _axis_options(rig)
     rig.set_defaults(run=_run_rig)
 
-    batch = commands.add_parser("batch", help="rig every model file of a folder in parallel processes")
-    batch.add_argument("folder", type=pathlib.Path, help="folder of model files (not searched recursively)")
+    batch = commands.add_parser("batch", help="rig a library of model files in parallel, here or on a Ray cluster")
+    batch.add_argument("inputs", nargs="+", metavar="INPUTS",
+                       help="folders (searched recursively), model files, text files listing model files one per "
+                            "line, or quoted glob patterns (** for any depth)")
     batch.add_argument("-o", "--output", type=pathlib.Path, required=True, help="folder for the results")
     batch.add_argument("--format", choices=[suffix[1:] for suffix in OUTPUTS], default="blend",
                        help="output format (default blend)")
-    batch.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel processes (default: CPUs)")
+    batch.add_argument("--engine", choices=("local", "ray"), default="local",
+                       help="local: a child process per file on this machine (default); ray: long-lived Blender "
+                            "workers on a Ray cluster (pip install -r requirements-ray.txt)")
+    batch.add_argument("--address", help="the Ray cluster to join (default RAY_ADDRESS; without either, a Ray "
+                                         "instance of this machine is started and stopped again)")
+    batch.add_argument("--jobs", type=int, help="files at once (default: one per CPU of this machine, or of the "
+                                                "Ray cluster)")
     batch.add_argument("--timeout", type=float, metavar="SECONDS",
                        help="give up on a file after this many seconds (default: no limit)")
+    batch.add_argument("--resume", action="store_true",
+                       help="skip files whose results an earlier run with the same settings completed")
     _method_options(batch)
     _axis_options(batch)
     batch.set_defaults(run=_run_batch)
@@ -139,9 +145,6 @@ def _print_tuning(table):
 
 
 def _run_rig(args):
-    from .api import method_registry
-    from .core.params import resolve
-
     source = args.input
     if not source.is_file():
         raise CliError(f"{source}: no such file")
@@ -151,33 +154,39 @@ def _run_rig(args):
     if output.suffix.lower() not in OUTPUTS:
         raise CliError(f"{output}: cannot write {output.suffix or 'files without a suffix'}; use {', '.join(OUTPUTS)}")
     _check_destinations(source, output, args.report)
-    try:  # check the method, parameters and axes before the slow import
-        method = method_registry().lookup(args.method)
-        params = resolve(method.params, _settings(args.settings))
+    settings = _file_settings(args)  # before the slow import
+    try:
         file_axes(source.suffix, args.up, args.forward)
     except ValueError as error:
         raise CliError(str(error)) from None
 
-    from . import register
-    from .blender import scenefiles
+    from .batch.work import FileFailed, prepare, rig_to_files
 
-    register()  # the properties the Blender layer keeps on scenes and objects
+    prepare()
     try:
-        report = scenefiles.rig_file(source, output, method.name, params, target=args.target, skin=not args.no_skin,
-                                     up=args.up, forward=args.forward)
-        if args.report is not None:
-            with replaced_on_success(args.report) as path:
-                path.write_text(json.dumps(report, indent=2))
-    except ValueError as error:
+        report = rig_to_files(source, output, args.report, settings)
+    except FileFailed as error:
         raise CliError(str(error)) from None
-    except RuntimeError as error:  # a Blender operator failed (an exporter, say)
-        raise CliError(f"{source}: {scenefiles.blender_message(error)}") from None
-    except OSError as error:  # a folder that cannot be written, a full disk
-        raise CliError(f"{error.filename or output}: {error.strerror or error}") from None
     print(f"rigged {source} → {output}: {len(report['bones'])} bones, {report['skinning']['summary']}")
     for warning in report["warnings"]:
         print(f"warning: {warning}", file=sys.stderr)
     return 0
+
+
+def _file_settings(args):
+    """How each file is rigged (``batch.work.Settings``) from the options: the method's name, its parameters
+    resolved from ``--set``, the target, skinning and axes; CliError for an unknown method or bad values."""
+    from .api import method_registry
+    from .batch.work import Settings
+    from .core.params import resolve
+
+    try:
+        method = method_registry().lookup(args.method)
+        params = resolve(method.params, _settings(args.settings))
+    except ValueError as error:
+        raise CliError(str(error)) from None
+    return Settings(method.name, params, target=args.target, skin=not args.no_skin, up=args.up, forward=args.forward,
+                    pairs=tuple(args.settings))
 
 
 def _check_destinations(source, output, report):
@@ -214,116 +223,59 @@ def _check_folder(folder, role):
 
 
 def _run_batch(args):
-    if not args.folder.is_dir():
-        raise CliError(f"{args.folder}: no such folder")
-    if args.jobs < 1:
+    from .batch import BatchError, driver, inputs
+
+    if args.jobs is not None and args.jobs < 1:
         raise CliError(f"--jobs must be at least 1, got {args.jobs}")
     if args.timeout is not None and args.timeout <= 0:
         raise CliError(f"--timeout must be a positive number of seconds, got {args.timeout}")
-    sources = sorted(path for path in args.folder.iterdir() if path.suffix.lower() in INPUTS and path.is_file())
-    if not sources:
-        raise CliError(f"{args.folder}: no model files ({', '.join(INPUTS)})")
-    axes = _batch_axes(args, sources)
+    if args.address and args.engine != "ray":
+        raise CliError("--address needs --engine ray")
+    settings = _file_settings(args)
+    _check_batch_axes(args)
     _check_folder(args.output, "the results")
-    args.output.mkdir(parents=True, exist_ok=True)
-    extra = [f"--method={args.method}", f"--target={args.target}", *(f"--set={pair}" for pair in args.settings)]
-    extra += ["--no-skin"] if args.no_skin else []
-    stems = output_stems(sources, args.format, args.folder.resolve() == args.output.resolve())
-    rows = []
-    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        futures = [pool.submit(rig_in_child, source, args.output / f"{stem}.{args.format}",
-                               args.output / f"{stem}.json", extra + axes.get(source.suffix.lower(), []),
-                               args.timeout)
-                   for source, stem in zip(sources, stems)]
-        for done, future in enumerate(concurrent.futures.as_completed(futures), start=1):
-            rows.append(future.result())
-            _progress(done, len(sources))
-    rows.sort(key=lambda row: row["file"])
-    print(_summary_table(rows))
-    (args.output / SUMMARY).write_text(json.dumps(rows, indent=2))
-    failed = sum(row["status"] != "ok" for row in rows)
-    return EXIT_FAILED if failed else 0
 
+    def found():
+        return inputs.sources(args.inputs, args.output, args.format, INPUTS)
 
-def _batch_axes(args, sources):
-    """The ``--up``/``--forward`` arguments of a batch's children by file suffix: given only to the OBJ and FBX files
-    (checked here, once); a warning when other files are read in their own frames."""
-    if args.up is None and args.forward is None:
-        return {}
     try:
-        axes = {suffix: file_axes(suffix, args.up, args.forward) for suffix in AXIS_SUFFIXES}
+        # counted first for the progress bar (and the files whose frame is fixed); found again as they go
+        suffixes = [source.path.suffix.lower() for source in found()]
+        total, fixed = len(suffixes), sum(suffix not in AXIS_SUFFIXES for suffix in suffixes)
+        if not total:
+            raise CliError(f"no model files ({', '.join(INPUTS)}) in {' '.join(args.inputs)}")
+        if fixed and (args.up or args.forward):
+            print(f"warning: --up and --forward apply to OBJ and FBX files only; {fixed} glTF or .blend file(s) keep "
+                  f"their own frames", file=sys.stderr)
+        # stdout carries the summary table alone: what an engine prints meanwhile (Ray's notes on dead workers,
+        # which the rows give too) goes to stderr with the progress bar
+        with contextlib.redirect_stdout(sys.stderr), _engine(args, settings) as engine:
+            args.output.mkdir(parents=True, exist_ok=True)
+            rows = driver.run(found(), total, engine, args.output, args.format, settings, resume=args.resume)
+    except BatchError as error:
+        raise CliError(str(error)) from None
+    except KeyboardInterrupt:
+        print(f"rigger: interrupted; {args.output / driver.SUMMARY} lists the files done so far, and the same "
+              f"command with --resume goes on from there", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    print(driver.summary_table(rows))
+    return EXIT_FAILED if any(row["status"] != "ok" for row in rows) else 0
+
+
+def _check_batch_axes(args):
+    """CliError for ``--up``/``--forward`` values no OBJ or FBX file could be read with, before any file is."""
+    try:
+        for suffix in AXIS_SUFFIXES:
+            file_axes(suffix, args.up, args.forward)
     except ValueError as error:
         raise CliError(str(error)) from None
-    fixed = sum(source.suffix.lower() not in AXIS_SUFFIXES for source in sources)
-    if fixed:
-        print(f"warning: --up and --forward apply to OBJ and FBX files only; {fixed} glTF or .blend file(s) keep "
-              f"their own frames", file=sys.stderr)
-    return {suffix: [f"--up={up}", f"--forward={forward}"] for suffix, (up, forward) in axes.items()}
 
 
-def output_stems(sources, suffix, in_place):
-    """The name (without suffix) of each source's output and report: its stem, or stem_suffix where that would
-    overwrite another source's results, the summary, or (``in_place``: results written into the input folder) the
-    source itself."""
-    counts = collections.Counter(source.stem for source in sources)
+def _engine(args, settings):
+    if args.engine == "ray":
+        from .batch.ray_engine import RayEngine
 
-    def clashes(source):
-        return (counts[source.stem] > 1 or source.stem == pathlib.Path(SUMMARY).stem
-                or in_place and source.suffix.lower() == f".{suffix}")
+        return RayEngine(args.jobs, args.timeout, settings, args.address)
+    from .batch.local import LocalEngine
 
-    return [f"{source.stem}_{source.suffix[1:]}" if clashes(source) else source.stem for source in sources]
-
-
-def child_command(source, output, report, extra):
-    """The command that rigs one file of a batch: this CLI's ``rig`` in a fresh Python (each needs its own Blender)."""
-    return [sys.executable, "-m", __package__, "rig", str(source), "-o", str(output), "--report", str(report), *extra]
-
-
-def rig_in_child(source, output, report, extra, timeout=None):
-    """Rig ``source`` in a child process; its row of the summary table. A child that fails, crashes or runs past
-    ``timeout`` seconds (killed then) gives a failed row saying so; it never stops the batch."""
-    start = time.perf_counter()
-    try:
-        child = subprocess.run(child_command(source, output, report, extra), capture_output=True, text=True,
-                               timeout=timeout)
-    except subprocess.TimeoutExpired:
-        child = None
-    row = {"file": source.name, "seconds": round(time.perf_counter() - start, 2), "status": "failed", "bones": 0,
-           "skinning": ""}
-    if child is None or child.returncode:
-        for final in (output, report):  # what a killed child left half written
-            remove_leftovers(final)
-        return {**row, "message": f"timed out after {timeout:g} s" if child is None else _child_failure(child)}
-    try:
-        data = json.loads(report.read_text())
-    except (OSError, ValueError) as error:
-        return {**row, "message": f"finished without a readable report: {error}"}
-    return {**row, "status": "ok", "bones": len(data["bones"]), "skinning": data["skinning"]["summary"],
-            "message": "; ".join(data["warnings"]), "output": output.name}
-
-
-def _child_failure(child):
-    """What went wrong in a failed child: its ``rigger: error:`` line, else how it ended and its last output."""
-    lines = [line for line in child.stderr.splitlines() if line.startswith("rigger: error:")]
-    if lines:
-        return lines[-1].removeprefix("rigger: error: ")
-    how = f"killed by signal {-child.returncode}" if child.returncode < 0 else f"exit status {child.returncode}"
-    tail = child.stderr.strip()[-300:]
-    return f"crashed ({how})" + (f": {tail}" if tail else "")
-
-
-def _progress(done, total, width=30):
-    filled = round(width * done / total)
-    end = "\n" if done == total else ""
-    print(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{total}", end=end, file=sys.stderr, flush=True)
-
-
-def _summary_table(rows):
-    header = ("file", "status", "bones", "seconds", "skinning / message")
-    lines = [" | ".join(header), " | ".join("---" for _ in header)]
-    for row in rows:
-        note = row["message"] if row["status"] != "ok" else row["skinning"]
-        lines.append(" | ".join(str(value) for value in (row["file"], row["status"], row["bones"], row["seconds"],
-                                                           note)))
-    ok = sum(row["status"] == "ok" for row in rows)
-    return "\n".join(lines) + f"\n{ok} of {len(rows)} rigged"
+    return LocalEngine(args.jobs or os.cpu_count() or 1, args.timeout, settings)

@@ -45,6 +45,14 @@ def load_character(name):
         return arrays["vertices"], arrays["triangles"]
 
 
+def write_obj(path, vertices, triangles):
+    """Write ``vertices`` and (0-based) ``triangles`` as an OBJ file at ``path``; returns ``path``."""
+    with open(path, "w") as out:
+        out.write("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in vertices))
+        out.write("".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
+    return path
+
+
 def winding_numbers(vertices, triangles, points):
     """Generalised winding number of a closed triangle mesh at each point: about 1 inside, 0 outside (and 2 where
     parts overlap, so it stays right where ray parity would not); the benchmark's implementation, in the argument

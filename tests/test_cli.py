@@ -1,37 +1,23 @@
 """``python -m rigger``: rig files end to end in child processes, as a pipeline would, including the error paths."""
 import json
-import subprocess
-import sys
-import time
 
 import numpy as np
 import pytest
 
-from characters import strictly_inside_fraction, load_character
+from characters import load_character, strictly_inside_fraction, write_obj
+from commands import run_cli as run
 
 bpy = pytest.importorskip("bpy")
 
 import rigger  # noqa: E402
 from bpy_extras.io_utils import axis_conversion  # noqa: E402  (Blender's own axis table)
-from rigger import axes, cli  # noqa: E402
+from rigger import axes  # noqa: E402
 from rigger.blender.armature import build_armature  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
 from rigger.core.skeleton import Skeleton  # noqa: E402
 
 # How Blender's OBJ importer turns the OBJ's Y-up frame into its Z-up world (file x, y, z → x, -z, y).
 Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
-
-
-def run(*args, timeout=180):
-    return subprocess.run([sys.executable, "-m", "rigger", *map(str, args)], capture_output=True, text=True,
-                          timeout=timeout)
-
-
-def write_obj(path, vertices, triangles):
-    with open(path, "w") as out:
-        out.write("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in vertices))
-        out.write("".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
-    return path
 
 
 @pytest.fixture(scope="module")
@@ -322,61 +308,3 @@ def test_methods_lists_every_method_and_its_parameters():
     result = run("methods")
     assert result.returncode == 0
     assert "silhouette:" in result.stdout and "--set bone_length=VALUE" in result.stdout
-
-
-def test_batch_rigs_a_folder_in_parallel_and_summarises(humanoid_obj, tmp_path):
-    folder = tmp_path / "models"
-    folder.mkdir()
-    vertices, triangles = load_character("snake")
-    write_obj(folder / "snake.obj", vertices, triangles)
-    (folder / "snake.fbx").write_text("not an FBX")  # the same stem: the results must not share a name
-    (folder / "notes.txt").write_text("not a model")
-    out = tmp_path / "rigged"
-    result = run("batch", folder, "-o", out, "--jobs", 2, "--format", "glb", "--timeout", 300, "--up", "Z")
-    assert result.returncode == 1  # one file failed
-    assert "1 of 2 rigged" in result.stdout and "2/2" in result.stderr and "warning" not in result.stderr
-    assert json.loads((out / "snake_obj.json").read_text())["axes"] == {"up": "Z", "forward": "Y"}
-    rows = {row["file"]: row for row in json.loads((out / "summary.json").read_text())}
-    assert rows["snake.obj"]["status"] == "ok" and rows["snake.obj"]["bones"] > 0
-    assert rows["snake.obj"]["output"] == "snake_obj.glb"
-    assert rows["snake.fbx"]["status"] == "failed" and "could not import" in rows["snake.fbx"]["message"]
-    assert sorted(leaves_nothing(out)) == ["snake_obj.glb", "snake_obj.json", "summary.json"]
-
-
-def test_batch_results_written_into_the_input_folder_never_replace_an_input(tmp_path):
-    sources = [tmp_path / name for name in ("a.glb", "b.obj", "summary.obj")]
-    assert cli.output_stems(sources, "glb", in_place=True) == ["a_glb", "b", "summary_obj"]
-    assert cli.output_stems(sources, "glb", in_place=False) == ["a", "b", "summary_obj"]
-
-
-def test_a_batch_child_that_crashes_or_hangs_gives_a_failed_row(monkeypatch, tmp_path):
-    half_written = "import os, sys; os.mkdir(os.path.join(os.path.dirname(sys.argv[1]), '.crash.glb.tmp')); "
-    scripts = {"crash": half_written + "import signal; os.kill(os.getpid(), signal.SIGKILL)",
-               "hang": "import time; time.sleep(60)"}
-    monkeypatch.setattr(cli, "child_command",
-                        lambda source, output, *_: [sys.executable, "-c", scripts[source.stem], str(output)])
-
-    def row(name, timeout):
-        return cli.rig_in_child(tmp_path / f"{name}.obj", tmp_path / f"{name}.glb", tmp_path / f"{name}.json", [],
-                                timeout=timeout)
-
-    crashed = row("crash", timeout=60)
-    assert crashed["status"] == "failed" and crashed["message"] == "crashed (killed by signal 9)"
-    start = time.perf_counter()
-    hung = row("hang", timeout=1)
-    assert hung["status"] == "failed" and hung["message"] == "timed out after 1 s"
-    assert time.perf_counter() - start < 30
-    assert leaves_nothing(tmp_path) == []
-
-
-def test_batch_on_a_missing_folder_is_an_error(tmp_path):
-    result = run("batch", tmp_path / "nope", "-o", tmp_path / "out")
-    assert result.returncode == 1 and "no such folder" in result.stderr
-    assert not (tmp_path / "out").exists()
-
-
-def test_batch_results_under_a_file_are_an_error(humanoid_obj, tmp_path):
-    (tmp_path / "a_file").write_text("")
-    result = run("batch", humanoid_obj[0].parent, "-o", tmp_path / "a_file" / "out")
-    assert result.returncode == 1 and "a_file: is not a folder, so the results cannot go in" in result.stderr
-    assert "Traceback" not in result.stderr

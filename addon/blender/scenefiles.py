@@ -5,7 +5,7 @@ import pathlib
 import bpy
 import numpy as np
 
-from ..axes import file_axes, to_blender
+from ..axes import axes_field, file_axes, to_blender
 from ..core.files import replaced_on_success
 from . import overlays, skinning
 from .armature import delete_armature
@@ -47,7 +47,7 @@ def rig_file(source, output, method, params, *, target="plain", skin=True, up=No
         outcomes, skin_warnings = skin_meshes(meshes, result.armature)
         warnings += skin_warnings
     save_scene(output, [*meshes, result.armature])
-    return {"input": str(source), "output": str(output),
+    return {"input": str(source), "output": str(output), "asked_target": target,
             **rig_report(result, outcomes, *frame, warnings=warnings, axes=axes)}
 
 
@@ -118,7 +118,7 @@ def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warn
     timings = {**result.timings, **{f"method.{k}": v for k, v in skeleton.timings.items()}}
     return {
         "frame": frame,
-        "axes": None if axes is None else dict(zip(("up", "forward"), axes)),
+        "axes": axes_field(axes),
         "method": result.armature.get(METHOD_PROPERTY),
         "params": skeleton.params,
         "target": result.armature.get(TARGET_PROPERTY),

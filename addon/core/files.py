@@ -3,11 +3,13 @@ import contextlib
 import glob
 import os
 import pathlib
+import re
 import shutil
 import tempfile
 
 
 _LEFTOVER = ".{}."  # the prefix of the temporary folder beside the final file
+_LEFTOVER_NAME = re.compile(r"\..+\.[a-z0-9_]{8}")  # that prefix and the eight random characters tempfile adds
 
 
 @contextlib.contextmanager
@@ -30,3 +32,12 @@ def remove_leftovers(final):
     for leftover in final.parent.glob(glob.escape(_LEFTOVER.format(final.name)) + "*"):
         if leftover.is_dir():
             shutil.rmtree(leftover)
+
+
+def remove_leftover_folders(folder):
+    """Remove every folder ``replaced_on_success`` left anywhere below ``folder`` (processes killed before the
+    rename, say a whole batch killed at once)."""
+    for parent, folders, _ in os.walk(folder):
+        for name in [name for name in folders if _LEFTOVER_NAME.fullmatch(name)]:
+            shutil.rmtree(os.path.join(parent, name), ignore_errors=True)
+            folders.remove(name)

@@ -1,0 +1,90 @@
+"""The local engine: each file in a child process of its own (``python -m rigger rig``), ``jobs`` at a time.
+
+A fresh process per file pays for Blender's start-up every time, but a file can take nothing with it into the next
+one, and a child that crashes or hangs takes only its own file down.
+"""
+import concurrent.futures
+import json
+import subprocess
+import sys
+import threading
+import time
+
+from .work import rigged_row
+
+
+class LocalEngine:
+    """Up to ``jobs`` child processes at once; each gets ``timeout`` seconds (None: no limit) for its file."""
+
+    def __init__(self, jobs, timeout, settings):
+        self.slots = jobs
+        self._timeout = timeout
+        self._settings = settings
+        self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=jobs)
+        self._futures = {}
+        self._children = set()
+        self._lock = threading.Lock()
+        self._stopping = False
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc_info):
+        self.stop()
+
+    def start(self, job):
+        self._futures[self._pool.submit(self._rig, job)] = job
+
+    def finished(self):
+        done, _ = concurrent.futures.wait(self._futures, return_when=concurrent.futures.FIRST_COMPLETED)
+        return [(self._futures.pop(future), *future.result()) for future in done]
+
+    def stop(self):
+        """Kill the children still running and wait for their threads."""
+        with self._lock:
+            self._stopping = True
+            for child in self._children:
+                child.kill()
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+    def _rig(self, job):
+        """(row, crashed) for one file rigged in a child process."""
+        command = [sys.executable, "-m", __package__.rpartition(".")[0], "rig", str(job.source.path),
+                   "-o", str(job.output), "--report", str(job.report), *self._settings.options(job.source.path)]
+        start = time.perf_counter()
+        with self._lock:
+            if self._stopping:
+                return {"status": "failed", "message": "stopped", "seconds": 0.0}, False
+            child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            self._children.add(child)
+        timed_out = False
+        try:
+            _, stderr = child.communicate(timeout=self._timeout)
+        except subprocess.TimeoutExpired:
+            timed_out = True
+            child.kill()
+            _, stderr = child.communicate()
+        finally:
+            with self._lock:
+                self._children.discard(child)
+        seconds = round(time.perf_counter() - start, 2)
+        if timed_out:
+            return {"status": "failed", "message": f"timed out after {self._timeout:g} s", "seconds": seconds}, False
+        if child.returncode:
+            return {"status": "failed", "message": _failure(child.returncode, stderr), "seconds": seconds}, \
+                child.returncode < 0
+        try:
+            row = rigged_row(json.loads(job.report.read_text()))
+        except (OSError, ValueError, KeyError) as error:
+            row = {"status": "failed", "message": f"finished without a readable report: {error}"}
+        return {**row, "seconds": seconds}, False
+
+
+def _failure(returncode, stderr):
+    """What went wrong in a failed child: its ``rigger: error:`` line, else how it ended and its last output."""
+    lines = [line for line in stderr.splitlines() if line.startswith("rigger: error:")]
+    if lines:
+        return lines[-1].removeprefix("rigger: error: ")
+    how = f"killed by signal {-returncode}" if returncode < 0 else f"exit status {returncode}"
+    tail = stderr.strip()[-300:]
+    return f"crashed ({how})" + (f": {tail}" if tail else "")
