@@ -129,7 +129,7 @@ def shown_collection(obj, view_layer):
 
 def skin_meshes(meshes, armature, progress=None):
     """Skin every mesh of ``meshes`` to ``armature``, then let its output target finish the weights
-(``targets.skinned``): {mesh name: skinning report}, and warnings of our own.
+    (``targets.skinned``): {mesh name: skinning report}, and warnings of our own.
 
     Weights live in the mesh data, so a mesh object sharing its data with other objects (a linked duplicate) first
     gets its own copy: otherwise skinning one copy would rewrite the weights of the others.
