@@ -1,0 +1,452 @@
+"""Motion capture onto a game skeleton (bpy-free; ``rigger.blender.animate`` reads the BVH and writes the action).
+
+Mapping: each game bone (``rigger.core.game``'s names) takes the mocap joint whose name, with any namespace
+(``mixamorig:``) and separators dropped and case ignored, is one of its aliases (``aliases``: CMU's ``LowerBack``,
+Mixamo's, ``LeftUpLeg`` / ``LeftThigh`` / ``lThigh`` / ``thigh_l`` and so on). The spine's joints between the hips
+and the neck are shared out over Spine, Spine1 and Spine2 in order. The mapping fails, naming what is missing, when
+the hips, a leg (UpLeg, Leg, Foot) or an arm (Arm, ForeArm) of the game skeleton finds no joint.
+
+Retargeting, frame by frame (all in the game armature's space):
+
+- The mocap is turned about its up so that its left (from the right hip to the left one) and up meet the
+  character's (``Clip.up``: Blender's BVH importer reads files Y up, into +Z).
+- Limb bones (shoulders, arms, legs, hands, fingers) take their joint's rotation since its rest, after a fixed swing
+  that lays the character's bone along the mocap's bone at rest: their directions follow the mocap's whatever either
+  rest pose is (a T-pose onto an A-pose). The trunk, neck, head, feet and toes take their joint's rotation since its
+  rest as it is: both stand upright with their feet flat at rest. Bones without a joint turn with their parent.
+- The hips move as the mocap's do, scaled by the ratio of the legs' lengths (hip joint to knee to ankle): across the
+  ground from where the character stands, and up and down from its rest height where the mocap's hips would stand
+  on straight legs with planted feet. Heights are measured from the mocap's contact level (the
+  ``CONTACT_PERCENTILE``-th percentile of its toe joints' heights, else its ankles'); a planted foot's ankle stands
+  as high above it as it does, in the median, in the frames that foot is planted (:func:`contact_frames`).
+- Each leg then reaches, by two-bone IK in the plane its knee bends in, for its ankle's height: the character's
+  ankle height at rest plus, scaled, how far the mocap's ankle is above its planted height. Feet planted in the
+  mocap are planted in the character whatever the legs' proportions.
+"""
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+SIDES = (("Left", ("left", "l")), ("Right", ("right", "r")))
+SIDED_WORDS = {  # a game bone's word: aliases of the word, best first (sides are added around them)
+    "Shoulder": ("shoulder", "collar", "clavicle"),
+    "Arm": ("arm", "uparm", "upperarm", "shldr", "humerus"),
+    "ForeArm": ("forearm", "lowarm", "lowerarm", "elbow"),
+    "Hand": ("hand", "wrist"),
+    "UpLeg": ("upleg", "thigh", "upperleg", "hip"),
+    "Leg": ("leg", "lowleg", "lowerleg", "knee", "shin", "calf"),
+    "Foot": ("foot", "ankle"),
+    "ToeBase": ("toebase", "toe", "toes", "ball"),
+}
+DIGITS = {"Thumb": ("thumb",), "Index": ("index",), "Middle": ("middle",), "Ring": ("ring",),
+          "Pinky": ("pinky", "little")}
+MIDDLE = {"Hips": ("hips", "hip", "pelvis", "root"), "Neck": ("neck", "neck1", "neck01"), "Head": ("head",)}
+SPINE = ("Spine", "Spine1", "Spine2")
+SPINE_WORDS = ("lowerback", "spine", "abdomen", "chest", "torso", "back")
+REQUIRED = ("Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "RightUpLeg", "RightLeg", "RightFoot", "LeftArm",
+            "LeftForeArm", "RightArm", "RightForeArm")
+SWUNG = re.compile(r"Shoulder|Arm|ForeArm|Hand|UpLeg|Leg|Hand(Thumb|Index|Middle|Ring|Pinky)\d")  # laid along the
+# mocap's bones at rest
+CONTACT_PERCENTILE = 5.0
+
+
+class RetargetError(ValueError):
+    """A motion that cannot drive the game skeleton; the message names the bones and joints."""
+
+
+def normalised(name):
+    """A joint name as aliases are written: namespace (``mixamorig:``, ``mixamorig1_``) and separators dropped,
+    lower case."""
+    name = name.split(":")[-1].split("|")[-1]
+    name = re.sub(r"^mixamorig\d*_?", "", name, flags=re.IGNORECASE)
+    return re.sub(r"[^0-9a-z]", "", name.lower())
+
+
+def aliases(game_name):
+    """The normalised joint names that can drive game bone ``game_name``, best first (empty when none can)."""
+    if game_name in MIDDLE:
+        return MIDDLE[game_name]
+    for side, short in SIDES:
+        if not game_name.startswith(side):
+            continue
+        word = game_name[len(side):]
+        if word in SIDED_WORDS:
+            words = SIDED_WORDS[word]
+        else:
+            match = re.fullmatch(r"Hand(Thumb|Index|Middle|Ring|Pinky)([123])", word)
+            if match is None:
+                return ()
+            digit, number = match.groups()
+            words = tuple(form for alias in DIGITS[digit]
+                          for form in (f"hand{alias}{number}", f"{alias}{number}", f"{alias}0{number}")
+                          + ((f"hand{alias}", alias) if number == "1" else ()))
+        return tuple(f"{prefix}{w}" for w in words for prefix in short) + \
+            tuple(f"{w}{suffix}" for w in words for suffix in short)
+    return ()
+
+
+@dataclass
+class Mapping:
+    """Which mocap joint drives each game bone (``driven``: game name -> joint index), the game bones no joint drives
+    (``undriven``) and the joints that drive nothing (``unused``)."""
+
+    driven: dict
+    undriven: list
+    unused: list
+
+
+def map_joints(joint_names, joint_parents, game_names):
+    """The :class:`Mapping` of mocap joints ``joint_names`` (parents ``joint_parents``) onto ``game_names``;
+    :class:`RetargetError` naming the required game bones (``REQUIRED`` that the game skeleton has) no joint drives
+    and the joints left unplaced."""
+    normal = [normalised(name) for name in joint_names]
+    first = {}
+    for index, name in enumerate(normal):
+        first.setdefault(name, index)
+    driven = {}
+    for game in game_names:
+        joint = next((first[alias] for alias in aliases(game) if alias in first), None)
+        if joint is not None and joint not in driven.values():
+            driven[game] = joint
+    if "Hips" in driven:  # the spine: the joints between the hips and the neck (or the arms' parent), in order
+        top = driven.get("Neck", driven.get("LeftShoulder", driven.get("LeftArm")))
+        path = []
+        while top is not None and top >= 0 and top != driven["Hips"]:
+            path.append(top)
+            top = joint_parents[top]
+        chain = [j for j in reversed(path[1:]) if j not in driven.values()
+                 and any(word in normal[j] for word in SPINE_WORDS)] if top == driven["Hips"] else []
+        spine = [name for name in SPINE if name in game_names]
+        for k, name in enumerate(spine):
+            if chain:
+                driven[name] = chain[min(len(chain) - 1, round(k * (len(chain) - 1) / max(len(spine) - 1, 1)))]
+    undriven = [name for name in game_names if name not in driven and name != "root"]
+    used = set(driven.values())
+    unused = [joint_names[j] for j in range(len(joint_names)) if j not in used]
+    missing = [name for name in REQUIRED if name in game_names and name not in driven]
+    if missing:
+        raise RetargetError(f"the motion cannot drive the game bones {', '.join(missing)}: none of its joints has a "
+                            f"name they take (the common mocap names: Hips, LeftUpLeg, LeftLeg, LeftFoot, LeftArm, "
+                            f"LeftForeArm, ...); joints it could not place: {', '.join(unused) or 'none'}")
+    return Mapping(driven, undriven, unused)
+
+
+@dataclass
+class Clip:
+    """A motion: joint ``names`` and ``parents``, ``rest`` (J, 4, 4) and ``poses`` (F, J, 4, 4) world matrices of
+    every joint (rotation: the joint's frame; translation: where it is), frames per second and the world ``up``."""
+
+    names: tuple
+    parents: np.ndarray
+    rest: np.ndarray
+    poses: np.ndarray
+    fps: float
+    up: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+
+
+@dataclass
+class Rig:
+    """The game armature at rest: bone ``names``, ``parents``, ``rest`` (B, 4, 4) matrices (Blender's
+    ``bone.matrix_local``: the bone's frame, its head as translation), ``tails`` (B, 3), its ``up`` and the height
+    of its ``ground`` along it, all in the armature's space."""
+
+    names: tuple
+    parents: np.ndarray
+    rest: np.ndarray
+    tails: np.ndarray
+    up: np.ndarray
+    ground: float
+
+
+@dataclass
+class Motion:
+    """Baked keys: per frame and bone, the pose rotation (``rotations`` (F, B, 4) quaternions w, x, y, z, relative to
+    the rest pose, as ``pose_bone.rotation_quaternion``), the Hips' pose ``location`` (F, 3) and the ``scale`` the
+    mocap's lengths were taken at, with the :class:`Mapping`."""
+
+    rotations: np.ndarray
+    location: np.ndarray
+    hips: int
+    fps: float
+    scale: float
+    mapping: Mapping
+
+
+def retarget(clip, rig, mapping=None):
+    """The :class:`Motion` of ``clip`` on ``rig`` (see the module docstring)."""
+    mapping = mapping or map_joints(clip.names, clip.parents, rig.names)
+    index = {name: k for k, name in enumerate(rig.names)}
+    drive = {index[name]: joint for name, joint in mapping.driven.items()}
+    up = _unit(rig.up)
+    turn = _alignment(clip, rig, mapping.driven, index, up)
+    frames = len(clip.poses)
+    rest_rot = rig.rest[:, :3, :3]
+    heads = rig.rest[:, :3, 3]
+    directions = rig.tails - heads
+    swing = {}
+    for bone, joint in drive.items():
+        if SWUNG.fullmatch(_word(rig.names[bone])):
+            end = _segment_end(clip, joint, mapping, rig, bone)
+            if end is not None:
+                swing[bone] = _between(directions[bone], turn @ (clip.rest[end, :3, 3] - clip.rest[joint, :3, 3]))
+    deltas = np.einsum("fjab,jcb->fjac", clip.poses[:, :, :3, :3], clip.rest[:, :3, :3])  # pose * rest^T
+    deltas = np.einsum("ab,fjbc,dc->fjad", turn, deltas, turn)
+    world = np.empty((frames, len(rig.names), 3, 3))
+    for bone in range(len(rig.names)):
+        parent = rig.parents[bone]
+        if bone in drive:
+            world[:, bone] = deltas[:, drive[bone]] @ swing.get(bone, np.eye(3))
+        else:
+            world[:, bone] = world[:, parent] if parent >= 0 else np.eye(3)
+    scale = _leg_scale(clip, rig, mapping.driven, index)
+    hips = index["Hips"]
+    level, ankles = _planted(clip, mapping.driven, _unit(clip.up))
+    hips_at = _hips_path(clip, rig, mapping.driven, index, turn, up, scale, level, ankles)
+    _reach_ankles(clip, rig, mapping.driven, index, world, hips_at, up, scale, level, ankles)
+    rotations = np.empty((frames, len(rig.names), 4))
+    for bone in range(len(rig.names)):
+        parent = rig.parents[bone]
+        parent_world = world[:, parent] if parent >= 0 else np.broadcast_to(np.eye(3), (frames, 3, 3))
+        local = np.einsum("ba,fcb,fcd,de->fae", rest_rot[bone], parent_world, world[:, bone], rest_rot[bone])
+        rotations[:, bone] = _continuous(_quaternions(local))
+    location = (hips_at - heads[hips]) @ rest_rot[hips]  # into the Hips' rest frame
+    return Motion(rotations, location, hips, clip.fps, scale, mapping)
+
+
+def posed_points(rig, world, hips_at):
+    """Heads and tails (F, B, 3) of ``rig``'s bones posed with world rotations ``world`` (F, B, 3, 3) (relative to
+    rest) and the Hips' head at ``hips_at`` (F, 3): every bone's head rides on its parent."""
+    heads = rig.rest[:, :3, 3]
+    frames = len(world)
+    posed_heads = np.empty((frames, len(rig.names), 3))
+    hips = rig.names.index("Hips")
+    for bone in range(len(rig.names)):
+        parent = rig.parents[bone]
+        if bone == hips:
+            posed_heads[:, bone] = hips_at
+        elif parent < 0:
+            posed_heads[:, bone] = heads[bone]
+        else:
+            posed_heads[:, bone] = posed_heads[:, parent] + world[:, parent] @ (heads[bone] - heads[parent])
+    posed_tails = posed_heads + np.einsum("fbij,bj->fbi", world, rig.tails - heads)
+    return posed_heads, posed_tails
+
+
+def world_rotations(rig, motion):
+    """World rotations (F, B, 3, 3) relative to rest and the Hips' head (F, 3) of ``motion`` on ``rig``: the inverse
+    of what :func:`retarget` bakes, for measuring."""
+    frames = len(motion.rotations)
+    rest_rot = rig.rest[:, :3, :3]
+    world = np.empty((frames, len(rig.names), 3, 3))
+    for bone in range(len(rig.names)):
+        parent = rig.parents[bone]
+        local = _matrices(motion.rotations[:, bone])
+        parent_world = world[:, parent] if parent >= 0 else np.eye(3)
+        world[:, bone] = parent_world @ rest_rot[bone] @ local @ rest_rot[bone].T
+    hips = motion.hips
+    return world, rig.rest[hips, :3, 3] + motion.location @ rest_rot[hips].T
+
+
+def contact_frames(clip, mapping, side, leg_length=None, height=0.05, speed=0.5):
+    """Frames (bool (F,)) where the mocap's foot on ``side`` ("Left"/"Right") is planted: its lowest joint (toe,
+    else ankle) within ``height`` leg lengths of its contact level and slower than ``speed`` leg lengths a second."""
+    joint = _foot_joint(mapping.driven, side)
+    up = _unit(clip.up)
+    leg = leg_length or _leg_length(clip.rest, mapping.driven, side)
+    path = clip.poses[:, joint, :3, 3]
+    heights = path @ up
+    level = np.percentile(heights, CONTACT_PERCENTILE)
+    velocity = np.gradient(path, axis=0) * clip.fps
+    return (heights - level <= height * leg) & (np.linalg.norm(velocity, axis=1) <= speed * leg)
+
+
+def _word(name):
+    return name[4:] if name.startswith("Left") else name[5:] if name.startswith("Right") else name
+
+
+def _unit(vector):
+    vector = np.asarray(vector, dtype=np.float64)
+    return vector / np.linalg.norm(vector)
+
+
+def _alignment(clip, rig, driven, index, up):
+    """The rotation taking the mocap's (left, up, forward) at rest onto the character's."""
+    def left_of(points, names):
+        for a, b in (("LeftUpLeg", "RightUpLeg"), ("LeftArm", "RightArm"), ("LeftShoulder", "RightShoulder")):
+            if a in names and b in names:
+                return points(names[a]) - points(names[b])
+        raise RetargetError("the motion and the character need a left and a right leg or arm to face each other")
+
+    source_up = _unit(clip.up)
+    source_left = left_of(lambda j: clip.rest[j, :3, 3], driven)
+    target_left = left_of(lambda name: rig.rest[index[name], :3, 3], {n: n for n in driven if n in index})
+    frames = []
+    for left, upward in ((source_left, source_up), (target_left, up)):
+        left = _unit(left - (left @ upward) * upward)
+        frames.append(np.column_stack([left, upward, np.cross(left, upward)]))
+    return frames[1] @ frames[0].T
+
+
+def _segment_end(clip, joint, mapping, rig, bone):
+    """The joint ending the mocap bone of ``joint`` for game bone ``bone``: the joint driving the game bone's first
+    child, else ``joint``'s nearest descendant away from it."""
+    children = [k for k, parent in enumerate(rig.parents) if parent == bone]
+    for child in children:
+        end = mapping.driven.get(rig.names[child])
+        if end is not None and np.linalg.norm(clip.rest[end, :3, 3] - clip.rest[joint, :3, 3]) > 0:
+            return end
+    todo = [k for k, parent in enumerate(clip.parents) if parent == joint]
+    while todo:
+        k = todo.pop(0)
+        if np.linalg.norm(clip.rest[k, :3, 3] - clip.rest[joint, :3, 3]) > 0:
+            return k
+        todo += [c for c, parent in enumerate(clip.parents) if parent == k]
+    return None
+
+
+def _between(a, b):
+    """The smallest rotation taking direction ``a`` onto direction ``b``."""
+    a, b = _unit(a), _unit(b)
+    axis = np.cross(a, b)
+    sine, cosine = np.linalg.norm(axis), float(a @ b)
+    if sine < 1e-12:
+        if cosine > 0:
+            return np.eye(3)
+        other = np.eye(3)[np.argmin(np.abs(a))]
+        axis = _unit(np.cross(a, other))
+        return 2 * np.outer(axis, axis) - np.eye(3)
+    axis /= sine
+    cross = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + sine * cross + (1 - cosine) * cross @ cross
+
+
+def _leg_length(points, driven, side):
+    """Hip joint to knee to ankle, from (J, 4, 4) matrices ``points``."""
+    joints = [driven.get(f"{side}{word}") for word in ("UpLeg", "Leg", "Foot")]
+    if None in joints:
+        return None
+    at = points[joints, :3, 3]
+    return float(np.linalg.norm(np.diff(at, axis=0), axis=1).sum())
+
+
+def _rig_leg_length(rig, index, side):
+    bones = [index.get(f"{side}{word}") for word in ("UpLeg", "Leg")]
+    if None in bones:
+        return None
+    return float(sum(np.linalg.norm(rig.tails[bone] - rig.rest[bone, :3, 3]) for bone in bones))
+
+
+def _leg_scale(clip, rig, driven, index):
+    """The character's leg length over the mocap's (the mean of both sides that both have)."""
+    ratios = [target / source for side in ("Left", "Right")
+              for source, target in [(_leg_length(clip.rest, driven, side), _rig_leg_length(rig, index, side))]
+              if source and target]
+    if not ratios:
+        raise RetargetError("the motion and the character need legs (UpLeg, Leg, Foot) to be scaled to each other")
+    return float(np.mean(ratios))
+
+
+def _foot_joint(driven, side):
+    return driven.get(f"{side}ToeBase", driven.get(f"{side}Foot"))
+
+
+def _planted(clip, driven, up):
+    """(the contact level: the height along ``up`` where the mocap's toe joints, else ankles, touch the ground; per
+    side, how high its ankle then stands above that level: the median over the frames its foot is planted, else
+    at rest)."""
+    joints = [_foot_joint(driven, side) for side in ("Left", "Right")]
+    level = float(np.percentile((clip.poses[:, joints, :3, 3] @ up).min(axis=1), CONTACT_PERCENTILE))
+    ankles = {}
+    for side in ("Left", "Right"):
+        ankle = driven[f"{side}Foot"]
+        heights = clip.poses[:, ankle, :3, 3] @ up - level
+        planted = contact_frames(clip, Mapping(driven, [], []), side)
+        ankles[side] = float(np.median(heights[planted])) if planted.any() else \
+            float((clip.rest[ankle, :3, 3] - clip.rest[_foot_joint(driven, side), :3, 3]) @ up)
+    return level, ankles
+
+
+def _hips_path(clip, rig, driven, index, turn, up, scale, level, ankles):
+    """Where the character's hips go (F, 3): see the module docstring."""
+    source_up = _unit(clip.up)
+    hips = driven["Hips"]
+    path = clip.poses[:, hips, :3, 3]
+    rest = clip.rest[:, :3, 3]
+    standing = np.mean([(rest[hips] - rest[driven[f"{side}UpLeg"]]) @ source_up
+                        + _leg_length(clip.rest, driven, side) + ankles[side] for side in ("Left", "Right")])
+    across = (path - path[0]) @ turn.T
+    across -= np.outer(across @ up, up)
+    height = (path @ source_up - level) - standing
+    return rig.rest[index["Hips"], :3, 3] + scale * (across + np.outer(height, up))
+
+
+def _reach_ankles(clip, rig, driven, index, world, hips_at, up, scale, level, ankles):
+    """Turn each leg's UpLeg and Leg (in ``world``, in place) so the ankle reaches its height (module docstring)."""
+    source_up = _unit(clip.up)
+    rest = rig.rest[:, :3, 3]
+    for side in ("Left", "Right"):
+        names = [f"{side}{word}" for word in ("UpLeg", "Leg", "Foot")]
+        if any(name not in index for name in names):
+            continue
+        thigh, shin, foot = (index[name] for name in names)
+        source_ankle = clip.poses[:, driven[f"{side}Foot"], :3, 3] @ source_up - level
+        wanted_height = (rest[foot] @ up - rig.ground) + scale * (source_ankle - ankles[side])
+        heads, _ = posed_points(rig, world, hips_at)
+        hip, knee, ankle = heads[:, thigh], heads[:, shin], heads[:, foot]
+        target = ankle + np.outer(rig.ground + wanted_height - ankle @ up, up)
+        upper, lower = np.linalg.norm(rest[shin] - rest[thigh]), np.linalg.norm(rest[foot] - rest[shin])
+        for frame in range(len(world)):
+            new_knee = _two_bone(hip[frame], knee[frame], target[frame], upper, lower)
+            world[frame, thigh] = _between(knee[frame] - hip[frame], new_knee - hip[frame]) @ world[frame, thigh]
+            world[frame, shin] = _between(ankle[frame] - knee[frame], target[frame] - new_knee) @ world[frame, shin]
+
+
+def _two_bone(hip, knee, target, upper, lower):
+    """The knee that puts a leg of bone lengths ``upper`` and ``lower`` from ``hip`` onto ``target`` (as near as
+    it reaches), bending in the plane of ``hip``, ``knee`` and ``target``, to ``knee``'s side."""
+    reach = target - hip
+    distance = np.linalg.norm(reach)
+    along = reach / distance if distance > 0 else _unit(knee - hip)
+    distance = np.clip(distance, abs(upper - lower) + 1e-9, upper + lower - 1e-9)
+    bend = (knee - hip) - ((knee - hip) @ along) * along
+    if np.linalg.norm(bend) < 1e-9 * (upper + lower):
+        return hip + along * upper
+    bend = _unit(bend)
+    share = (upper ** 2 - lower ** 2 + distance ** 2) / (2 * distance)
+    return hip + share * along + np.sqrt(max(upper ** 2 - share ** 2, 0.0)) * bend
+
+
+def _quaternions(matrices):
+    """(..., 4) unit quaternions w, x, y, z of rotation matrices (..., 3, 3)."""
+    m = matrices
+    trace = m[..., 0, 0] + m[..., 1, 1] + m[..., 2, 2]
+    candidates = np.stack([
+        np.stack([1 + trace, m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]], -1),
+        np.stack([m[..., 2, 1] - m[..., 1, 2], 1 + 2 * m[..., 0, 0] - trace, m[..., 0, 1] + m[..., 1, 0],
+                  m[..., 0, 2] + m[..., 2, 0]], -1),
+        np.stack([m[..., 0, 2] - m[..., 2, 0], m[..., 0, 1] + m[..., 1, 0], 1 + 2 * m[..., 1, 1] - trace,
+                  m[..., 1, 2] + m[..., 2, 1]], -1),
+        np.stack([m[..., 1, 0] - m[..., 0, 1], m[..., 0, 2] + m[..., 2, 0], m[..., 1, 2] + m[..., 2, 1],
+                  1 + 2 * m[..., 2, 2] - trace], -1)], -2)
+    diagonal = np.stack([trace, m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]], -1)
+    best = np.take_along_axis(candidates, np.argmax(diagonal, -1)[..., None, None], -2)[..., 0, :]
+    return best / np.linalg.norm(best, axis=-1, keepdims=True)
+
+
+def _matrices(quaternions):
+    """Rotation matrices (..., 3, 3) of unit quaternions (..., 4) w, x, y, z."""
+    w, x, y, z = np.moveaxis(np.asarray(quaternions, dtype=np.float64), -1, 0)
+    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+                     np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+                     np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
+
+
+def _continuous(quaternions):
+    """``quaternions`` (F, 4) with signs flipped so that neighbouring frames agree (interpolation takes the short
+    way)."""
+    result = quaternions.copy()
+    for frame in range(1, len(result)):
+        if result[frame] @ result[frame - 1] < 0:
+            result[frame] = -result[frame]
+    return result
