@@ -12,16 +12,19 @@ Retargeting, frame by frame (all in the game armature's space):
   character's (``Clip.up``: Blender's BVH importer reads files Y up, into +Z).
 - Limb bones (shoulders, arms, legs, hands, fingers) take their joint's rotation since its rest, after a fixed swing
   that lays the character's bone along the mocap's bone at rest: their directions follow the mocap's whatever either
-  rest pose is (a T-pose onto an A-pose). The trunk, neck, head, feet and toes take their joint's rotation since its
-  rest as it is: both stand upright with their feet flat at rest. Bones without a joint turn with their parent.
+  rest pose is (a T-pose onto an A-pose). The trunk, neck and head take their joint's rotation since its rest as it
+  is: both stand upright at rest. Feet and toes too, after a fixed pitch that lays the character's foot flat where
+  the mocap's is planted (:func:`_flat_foot`). Bones without a joint turn with their parent.
 - The hips move as the mocap's do, scaled by the ratio of the legs' lengths (hip joint to knee to ankle): across the
   ground from where the character stands, and up and down from its rest height where the mocap's hips would stand
-  on straight legs with planted feet. Heights are measured from the mocap's contact level (the
-  ``CONTACT_PERCENTILE``-th percentile of its toe joints' heights, else its ankles'); a planted foot's ankle stands
-  as high above it as it does, in the median, in the frames that foot is planted (:func:`contact_frames`).
-- Each leg then reaches, by two-bone IK in the plane its knee bends in, for its ankle's height: the character's
-  ankle height at rest plus, scaled, how far the mocap's ankle is above its planted height. Feet planted in the
-  mocap are planted in the character whatever the legs' proportions.
+  on straight legs with flat feet. Heights are measured from the mocap's ground (:func:`mocap_ground`, a plane
+  through its planted toes); a flat foot's ankle and toe joint stand as high above it as they do, in the median, in
+  the frames that foot lies flat (:func:`_flat_frames`).
+- Each leg then reaches, by two-bone IK bending the knee forward (the thigh's turned rest forward), for the
+  ankle height that puts the lower of its heel (ankle) and toes (the foot's far end) as high above their rest
+  heights as, scaled, the lower of the mocap's ankle and toe joint is above their heights when its foot lies flat
+  (never below): a heel raised to push off pivots on the toes. In a frame where a leg would not reach, the hips
+  come down until it does. Feet planted in the mocap are planted in the character whatever the legs' proportions.
 """
 import re
 from dataclasses import dataclass, field
@@ -48,7 +51,10 @@ REQUIRED = ("Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "RightUpLeg", "RightLeg"
             "LeftForeArm", "RightArm", "RightForeArm")
 SWUNG = re.compile(r"Shoulder|Arm|ForeArm|Hand|UpLeg|Leg|Hand(Thumb|Index|Middle|Ring|Pinky)\d")  # laid along the
 # mocap's bones at rest
-CONTACT_PERCENTILE = 5.0
+CONTACT_HEIGHT = 0.05  # a planted foot's joint is this close to the ground (leg lengths) ...
+CONTACT_SPEED = 0.5  # ... and slower than this (leg lengths a second)
+MAX_SLOPE = 0.05  # the steepest capture floor taken (a rise over a run) ...
+SLOPE_RUN = 2.0  # ... fitted only when the feet go this many leg lengths
 
 
 class RetargetError(ValueError):
@@ -89,11 +95,13 @@ def aliases(game_name):
 @dataclass
 class Mapping:
     """Which mocap joint drives each game bone (``driven``: game name -> joint index), the game bones no joint drives
-    (``undriven``) and the joints that drive nothing (``unused``)."""
+    (``undriven``), the joints that drive nothing (``unused``) and the toe joints by side (``toes``: "Left" ->
+    joint index), which tell where the feet touch the ground even when the character has no toe bones."""
 
     driven: dict
     undriven: list
     unused: list
+    toes: dict = field(default_factory=dict)
 
 
 def map_joints(joint_names, joint_parents, game_names):
@@ -122,14 +130,17 @@ def map_joints(joint_names, joint_parents, game_names):
             if chain:
                 driven[name] = chain[min(len(chain) - 1, round(k * (len(chain) - 1) / max(len(spine) - 1, 1)))]
     undriven = [name for name in game_names if name not in driven and name != "root"]
-    used = set(driven.values())
+    toes = {side: driven.get(f"{side}ToeBase", next((first[alias] for alias in aliases(f"{side}ToeBase")
+                                                     if alias in first), None)) for side in ("Left", "Right")}
+    toes = {side: joint for side, joint in toes.items() if joint is not None}
+    used = set(driven.values()) | set(toes.values())
     unused = [joint_names[j] for j in range(len(joint_names)) if j not in used]
     missing = [name for name in REQUIRED if name in game_names and name not in driven]
     if missing:
         raise RetargetError(f"the motion cannot drive the game bones {', '.join(missing)}: none of its joints has a "
                             f"name they take (the common mocap names: Hips, LeftUpLeg, LeftLeg, LeftFoot, LeftArm, "
                             f"LeftForeArm, ...); joints it could not place: {', '.join(unused) or 'none'}")
-    return Mapping(driven, undriven, unused)
+    return Mapping(driven, undriven, unused, toes)
 
 
 @dataclass
@@ -179,7 +190,7 @@ def retarget(clip, rig, mapping=None):
     index = {name: k for k, name in enumerate(rig.names)}
     drive = {index[name]: joint for name, joint in mapping.driven.items()}
     up = _unit(rig.up)
-    turn = _alignment(clip, rig, mapping.driven, index, up)
+    turn, forward = _alignment(clip, rig, mapping.driven, index, up)
     frames = len(clip.poses)
     rest_rot = rig.rest[:, :3, :3]
     heads = rig.rest[:, :3, 3]
@@ -190,6 +201,12 @@ def retarget(clip, rig, mapping=None):
             end = _segment_end(clip, joint, mapping, rig, bone)
             if end is not None:
                 swing[bone] = _between(directions[bone], turn @ (clip.rest[end, :3, 3] - clip.rest[joint, :3, 3]))
+    ground, ankles = _planted(clip, mapping)
+    for side in ("Left", "Right"):
+        flat = _flat_foot(clip, mapping, ground, turn, up, side)
+        for word in ("Foot", "ToeBase"):
+            if f"{side}{word}" in mapping.driven and f"{side}{word}" in index:
+                swing[index[f"{side}{word}"]] = flat
     deltas = np.einsum("fjab,jcb->fjac", clip.poses[:, :, :3, :3], clip.rest[:, :3, :3])  # pose * rest^T
     deltas = np.einsum("ab,fjbc,dc->fjad", turn, deltas, turn)
     world = np.empty((frames, len(rig.names), 3, 3))
@@ -201,9 +218,8 @@ def retarget(clip, rig, mapping=None):
             world[:, bone] = world[:, parent] if parent >= 0 else np.eye(3)
     scale = _leg_scale(clip, rig, mapping.driven, index)
     hips = index["Hips"]
-    level, ankles = _planted(clip, mapping.driven, _unit(clip.up))
-    hips_at = _hips_path(clip, rig, mapping.driven, index, turn, up, scale, level, ankles)
-    _reach_ankles(clip, rig, mapping.driven, index, world, hips_at, up, scale, level, ankles)
+    hips_at = _hips_path(clip, rig, mapping.driven, index, turn, up, scale, ground, ankles)
+    _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale, ground, ankles)
     rotations = np.empty((frames, len(rig.names), 4))
     for bone in range(len(rig.names)):
         parent = rig.parents[bone]
@@ -248,17 +264,65 @@ def world_rotations(rig, motion):
     return world, rig.rest[hips, :3, 3] + motion.location @ rest_rot[hips].T
 
 
-def contact_frames(clip, mapping, side, leg_length=None, height=0.05, speed=0.5):
+def contact_frames(clip, mapping, side):
     """Frames (bool (F,)) where the mocap's foot on ``side`` ("Left"/"Right") is planted: its lowest joint (toe,
-    else ankle) within ``height`` leg lengths of its contact level and slower than ``speed`` leg lengths a second."""
-    joint = _foot_joint(mapping.driven, side)
-    up = _unit(clip.up)
-    leg = leg_length or _leg_length(clip.rest, mapping.driven, side)
+    else ankle) within ``CONTACT_HEIGHT`` leg lengths of the mocap's ground (:func:`mocap_ground`) and slower than
+    ``CONTACT_SPEED`` leg lengths a second."""
+    ground = mocap_ground(clip, mapping)
+    joint = _foot_joint(mapping, side)
     path = clip.poses[:, joint, :3, 3]
-    heights = path @ up
-    level = np.percentile(heights, CONTACT_PERCENTILE)
-    velocity = np.gradient(path, axis=0) * clip.fps
-    return (heights - level <= height * leg) & (np.linalg.norm(velocity, axis=1) <= speed * leg)
+    speed = np.linalg.norm(np.gradient(path, axis=0), axis=1) * clip.fps
+    return (ground.height(path) <= CONTACT_HEIGHT * ground.leg) & (speed <= CONTACT_SPEED * ground.leg)
+
+
+@dataclass(frozen=True)
+class Ground:
+    """The mocap's ground: a plane through its planted toe joints (or ankles), at ``offset`` along ``up`` at the
+    origin, rising by ``slope`` (a vector across ``up``) per unit across; ``leg`` is the mocap's leg length."""
+
+    up: np.ndarray
+    offset: float
+    slope: np.ndarray
+    leg: float
+
+    def height(self, points):
+        """Heights of ``points`` (..., 3) above the ground."""
+        points = np.asarray(points, dtype=np.float64)
+        return points @ self.up - self.offset - points @ self.slope
+
+
+def mocap_ground(clip, mapping):
+    """The :class:`Ground` the mocap's feet stand on: a plane fitted to its toe joints (else ankles) in the frames
+    they move slower than ``CONTACT_SPEED`` leg lengths a second, leaving out those more than ``CONTACT_HEIGHT``
+    leg lengths above it (a foot still in the air, the top of a jump). Capture floors tilt (CMU's walk climbs 0.7
+    of its units over its 50); the slope is at most ``MAX_SLOPE``, and none when the feet stay within ``SLOPE_RUN``
+    leg lengths of one place (feet apart on a level floor would tilt it)."""
+    up = _unit(clip.up)
+    leg = np.mean([length for side in ("Left", "Right")
+                   if (length := _leg_length(clip.rest, mapping.driven, side))])
+    joints = [_foot_joint(mapping, side) for side in ("Left", "Right")]
+    paths = clip.poses[:, joints, :3, 3]
+    speed = np.linalg.norm(np.gradient(paths, axis=0), axis=2) * clip.fps
+    points = paths[speed <= CONTACT_SPEED * leg]
+    if len(points) < 3:
+        points = paths.reshape(-1, 3)
+    heights = points @ up
+    across = points - np.outer(heights, up)
+    axes = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]  # two directions across up
+    flat = across @ axes
+    kept = heights <= np.percentile(heights, 25) + CONTACT_HEIGHT * leg
+    offset, slope = float(np.median(heights[kept])), np.zeros(3)
+    spread = np.ptp(flat[kept], axis=0).max() if kept.any() else 0.0
+    if kept.sum() >= 3 and spread > SLOPE_RUN * leg:
+        for _ in range(4):
+            design = np.column_stack([np.ones(kept.sum()), flat[kept]])
+            solution = np.linalg.lstsq(design, heights[kept], rcond=None)[0]
+            gradient = solution[1:]
+            if np.linalg.norm(gradient) > MAX_SLOPE:
+                gradient *= MAX_SLOPE / np.linalg.norm(gradient)
+            offset, slope = float(np.median(heights[kept] - flat[kept] @ gradient)), axes @ gradient
+            kept = heights - offset - points @ slope <= CONTACT_HEIGHT * leg
+    return Ground(up, offset, slope, float(leg))
 
 
 def _word(name):
@@ -271,7 +335,8 @@ def _unit(vector):
 
 
 def _alignment(clip, rig, driven, index, up):
-    """The rotation taking the mocap's (left, up, forward) at rest onto the character's."""
+    """(the rotation taking the mocap's (left, up, forward) at rest onto the character's, the character's
+    forward)."""
     def left_of(points, names):
         for a, b in (("LeftUpLeg", "RightUpLeg"), ("LeftArm", "RightArm"), ("LeftShoulder", "RightShoulder")):
             if a in names and b in names:
@@ -285,13 +350,32 @@ def _alignment(clip, rig, driven, index, up):
     for left, upward in ((source_left, source_up), (target_left, up)):
         left = _unit(left - (left @ upward) * upward)
         frames.append(np.column_stack([left, upward, np.cross(left, upward)]))
-    return frames[1] @ frames[0].T
+    return frames[1] @ frames[0].T, frames[1][:, 2]
+
+
+def _flat_foot(clip, mapping, ground, turn, up, side):
+    """The fixed turn of the character's foot (and toes) on ``side`` that keeps it flat when the mocap's foot is
+    flat: it pitches the mocap's rest foot (ankle to toe) to the slope it has, in the median, in the frames it lies
+    flat on the ground (:func:`_flat_frames`; a capture's rest foot seldom lies as the planted one does)."""
+    ankle = mapping.driven.get(f"{side}Foot")
+    toe = None if ankle is None else _segment_end(clip, ankle, mapping, None, None)
+    planted = _flat_frames(clip, mapping, ground, side) if toe is not None else None
+    if planted is None or not planted.any():
+        return np.eye(3)
+    rest = turn @ (clip.rest[toe, :3, 3] - clip.rest[ankle, :3, 3])
+    along = (clip.poses[planted, toe, :3, 3] - clip.poses[planted, ankle, :3, 3]) @ turn.T
+    slope = float(np.median(along @ up / np.linalg.norm(along, axis=1)))
+    across = rest - (rest @ up) * up
+    if not np.linalg.norm(across) > 0:
+        return np.eye(3)
+    wanted = np.sqrt(max(1 - slope ** 2, 0.0)) * _unit(across) + slope * up
+    return _between(wanted, rest)
 
 
 def _segment_end(clip, joint, mapping, rig, bone):
     """The joint ending the mocap bone of ``joint`` for game bone ``bone``: the joint driving the game bone's first
     child, else ``joint``'s nearest descendant away from it."""
-    children = [k for k, parent in enumerate(rig.parents) if parent == bone]
+    children = [] if rig is None else [k for k, parent in enumerate(rig.parents) if parent == bone]
     for child in children:
         end = mapping.driven.get(rig.names[child])
         if end is not None and np.linalg.norm(clip.rest[end, :3, 3] - clip.rest[joint, :3, 3]) > 0:
@@ -347,69 +431,96 @@ def _leg_scale(clip, rig, driven, index):
     return float(np.mean(ratios))
 
 
-def _foot_joint(driven, side):
-    return driven.get(f"{side}ToeBase", driven.get(f"{side}Foot"))
+def _foot_joint(mapping, side):
+    """The mocap's joint that touches the ground on ``side``: its toe joint, else its ankle."""
+    return mapping.toes.get(side, mapping.driven.get(f"{side}Foot"))
 
 
-def _planted(clip, driven, up):
-    """(the contact level: the height along ``up`` where the mocap's toe joints, else ankles, touch the ground; per
-    side, how high its ankle then stands above that level: the median over the frames its foot is planted, else
-    at rest)."""
-    joints = [_foot_joint(driven, side) for side in ("Left", "Right")]
-    level = float(np.percentile((clip.poses[:, joints, :3, 3] @ up).min(axis=1), CONTACT_PERCENTILE))
-    ankles = {}
+def _planted(clip, mapping):
+    """(the mocap's :class:`Ground`; per side, how high its ankle and its toe joint stand above the ground when the
+    foot lies flat on it: the medians over the frames it does (:func:`_flat_frames`), else as at rest)."""
+    ground = mocap_ground(clip, mapping)
+    heights = {}
     for side in ("Left", "Right"):
-        ankle = driven[f"{side}Foot"]
-        heights = clip.poses[:, ankle, :3, 3] @ up - level
-        planted = contact_frames(clip, Mapping(driven, [], []), side)
-        ankles[side] = float(np.median(heights[planted])) if planted.any() else \
-            float((clip.rest[ankle, :3, 3] - clip.rest[_foot_joint(driven, side), :3, 3]) @ up)
-    return level, ankles
+        ankle, toe = mapping.driven[f"{side}Foot"], _foot_joint(mapping, side)
+        flat = _flat_frames(clip, mapping, ground, side)
+        if flat.any():
+            heights[side] = tuple(float(np.median(ground.height(clip.poses[flat, joint, :3, 3])))
+                                  for joint in (ankle, toe))
+        else:
+            heights[side] = (float((clip.rest[ankle, :3, 3] - clip.rest[toe, :3, 3]) @ ground.up), 0.0)
+    return ground, heights
 
 
-def _hips_path(clip, rig, driven, index, turn, up, scale, level, ankles):
+def _flat_frames(clip, mapping, ground, side):
+    """Frames where the mocap's foot on ``side`` lies flat: planted (:func:`contact_frames`) with its ankle slower
+    than ``CONTACT_SPEED`` leg lengths a second too (a heel rising to push off or falling onto the ground is not)."""
+    path = clip.poses[:, mapping.driven[f"{side}Foot"], :3, 3]
+    speed = np.linalg.norm(np.gradient(path, axis=0), axis=1) * clip.fps
+    return contact_frames(clip, mapping, side) & (speed <= CONTACT_SPEED * ground.leg)
+
+
+def _hips_path(clip, rig, driven, index, turn, up, scale, ground, ankles):
     """Where the character's hips go (F, 3): see the module docstring."""
     source_up = _unit(clip.up)
     hips = driven["Hips"]
     path = clip.poses[:, hips, :3, 3]
     rest = clip.rest[:, :3, 3]
     standing = np.mean([(rest[hips] - rest[driven[f"{side}UpLeg"]]) @ source_up
-                        + _leg_length(clip.rest, driven, side) + ankles[side] for side in ("Left", "Right")])
+                        + _leg_length(clip.rest, driven, side) + ankles[side][0] for side in ("Left", "Right")])
     across = (path - path[0]) @ turn.T
     across -= np.outer(across @ up, up)
-    height = (path @ source_up - level) - standing
+    height = ground.height(path) - standing
     return rig.rest[index["Hips"], :3, 3] + scale * (across + np.outer(height, up))
 
 
-def _reach_ankles(clip, rig, driven, index, world, hips_at, up, scale, level, ankles):
-    """Turn each leg's UpLeg and Leg (in ``world``, in place) so the ankle reaches its height (module docstring)."""
-    source_up = _unit(clip.up)
+def _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale, ground, ankles):
+    """Turn each leg's UpLeg and Leg (in ``world``, in place) so the ankle reaches its height (module docstring),
+    lowering the hips (``hips_at``, in place) in the frames a leg would not reach that far."""
     rest = rig.rest[:, :3, 3]
+    heads, tails = posed_points(rig, world, hips_at)
+    legs = []
     for side in ("Left", "Right"):
         names = [f"{side}{word}" for word in ("UpLeg", "Leg", "Foot")]
         if any(name not in index for name in names):
             continue
         thigh, shin, foot = (index[name] for name in names)
-        source_ankle = clip.poses[:, driven[f"{side}Foot"], :3, 3] @ source_up - level
-        wanted_height = (rest[foot] @ up - rig.ground) + scale * (source_ankle - ankles[side])
-        heads, _ = posed_points(rig, world, hips_at)
-        hip, knee, ankle = heads[:, thigh], heads[:, shin], heads[:, foot]
-        target = ankle + np.outer(rig.ground + wanted_height - ankle @ up, up)
+        end = index.get(f"{side}ToeBase", foot)  # the foot's far end
+        source_ankle = ground.height(clip.poses[:, mapping.driven[f"{side}Foot"], :3, 3])
+        source_toe = ground.height(clip.poses[:, _foot_joint(mapping, side), :3, 3])
+        flat_ankle, flat_toe = ankles[side]
+        sole = np.maximum(np.minimum(source_ankle - flat_ankle, source_toe - flat_toe), 0.0)
+        slope, rest_slope = (tails[:, end] - heads[:, foot]) @ up, (rig.tails[end] - rest[foot]) @ up
+        height = rest[foot] @ up + scale * sole - np.minimum(slope - rest_slope, 0.0)
+        target = heads[:, foot] + np.outer(height - heads[:, foot] @ up, up)
+        reach = 0.999 * (np.linalg.norm(rest[shin] - rest[thigh]) + np.linalg.norm(rest[foot] - rest[shin]))
+        legs.append((thigh, shin, foot, target, reach))
+    drop = np.zeros(len(world))
+    for thigh, _, _, target, reach in legs:
+        offset = heads[:, thigh] - target
+        rise = offset @ up
+        across = np.linalg.norm(offset - np.outer(rise, up), axis=1)
+        drop = np.maximum(drop, rise - np.sqrt(np.maximum(reach ** 2 - across ** 2, 0.0)))
+    hips_at -= np.outer(drop, up)
+    heads, _ = posed_points(rig, world, hips_at)
+    for thigh, shin, foot, target, reach in legs:
         upper, lower = np.linalg.norm(rest[shin] - rest[thigh]), np.linalg.norm(rest[foot] - rest[shin])
-        for frame in range(len(world)):
-            new_knee = _two_bone(hip[frame], knee[frame], target[frame], upper, lower)
+        hip, knee, ankle = heads[:, thigh], heads[:, shin], heads[:, foot]
+        for frame in range(len(world)):  # knees bend forward: towards the thigh's turned rest forward
+            pole = knee[frame] + world[frame, thigh] @ forward
+            new_knee = _two_bone(hip[frame], pole, target[frame], upper, lower)
             world[frame, thigh] = _between(knee[frame] - hip[frame], new_knee - hip[frame]) @ world[frame, thigh]
             world[frame, shin] = _between(ankle[frame] - knee[frame], target[frame] - new_knee) @ world[frame, shin]
 
 
-def _two_bone(hip, knee, target, upper, lower):
+def _two_bone(hip, pole, target, upper, lower):
     """The knee that puts a leg of bone lengths ``upper`` and ``lower`` from ``hip`` onto ``target`` (as near as
-    it reaches), bending in the plane of ``hip``, ``knee`` and ``target``, to ``knee``'s side."""
+    it reaches), bending in the plane of ``hip``, ``pole`` and ``target``, towards ``pole``."""
     reach = target - hip
     distance = np.linalg.norm(reach)
-    along = reach / distance if distance > 0 else _unit(knee - hip)
+    along = reach / distance if distance > 0 else _unit(pole - hip)
     distance = np.clip(distance, abs(upper - lower) + 1e-9, upper + lower - 1e-9)
-    bend = (knee - hip) - ((knee - hip) @ along) * along
+    bend = (pole - hip) - ((pole - hip) @ along) * along
     if np.linalg.norm(bend) < 1e-9 * (upper + lower):
         return hip + along * upper
     bend = _unit(bend)
