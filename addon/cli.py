@@ -48,6 +48,9 @@ def _parser():
     rig.add_argument("-o", "--output", type=pathlib.Path,
                      help=f"where to save ({', '.join(OUTPUTS)}); default INPUT_rigged.blend beside the input")
     rig.add_argument("--report", type=pathlib.Path, help="write a JSON report here")
+    rig.add_argument("--animate", type=pathlib.Path, metavar="BVH",
+                     help="retarget this motion-capture file onto the rig and bake it as its action (needs the game "
+                          "target, which it makes the default, and a humanoid)")
     _method_options(rig)
     _axis_options(rig)
     rig.set_defaults(run=_run_rig)
@@ -75,7 +78,7 @@ def _method_options(parser):
     parser.add_argument("--method", default="silhouette", help="rigging method (see `python -m rigger methods`)")
     parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
                         help="a method parameter, e.g. --set bone_length=0.08 (repeatable)")
-    parser.add_argument("--target", choices=list(TARGETS), default="plain",
+    parser.add_argument("--target", choices=list(TARGETS), default=None,
                         help="what the armature becomes: " + "; ".join(f"{name}: {target.description}"
                                                                       for name, target in TARGETS.items())
                         + " (default plain; a body plan that cannot fill a target falls back, with a warning)")
@@ -147,6 +150,13 @@ def _run_rig(args):
         raise CliError(f"{source}: no such file")
     if source.suffix.lower() not in INPUTS:
         raise CliError(f"{source}: cannot read {source.suffix or 'files without a suffix'}; use {', '.join(INPUTS)}")
+    target = args.target or ("game" if args.animate else "plain")
+    if args.animate is not None:
+        if target != "game":
+            raise CliError(f"--animate needs the game target (its Mixamo names are what a motion drives), not "
+                           f"--target {target}")
+        if not args.animate.is_file():
+            raise CliError(f"{args.animate}: no such BVH file")
     output = args.output or source.with_name(f"{source.stem}_rigged.blend")
     if output.suffix.lower() not in OUTPUTS:
         raise CliError(f"{output}: cannot write {output.suffix or 'files without a suffix'}; use {', '.join(OUTPUTS)}")
@@ -163,8 +173,8 @@ def _run_rig(args):
 
     register()  # the properties the Blender layer keeps on scenes and objects
     try:
-        report = scenefiles.rig_file(source, output, method.name, params, target=args.target, skin=not args.no_skin,
-                                     up=args.up, forward=args.forward)
+        report = scenefiles.rig_file(source, output, method.name, params, target=target, skin=not args.no_skin,
+                                     up=args.up, forward=args.forward, animate=args.animate)
         if args.report is not None:
             with replaced_on_success(args.report) as path:
                 path.write_text(json.dumps(report, indent=2))
@@ -175,6 +185,9 @@ def _run_rig(args):
     except OSError as error:  # a folder that cannot be written, a full disk
         raise CliError(f"{error.filename or output}: {error.strerror or error}") from None
     print(f"rigged {source} → {output}: {len(report['bones'])} bones, {report['skinning']['summary']}")
+    if report.get("animation"):
+        animation = report["animation"]
+        print(f"animated with {animation['bvh']}: {animation['frames']} frames at {animation['fps']:g} fps")
     for warning in report["warnings"]:
         print(f"warning: {warning}", file=sys.stderr)
     return 0
@@ -226,7 +239,8 @@ def _run_batch(args):
     axes = _batch_axes(args, sources)
     _check_folder(args.output, "the results")
     args.output.mkdir(parents=True, exist_ok=True)
-    extra = [f"--method={args.method}", f"--target={args.target}", *(f"--set={pair}" for pair in args.settings)]
+    extra = [f"--method={args.method}", f"--target={args.target or 'plain'}",
+             *(f"--set={pair}" for pair in args.settings)]
     extra += ["--no-skin"] if args.no_skin else []
     stems = output_stems(sources, args.format, args.folder.resolve() == args.output.resolve())
     rows = []

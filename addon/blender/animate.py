@@ -61,7 +61,9 @@ def _imported(path):
 def _remove(source):
     data = source.data
     action = source.animation_data.action if source.animation_data else None
+    source.select_set(False)  # a removed object left selected stays in the view layer's selection as None
     bpy.data.objects.remove(source)
+    bpy.context.view_layer.update()
     if data.users == 0:
         bpy.data.armatures.remove(data)
     if action is not None and action.users == 0:
