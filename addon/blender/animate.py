@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 
 from ..core.game import ROOT
-from ..core.retarget import Clip, Rig, RetargetError, retarget
+from ..core.retarget import Clip, Rig, retarget
 
 
 def animate(armature, path):

@@ -249,21 +249,6 @@ def posed_points(rig, world, hips_at):
     return posed_heads, posed_tails
 
 
-def world_rotations(rig, motion):
-    """World rotations (F, B, 3, 3) relative to rest and the Hips' head (F, 3) of ``motion`` on ``rig``: the inverse
-    of what :func:`retarget` bakes, for measuring."""
-    frames = len(motion.rotations)
-    rest_rot = rig.rest[:, :3, :3]
-    world = np.empty((frames, len(rig.names), 3, 3))
-    for bone in range(len(rig.names)):
-        parent = rig.parents[bone]
-        local = _matrices(motion.rotations[:, bone])
-        parent_world = world[:, parent] if parent >= 0 else np.eye(3)
-        world[:, bone] = parent_world @ rest_rot[bone] @ local @ rest_rot[bone].T
-    hips = motion.hips
-    return world, rig.rest[hips, :3, 3] + motion.location @ rest_rot[hips].T
-
-
 def contact_frames(clip, mapping, side):
     """Frames (bool (F,)) where the mocap's foot on ``side`` ("Left"/"Right") is planted: its lowest joint (toe,
     else ankle) within ``CONTACT_HEIGHT`` leg lengths of the mocap's ground (:func:`mocap_ground`) and slower than
@@ -543,14 +528,6 @@ def _quaternions(matrices):
     diagonal = np.stack([trace, m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]], -1)
     best = np.take_along_axis(candidates, np.argmax(diagonal, -1)[..., None, None], -2)[..., 0, :]
     return best / np.linalg.norm(best, axis=-1, keepdims=True)
-
-
-def _matrices(quaternions):
-    """Rotation matrices (..., 3, 3) of unit quaternions (..., 4) w, x, y, z."""
-    w, x, y, z = np.moveaxis(np.asarray(quaternions, dtype=np.float64), -1, 0)
-    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-                     np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-                     np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
 
 
 def _continuous(quaternions):
