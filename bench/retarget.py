@@ -158,7 +158,9 @@ def _posed_measures(obj, armature, rig, motion, clip, outcome, contact_frames):
 
 def _bend(pose, first, middle, last, facing):
     """+1 when the joint at ``middle`` lies in front of the line from ``first``'s head to ``last``'s head (along
-    ``facing``), -1 behind, 0 when the limb is within ``BENT`` degrees of straight."""
+    ``facing``), -1 behind, 0 when the limb is within ``BENT`` degrees of straight (or the rig lacks one of them)."""
+    if any(name not in pose for name in (first, middle, last)):
+        return 0
     a, b, c = (np.array(pose[name].head) for name in (first, middle, last))
     upper, lower = b - a, c - b
     angle = np.degrees(np.arccos(np.clip(upper @ lower / (np.linalg.norm(upper) * np.linalg.norm(lower)), -1, 1)))

@@ -188,6 +188,10 @@ def retarget(clip, rig, mapping=None):
     """The :class:`Motion` of ``clip`` on ``rig`` (see the module docstring)."""
     mapping = mapping or map_joints(clip.names, clip.parents, rig.names)
     index = {name: k for k, name in enumerate(rig.names)}
+    legs = [f"{side}{word}" for side in ("Left", "Right") for word in ("UpLeg", "Leg", "Foot")]
+    if "Hips" not in mapping.driven or any(name not in mapping.driven for name in legs):
+        raise RetargetError(f"a motion needs the character's hips and both legs (UpLeg, Leg, Foot) to carry it; "
+                            f"this rig lacks {', '.join(n for n in ['Hips', *legs] if n not in mapping.driven)}")
     drive = {index[name]: joint for name, joint in mapping.driven.items()}
     up = _unit(rig.up)
     turn, forward = _alignment(clip, rig, mapping.driven, index, up)
