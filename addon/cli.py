@@ -44,6 +44,9 @@ def _parser():
     rig.add_argument("-o", "--output", type=pathlib.Path,
                      help=f"where to save ({', '.join(OUTPUTS)}); default INPUT_rigged.blend beside the input")
     rig.add_argument("--report", type=pathlib.Path, help="write a JSON report here")
+    rig.add_argument("--animate", type=pathlib.Path, metavar="BVH",
+                     help="retarget this motion-capture file onto the rig and bake it as its action (needs the game "
+                          "target, which it makes the default, and a humanoid)")
     _method_options(rig)
     _axis_options(rig)
     rig.set_defaults(run=_run_rig)
@@ -81,7 +84,7 @@ def _method_options(parser):
     parser.add_argument("--method", default="silhouette", help="rigging method (see `python -m rigger methods`)")
     parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
                         help="a method parameter, e.g. --set bone_length=0.08 (repeatable)")
-    parser.add_argument("--target", choices=list(TARGETS), default="plain",
+    parser.add_argument("--target", choices=list(TARGETS), default=None,
                         help="what the armature becomes: " + "; ".join(f"{name}: {target.description}"
                                                                       for name, target in TARGETS.items())
                         + " (default plain; a body plan that cannot fill a target falls back, with a warning)")
@@ -155,6 +158,12 @@ def _run_rig(args):
         raise CliError(f"{output}: cannot write {output.suffix or 'files without a suffix'}; use {', '.join(OUTPUTS)}")
     _check_destinations(source, output, args.report)
     settings = _file_settings(args)  # before the slow import
+    if args.animate is not None:
+        if settings.target != "game":
+            raise CliError(f"--animate needs the game target (its Mixamo names are what a motion drives), not "
+                           f"--target {settings.target}")
+        if not args.animate.is_file():
+            raise CliError(f"{args.animate}: no such BVH file")
     try:
         file_axes(source.suffix, args.up, args.forward)
     except ValueError as error:
@@ -168,6 +177,9 @@ def _run_rig(args):
     except FileFailed as error:
         raise CliError(str(error)) from None
     print(f"rigged {source} → {output}: {len(report['bones'])} bones, {report['skinning']['summary']}")
+    if report.get("animation"):
+        animation = report["animation"]
+        print(f"animated with {animation['bvh']}: {animation['frames']} frames at {animation['fps']:g} fps")
     for warning in report["warnings"]:
         print(f"warning: {warning}", file=sys.stderr)
     return 0
@@ -175,7 +187,8 @@ def _run_rig(args):
 
 def _file_settings(args):
     """How each file is rigged (``batch.work.Settings``) from the options: the method's name, its parameters
-    resolved from ``--set``, the target, skinning and axes; CliError for an unknown method or bad values."""
+    resolved from ``--set``, the target (default plain, or game with ``--animate``), skinning, axes and the motion
+    to retarget; CliError for an unknown method or bad values."""
     from .api import method_registry
     from .batch.work import Settings
     from .core.params import resolve
@@ -185,8 +198,10 @@ def _file_settings(args):
         params = resolve(method.params, _settings(args.settings))
     except ValueError as error:
         raise CliError(str(error)) from None
-    return Settings(method.name, params, target=args.target, skin=not args.no_skin, up=args.up, forward=args.forward,
-                    pairs=tuple(args.settings))
+    animate = getattr(args, "animate", None)  # rig only
+    return Settings(method.name, params, target=args.target or ("game" if animate else "plain"),
+                    skin=not args.no_skin, up=args.up, forward=args.forward, pairs=tuple(args.settings),
+                    animate=animate)
 
 
 def _check_destinations(source, output, report):

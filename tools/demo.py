@@ -5,12 +5,16 @@ it through the add-on's Blender layer, and writes:
 - ``out/humanoid.blend``: mesh, armature, weights and the stage overlays (View3D > Sidebar > Rigger toggles them),
 - ``out/humanoid.glb``: the rigged, skinned character,
 - ``out/humanoid_report.json``: bones, timings, skinning outcome, and the distance to the known skeleton,
-- ``out/humanoid.png``: a Workbench render of the see-through mesh with the overlays and the bones.
+- ``out/humanoid.png``: a Workbench render of the see-through mesh with the overlays and the bones;
+- ``out/humanoid_walk.{glb,gif}``: the CMU walk (``../shared/anim``, read in place) retargeted onto the humanoid's
+  ``game`` rig through the Mixamo names, and a few seconds of it rendered (skipped, saying why, without the clip).
 """
 import json
 import math
+import os
 import pathlib
 import sys
+import tempfile
 
 import numpy as np
 
@@ -18,6 +22,10 @@ from rigger.blender.headless import empty_scene, temporary_user_folder
 
 OUT = pathlib.Path(__file__).resolve().parents[1] / "out"
 RENDER_SIZE = (960, 1080)
+WALK = pathlib.Path(os.environ.get("RIGGER_SHARED", pathlib.Path(__file__).resolve().parents[2] / "shared")) / \
+    "anim" / "cmu_07_01_walk.bvh"
+GIF_SIZE = (360, 400)
+GIF_STEP = 6  # render every 6th frame of the 120 fps clip: a 20 fps GIF
 BONE_WIDTH = 0.06  # octahedral bone display: the widest section's half width, in bone lengths
 BONE_COLOUR = (0.05, 0.05, 0.05, 1.0)
 HIDDEN_IN_PICTURE = {"cdt", "merged"}  # stages whose overlays would hide the others from the front
@@ -61,6 +69,67 @@ def main(name="humanoid"):
           f"size")
     print("wrote " + ", ".join(str(OUT / f"{name}{suffix}") for suffix in
                                (".blend", ".glb", "_report.json", ".png")))
+    walk(name)
+
+
+def walk(name):
+    """The CMU walk on the character's game rig: ``out/<name>_walk.glb`` and ``out/<name>_walk.gif``."""
+    if not WALK.is_file():
+        print(f"skipped the walk: {WALK} is not there (clone the project beside ../shared for the mocap clip)")
+        return
+    import bpy
+    from PIL import Image
+
+    from rigger.blender.animate import animate
+    from rigger.blender.pipeline import rig_object, skin_meshes
+    from rigger.blender.samples import build_character
+    from rigger.blender.scenefiles import save_scene
+
+    empty_scene()
+    obj = build_character(name)
+    result = rig_object(obj, "silhouette", target="game")
+    skin_meshes([obj], result.armature)
+    motion = animate(result.armature, WALK)
+    save_scene(OUT / f"{name}_walk.glb", [obj, result.armature])
+    with tempfile.TemporaryDirectory(prefix="rigger-walk-") as folder:
+        frames = walk_frames(bpy, obj, result.armature, pathlib.Path(folder))
+        images = [Image.open(frame).convert("RGB").quantize(colors=64) for frame in frames]
+        images[0].save(OUT / f"{name}_walk.gif", save_all=True, append_images=images[1:], loop=0,
+                       duration=round(1000 * GIF_STEP / motion["fps"]), optimize=True)
+    print(f"retargeted {WALK.name} onto the game rig ({motion['frames']} frames; no joint for "
+          f"{', '.join(motion['undriven']) or 'no bone'}); wrote {OUT / f'{name}_walk.glb'}, "
+          f"{OUT / f'{name}_walk.gif'}")
+
+
+def walk_frames(bpy, obj, armature, folder):
+    """Workbench renders into ``folder`` of every ``GIF_STEP``-th frame, seen from the front and side, the camera
+    keeping up with the hips, on a floor at the ground; the PNG paths."""
+    scene = bpy.context.scene
+    ground = armature.data.bones["root"].head_local[2]
+    bpy.ops.mesh.primitive_plane_add(size=40.0, location=(0.0, 0.0, ground))
+    floor = bpy.context.object
+    floor.data.materials.append(bpy.data.materials.new("floor"))
+    floor.data.materials[0].diffuse_color = (0.35, 0.38, 0.42, 1.0)
+    obj.data.materials.append(bpy.data.materials.new("skin"))
+    obj.data.materials[0].diffuse_color = (0.85, 0.62, 0.45, 1.0)
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    camera.data.type = 'ORTHO'
+    camera.data.ortho_scale = 2.3
+    camera.rotation_euler = (math.radians(80), 0.0, math.radians(50))
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    scene.render.engine = 'BLENDER_WORKBENCH'
+    scene.render.resolution_x, scene.render.resolution_y = GIF_SIZE
+    scene.display.shading.color_type = 'MATERIAL'
+    paths = []
+    for frame in range(scene.frame_start + 1, scene.frame_end + 1, GIF_STEP):  # frame 1: CMU's reference pose
+        scene.frame_set(frame)
+        hips = armature.matrix_world @ armature.pose.bones["Hips"].head
+        camera.location = (hips[0] + 7.0, hips[1] - 5.9, ground + 2.5)
+        scene.render.filepath = str(folder / f"{frame:04d}.png")
+        bpy.ops.render.render(write_still=True)
+        paths.append(scene.render.filepath)
+    return paths
 
 
 def render(bpy, overlays, obj, skeleton, path):

@@ -30,8 +30,8 @@ class FileFailed(Exception):
 @dataclasses.dataclass(frozen=True)
 class Settings:
     """How every file is rigged: the method's name, its resolved parameters, the output target asked for, whether
-    to skin, the file axes given (``--up``, ``--forward``; None: not given) and the ``--set`` pairs as given (what
-    the local engine hands its child processes)."""
+    to skin, the file axes given (``--up``, ``--forward``; None: not given), the ``--set`` pairs as given (what
+    the local engine hands its child processes) and a BVH to retarget onto the rig (``rig --animate``)."""
 
     method: str
     params: dict
@@ -40,6 +40,7 @@ class Settings:
     up: str = None
     forward: str = None
     pairs: tuple = ()
+    animate: pathlib.Path = None
 
     def axes_for(self, source):
         """(up, forward) to read model file ``source`` with: the settings' for OBJ and FBX files, (None, None) for
@@ -76,7 +77,7 @@ def rig_to_files(source, output, report, settings):
     try:
         up, forward = settings.axes_for(source)
         data = scenefiles.rig_file(source, output, settings.method, settings.params, target=settings.target,
-                                   skin=settings.skin, up=up, forward=forward)
+                                   skin=settings.skin, up=up, forward=forward, animate=settings.animate)
         data["timings"].update(file=time.perf_counter() - start, file_cpu=time.process_time() - cpu)
         if report is not None:
             with replaced_on_success(report) as path:

@@ -67,7 +67,7 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     replaced = any([remove_rig(mesh) for mesh in meshes])
     collection = shown_collection(obj, bpy.context.view_layer)
     frame = np.array(obj.matrix_world, dtype=np.float64)[:3, :3]
-    built = targets.build(chosen, skeleton, f"{obj.name}_rig", collection, frame)
+    built = targets.build(chosen, skeleton, f"{obj.name}_rig", collection, frame, mesh=(vertices, triangles))
     armature = built.armature
     if parent is not None:  # skinning makes the mesh the armature's child: the rig keeps following what moved it
         armature.parent = parent
@@ -128,7 +128,8 @@ def shown_collection(obj, view_layer):
 
 
 def skin_meshes(meshes, armature, progress=None):
-    """Skin every mesh of ``meshes`` to ``armature``: {mesh name: skinning report}, and warnings of our own.
+    """Skin every mesh of ``meshes`` to ``armature``, then let its output target finish the weights
+    (``targets.skinned``): {mesh name: skinning report}, and warnings of our own.
 
     Weights live in the mesh data, so a mesh object sharing its data with other objects (a linked duplicate) first
     gets its own copy: otherwise skinning one copy would rewrite the weights of the others.
@@ -140,6 +141,7 @@ def skin_meshes(meshes, armature, progress=None):
                             f"copy so that its weights are its own")
             mesh.data = mesh.data.copy()
         outcomes[mesh.name] = skinning.skin(mesh, armature)
+        targets.skinned(armature.get(TARGET_PROPERTY), mesh, armature, outcomes[mesh.name])
         if progress is not None:
             progress(done / len(meshes))
     return outcomes, warnings

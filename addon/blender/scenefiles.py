@@ -15,10 +15,13 @@ from .properties import ARMATURE_POINTER
 
 
 
-def rig_file(source, output, method, params, *, target="plain", skin=True, up=None, forward=None):
+def rig_file(source, output, method, params, *, target="plain", skin=True, up=None, forward=None, animate=None):
     """Rig the meshes of model file ``source`` together as output target ``target`` (``core.targets``), skin them,
     save them with their armature to ``output`` and return the report (bones in the file's frame, the axes it was
     read with, timings, skinning outcome, warnings).
+
+    ``animate``: a BVH file retargeted onto the rig (``rigger.blender.animate``; the game target on a humanoid) and
+    saved as its action; the report's ``animation`` says how.
 
     ``up`` and ``forward`` are the file axes that become Blender's +Z and +Y (``rigger.axes``: OBJ and FBX only; None
     takes the defaults, up Y and forward -Z for OBJ, the file's own axes for FBX).
@@ -46,9 +49,27 @@ def rig_file(source, output, method, params, *, target="plain", skin=True, up=No
     if skin:
         outcomes, skin_warnings = skin_meshes(meshes, result.armature)
         warnings += skin_warnings
+    animation = None if animate is None else _animated(result, animate)
     save_scene(output, [*meshes, result.armature])
-    return {"input": str(source), "output": str(output), "asked_target": target,
-            **rig_report(result, outcomes, *frame, warnings=warnings, axes=axes)}
+    report = rig_report(result, outcomes, *frame, warnings=warnings, axes=axes)
+    if animation is not None:
+        report["animation"] = animation
+        report["warnings"] += [f"no joint of {pathlib.Path(animate).name} drives {', '.join(animation['undriven'])}; "
+                               f"they turn with their parents"] if animation["undriven"] else []
+    return {"input": str(source), "output": str(output), "asked_target": target, **report}
+
+
+def _animated(result, bvh):
+    """Retarget ``bvh`` onto the rig of ``result`` (a ``pipeline.RigResult``); ValueError unless the rig is a
+    humanoid's game armature."""
+    from .animate import animate
+
+    plan = result.skeleton.body_plan
+    if result.target.name != "game" or plan is None or plan.kind != "humanoid":
+        kind = "unknown" if plan is None else plan.kind
+        raise ValueError(f"--animate needs a humanoid game rig, and this {kind} body got the {result.target.name} "
+                         f"target: a motion's joints are a human's")
+    return animate(result.armature, bvh)
 
 
 def shown_meshes(view_layer):

@@ -5,6 +5,7 @@ from dataclasses import dataclass, field
 import bpy
 
 from ..core.skeleton import Skeleton
+from . import game
 from .armature import build_armature
 
 
@@ -19,15 +20,25 @@ class Built:
     warnings: list = field(default_factory=list)
 
 
-def build(target, skeleton, name, collection, frame):
+def build(target, skeleton, name, collection, frame, mesh=None):
     """Build ``skeleton`` as ``target``'s armature (a ``core.targets.Target``) named ``name`` in ``collection``;
-    ``frame`` is the rigged object's rotation (``armature.build_armature``). A :class:`Built`."""
-    return BUILDERS[target.name](skeleton, name, collection, frame)
+    ``frame`` is the rigged object's rotation (``armature.build_armature``), ``mesh`` the rigged (vertices,
+    triangles) in world space. A :class:`Built`."""
+    return BUILDERS[target.name](skeleton, name, collection, frame, mesh)
 
 
-def _plain(skeleton, name, collection, frame):
+def skinned(target, mesh_obj, armature, report):
+    """What target ``target`` (its name) does after ``mesh_obj`` was skinned to its ``armature`` (the game target
+    keeps at most 4 weights per vertex); it notes that as a stage of the skinning ``report``."""
+    finish = FINISHERS.get(target)
+    if finish is not None:
+        finish(mesh_obj, armature, report)
+
+
+def _plain(skeleton, name, collection, frame, mesh=None):
     """The method's bones as they are."""
     return Built(build_armature(skeleton, name, collection, frame=frame), skeleton)
 
 
-BUILDERS = {"plain": _plain}
+BUILDERS = {"plain": _plain, "game": game.build}
+FINISHERS = {"game": game.finish_skin}

@@ -30,6 +30,9 @@ class Target:
 
 TARGETS = {target.name: target for target in (
     Target("plain", "Plain", "The method's bones as they are, named by part (trunk, limbs, sides)"),
+    Target("game", "Game", "A deform-only skeleton for game engines and mocap: a root bone on the ground, Mixamo "
+                           "names on humanoids, at most 4 weights per vertex",
+           plans=("humanoid", "quadruped", "bird", "fish"), fallback="plain"),
 )}
 
 

@@ -1,0 +1,432 @@
+"""The ``game`` target's skeleton: Rigger's skeleton, with its roles, redrawn as a deform-only skeleton a game engine
+and a mocap library expect (bpy-free; ``rigger.blender.game`` builds it).
+
+The naming scheme (one for every body plan; the README says the same for users):
+
+- ``root``: the hierarchy's single root, on the ground under the hips (the mesh's lowest point along the plan's up),
+  pointing up; it deforms nothing. ``Hips`` hangs from it and everything else from ``Hips``.
+- The trunk, from the hips joint (where the legs hang) to where the neck begins: ``Hips`` up to the spine joint (where
+  Rigger's ``spine`` role begins), then ``Spine``, ``Spine1``, ``Spine2``, the last from the chest joint (where
+  ``chest`` begins). A missing joint is put where Mixamo's humanoids have it: the spine joint at ``SPINE_AT`` and the
+  chest joint at ``CHEST_AT`` of the trunk's length; ``Spine1`` halfway between them.
+- Every other role is one bone per chain of that role, Rigger's bones of the chain merged into it, named with
+  Mixamo's word for the role: ``Neck``, ``Head``, ``Jaw``, ``Shoulder``, ``Arm`` (upper arm), ``ForeArm``, ``Hand``,
+  ``UpLeg`` (thigh), ``Leg`` (shin), ``Foot``, ``ToeBase``; sided ones get ``Left`` / ``Right`` before the word
+  (``LeftForeArm``). A quadruped's front legs have the roles, so the names, of arms and its hind legs those of legs.
+  A leg's ``hips`` bones (from the body's middle to the hip joint) are the pelvis: they merge into ``Hips``.
+- Fingers: ``LeftHandThumb1``..``3``, ``Index``, ``Middle``, ``Ring``, ``Pinky``, at most three bones each (Rigger's
+  bones merged at the joints nearest the thirds); a finger without a digit is ``LeftHandFinger1``..``3``.
+- Parts without a Mixamo name keep one bone per Rigger bone, numbered from 1 along the chain: ``Tail1``, ``Tail2``,
+  ``LeftEar1``, ``LeftWing1``, ``Fin1``, ``Extra1`` (role ``other``) and ``Stem1`` (role ``root``: a stem under the
+  hips).
+- A second chain of the same name (a second pair of arms) gets ``_2`` after the name (``LeftArm_2``), a third ``_3``:
+  chains are numbered from the highest start down.
+
+The hierarchy is Rigger's read from the hips outwards (Rigger may root a quadruped at its neck): a chain hangs from the
+game bone that holds the joint it starts from. Twins (``Left…`` and ``Right…`` bones that mirror each other within
+``TWIN_TOLERANCE`` of the size) get exactly mirrored points across the mirror plane.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .roles import BoneRole
+from .skeleton import Skeleton
+
+ROOT = "root"
+SPINE_AT = 0.2  # share of the trunk from the hips joint to the neck where Mixamo's Spine begins (0a59c5ff: 0.2) ...
+CHEST_AT = 0.7  # ... and Spine2 (0.7)
+TWIN_TOLERANCE = 0.02  # twins whose points mirror within this share of the size are mirrored exactly
+ROOT_LENGTH = 0.1  # the root bone's length, a share of the size
+MERGE_TOLERANCE = 1e-9  # points this close (a share of the size) are one joint
+
+WORDS = {"hips": "Hips", "neck": "Neck", "head": "Head", "jaw": "Jaw", "shoulder": "Shoulder", "upper_arm": "Arm",
+         "forearm": "ForeArm", "hand": "Hand", "thigh": "UpLeg", "shin": "Leg", "foot": "Foot", "toe": "ToeBase",
+         "tail": "Tail", "ear": "Ear", "wing": "Wing", "fin": "Fin", "other": "Extra", "root": "Stem"}
+NUMBERED = frozenset({"tail", "ear", "wing", "fin", "other", "root"})  # one game bone per Rigger bone
+DIGIT_WORDS = {"thumb": "Thumb", "index": "Index", "middle": "Middle", "ring": "Ring", "pinky": "Pinky", None: "Finger"}
+FINGER_BONES = 3
+TRUNK = ("hips", "spine", "chest")
+SIDE_WORDS = {"L": "Left", "R": "Right", None: ""}
+
+
+@dataclass(frozen=True)
+class GameSkeleton:
+    """The game skeleton (``skeleton``: names, world points, parents, roles, the body plan) and, for each bone of
+    Rigger's skeleton, the index of the game bone that took it over (``owners``)."""
+
+    skeleton: Skeleton
+    owners: tuple
+
+
+def game_skeleton(skeleton, vertices):
+    """The :class:`GameSkeleton` of ``skeleton`` (with its roles and body plan, as ``rigger.rig_mesh`` returns it)
+    rigging a mesh with ``vertices`` (N, 3), by the scheme of this module's docstring. ValueError without roles."""
+    if skeleton.roles is None or skeleton.body_plan is None:
+        raise ValueError("the game skeleton needs a skeleton with roles and a body plan (from rigger.rig_mesh)")
+    vertices = np.asarray(vertices, dtype=np.float64)
+    up = np.asarray(skeleton.body_plan.up, dtype=np.float64)
+    up /= np.linalg.norm(up)
+    size = float(np.ptp(vertices, axis=0).max()) if len(vertices) else 1.0
+    graph = _Graph(skeleton, size)
+    start = graph.hips_node()
+    order, arriving = graph.oriented(start)
+    chains = graph.chains(order, arriving)
+    bones = _Bones(graph)
+    trunk = next((chain for chain in chains if chain.key == ("trunk", None, None) and chain.nodes[0] == start), None)
+    if trunk is not None:
+        bones.trunk(trunk)
+    for chain in chains:
+        if chain is not trunk:
+            bones.chain(chain)
+    bones.name_instances(up)
+    names, heads, tails, parents, roles = bones.finished(start, arriving)
+    heads, tails = _mirrored_twins(names, heads, tails, skeleton.stages.get("mirror_plane"), size)
+    hips = graph.points[start]
+    ground = float((vertices @ up).min()) if len(vertices) else float(hips @ up)
+    foot = hips - (hips @ up - ground) * up
+    names = [ROOT, *names]
+    heads = np.vstack([foot, heads])
+    tails = np.vstack([foot + ROOT_LENGTH * size * up, tails])
+    parents = [-1] + [parent + 1 for parent in parents]
+    roles = [BoneRole("root"), *roles]
+    game = Skeleton(names, heads, tails, parents, roles=roles, body_plan=skeleton.body_plan)
+    return GameSkeleton(game, tuple(owner + 1 for owner in bones.owners(len(skeleton))))
+
+
+def _key(role):
+    """The chain key of a bone role: the trunk's roles are one chain, a leg's hips bones the pelvis."""
+    if role.role in TRUNK and role.side is None:
+        return ("trunk", None, None)
+    if role.role == "hips":
+        return ("pelvis", role.side, None)
+    return (role.role, role.side, role.digit if role.role == "finger" else None)
+
+
+class _Graph:
+    """Rigger's skeleton as an undirected graph of joints: one edge per bone, plus a link (no bone) from the nearer
+    end of a parent to a child's head where the child does not start at one of its parent's ends."""
+
+    def __init__(self, skeleton, size):
+        self.skeleton = skeleton
+        points, index = [], {}
+
+        def node(point):
+            key = tuple(np.round(np.asarray(point) / (MERGE_TOLERANCE * max(size, 1e-300))).astype(np.int64))
+            if key not in index:
+                index[key] = len(points)
+                points.append(np.asarray(point, dtype=np.float64))
+            return index[key]
+
+        self.ends = [(node(head), node(tail)) for head, tail in zip(skeleton.heads, skeleton.tails)]
+        self.edges = []  # (a, b, bone index or -1 for a link, chain key)
+        keys = [_key(role) for role in skeleton.roles]
+        for bone, (a, b) in enumerate(self.ends):
+            self.edges.append((a, b, bone, keys[bone]))
+        for bone, parent in enumerate(skeleton.parents):
+            if parent >= 0 and self.ends[bone][0] not in self.ends[parent]:
+                head = skeleton.heads[bone]
+                end = min(self.ends[parent], key=lambda n: np.linalg.norm(np.asarray(points[n]) - head))
+                self.edges.append((end, self.ends[bone][0], -1, keys[bone]))
+        self.points = np.array(points)
+        self.neighbours = [[] for _ in points]
+        for edge, (a, b, _, _) in enumerate(self.edges):
+            self.neighbours[a].append((b, edge))
+            self.neighbours[b].append((a, edge))
+
+    def hips_node(self):
+        """Where the hips are: the end of the trunk's longest path on the side of its hips bones (else the end
+        farther from the neck and head); without a trunk, the head of Rigger's first root bone."""
+        trunk = [edge for edge, (_, _, bone, key) in enumerate(self.edges) if key[0] == "trunk" and bone >= 0]
+        if not trunk:
+            return self.ends[self.skeleton.roots[0]][0]
+        path = self._longest_path(set(trunk))
+        ends = (path[0], path[-1])
+        roles = self.skeleton.roles
+
+        def hips_at(node):
+            return any(self.edges[edge][2] >= 0 and roles[self.edges[edge][2]].role == "hips"
+                       for _, edge in self.neighbours[node] if edge in trunk)
+
+        sided = [end for end in ends if hips_at(end)]
+        if len(sided) == 1:
+            return sided[0]
+        heads = [self.points[self.edges[edge][0]] for edge, (_, _, bone, key) in enumerate(self.edges)
+                 if key[0] in ("neck", "head") and bone >= 0]
+        if heads:
+            centre = np.mean(heads, axis=0)
+            return max(ends, key=lambda end: np.linalg.norm(self.points[end] - centre))
+        return ends[0]
+
+    def _longest_path(self, edges):
+        """The longest path (by length) through the edge set ``edges`` (a forest), as nodes."""
+        nodes = {n for edge in edges for n in self.edges[edge][:2]}
+
+        def farthest(start):
+            distance, before, todo = {start: 0.0}, {start: None}, [start]
+            while todo:
+                node = todo.pop()
+                for other, edge in self.neighbours[node]:
+                    if edge in edges and other not in distance:
+                        distance[other] = distance[node] + self._length(edge)
+                        before[other] = node
+                        todo.append(other)
+            end = max(distance, key=distance.get)
+            path = [end]
+            while before[path[-1]] is not None:
+                path.append(before[path[-1]])
+            return path
+
+        return farthest(farthest(min(nodes))[0])
+
+    def _length(self, edge):
+        a, b = self.edges[edge][:2]
+        return float(np.linalg.norm(self.points[a] - self.points[b]))
+
+    def oriented(self, start):
+        """Breadth-first order of the nodes from ``start`` and, per node, the edge arriving at it (None at the start
+        and at nodes of other components, whose first node is then taken as a start too)."""
+        arriving = {start: None}
+        order = [start]
+        for seed in [start, *range(len(self.points))]:
+            if seed not in arriving:
+                arriving[seed] = None
+                order.append(seed)
+            at = order.index(seed)
+            while at < len(order):
+                node = order[at]
+                for other, edge in self.neighbours[node]:
+                    if other not in arriving:
+                        arriving[other] = edge
+                        order.append(other)
+                at += 1
+        return order, arriving
+
+    def other_end(self, edge, node):
+        a, b = self.edges[edge][:2]
+        return b if node == a else a
+
+    def chains(self, order, arriving):
+        """The chains: runs of edges of one key, each from the node nearest the hips outwards, taking at a fork the
+        branch with the longest run of the same key (the others start chains of their own)."""
+        children = {}
+        for node in order:
+            edge = arriving[node]
+            if edge is not None:
+                children.setdefault(self.other_end(edge, node), []).append(node)
+        key_of = {node: self.edges[arriving[node]][3] for node in order if arriving[node] is not None}
+        reach = {}
+        for node in reversed(order):  # the length of the longest same-key run from each node outwards
+            same = [child for child in children.get(node, ()) if key_of[child] == key_of.get(node)]
+            reach[node] = max((reach[child] + 1 for child in same), default=0)
+        chains = []
+        for node in order:
+            for child in children.get(node, ()):
+                if node in key_of and key_of[child] == key_of[node] and child == self._continuation(node, children,
+                                                                                                     key_of, reach):
+                    continue
+                nodes = [node, child]
+                while (following := self._continuation(nodes[-1], children, key_of, reach)) is not None:
+                    nodes.append(following)
+                chains.append(_Chain(key_of[child], nodes, [arriving[n] for n in nodes[1:]]))
+        return chains
+
+    @staticmethod
+    def _continuation(node, children, key_of, reach):
+        same = [child for child in children.get(node, ()) if key_of[child] == key_of.get(node)]
+        return max(same, key=lambda child: (reach[child], -child)) if same else None
+
+
+@dataclass
+class _Chain:
+    key: tuple
+    nodes: list  # from the node nearest the hips outwards
+    edges: list  # edge indices between consecutive nodes
+
+
+class _Bones:
+    """Game bones being made: name parts, points, the chain they come from and which graph edges they own."""
+
+    def __init__(self, graph):
+        self.graph = graph
+        self.bones = []  # dicts: base, number, side, points (head, tail), role, start node, chain id
+        self.edge_owner = {}  # graph edge -> game bone index
+        self.node_owner = {}  # graph node -> the game bone that holds it (children hang from it)
+        self.hips = None  # the Hips bone, once the trunk made it
+
+    def _add(self, base, side, number, head, tail, role, start, chain, edges, end_nodes):
+        index = len(self.bones)
+        self.bones.append({"base": base, "side": side, "number": number, "head": np.asarray(head, float),
+                           "tail": np.asarray(tail, float), "role": role, "start": start, "chain": chain,
+                           "suffix": ""})
+        for edge in edges:
+            self.edge_owner[edge] = index
+        for node in end_nodes:
+            self.node_owner[node] = index
+        return index
+
+    def trunk(self, chain):
+        """Hips, Spine, Spine1, Spine2 along the trunk chain (see the module docstring)."""
+        graph, roles = self.graph, self.graph.skeleton.roles
+        points = graph.points[chain.nodes]
+        arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+        total = arc[-1]
+        role_at = [roles[graph.edges[edge][2]].role if graph.edges[edge][2] >= 0 else None for edge in chain.edges]
+
+        def begins(names, share):
+            at = next((k for k, role in enumerate(role_at) if role in names), None)
+            return arc[at] if at is not None and 0 < arc[at] < total else share * total
+
+        spine = begins(("spine", "chest"), SPINE_AT)
+        chest = begins(("chest",), CHEST_AT)
+        if not spine < chest < total:
+            spine, chest = SPINE_AT * total, CHEST_AT * total
+        cuts = [0.0, spine, 0.5 * (spine + chest), chest, total]
+        at = [_point_at(points, arc, cut) for cut in cuts]
+        names = [("Hips", BoneRole("hips")), ("Spine", BoneRole("spine")), ("Spine1", BoneRole("spine", index=1)),
+                 ("Spine2", BoneRole("chest"))]
+        made = [self._add(base, None, "", at[k], at[k + 1], role, chain.nodes[0] if k == 0 else None, id(chain),
+                          [], []) for k, (base, role) in enumerate(names)]
+        for k, edge in enumerate(chain.edges):
+            middle = 0.5 * (arc[k] + arc[k + 1])
+            self.edge_owner[edge] = made[int(np.searchsorted(cuts[1:-1], middle))]
+        for k, node in enumerate(chain.nodes):  # a node at a cut holds the bone that ends there
+            self.node_owner[node] = made[min(int(np.searchsorted(cuts[1:-1], arc[k], side="left")), 3)]
+        self.hips = made[0]
+
+    def chain(self, chain):
+        graph = self.graph
+        role_name, side, digit = chain.key
+        if role_name == "pelvis":  # a leg's hips bones are the pelvis: Hips holds them
+            owner = self.hips
+            if owner is not None:
+                for edge in chain.edges:
+                    self.edge_owner[edge] = owner
+                for node in chain.nodes[1:]:
+                    self.node_owner[node] = owner
+                return
+            role_name = "hips"
+        bones = [graph.edges[edge][2] for edge in chain.edges]
+        first = graph.skeleton.roles[next((bone for bone in bones if bone >= 0), bones[0])]
+        if role_name == "finger":
+            spans = _finger_spans(graph.points[chain.nodes], [bone >= 0 for bone in bones])
+            base = "Hand" + DIGIT_WORDS[digit]
+        elif role_name in NUMBERED:
+            spans = [(k, k + 1) for k, bone in enumerate(bones) if bone >= 0] or [(0, len(bones))]
+            base = WORDS[role_name]
+        else:  # from the first bone's head: a link before it (a limb beside its parent's joint) is no bone's
+            real = [k for k, bone in enumerate(bones) if bone >= 0]
+            spans = [(real[0], real[-1] + 1)] if real else [(0, len(bones))]
+            base = WORDS[role_name]
+        numbered = role_name == "finger" or role_name in NUMBERED
+        for number, (low, high) in enumerate(spans, start=1):
+            role = BoneRole(first.role, first.side, number - 1 if numbered else 0, first.digit)
+            self._add(base, side, str(number) if numbered else "", graph.points[chain.nodes[low]],
+                      graph.points[chain.nodes[high]], role, chain.nodes[0] if number == 1 else None, id(chain),
+                      chain.edges[low:high], chain.nodes[low + 1:high + 1])
+
+    def name_instances(self, up):
+        """``_2``, ``_3`` after the names that several chains share, the chains ordered from the highest start."""
+        first_of_chain = {}
+        for index, bone in enumerate(self.bones):
+            first_of_chain.setdefault(bone["chain"], index)
+        by_name = {}
+        for chain, index in first_of_chain.items():
+            bone = self.bones[index]
+            by_name.setdefault((bone["side"], bone["base"]), []).append(chain)
+        for chains in by_name.values():
+            chains.sort(key=lambda chain: (-round(float(self.bones[first_of_chain[chain]]["head"] @ up), 9),
+                                           first_of_chain[chain]))
+            for count, chain in enumerate(chains[1:], start=2):
+                for bone in self.bones:
+                    if bone["chain"] == chain:
+                        bone["suffix"] = f"_{count}"
+
+    def finished(self, start, arriving):
+        """(names, heads, tails, parents, roles): each bone hangs from the game bone holding the joint its chain
+        starts at (the Hips at the hips node), or from the bone before it in its chain."""
+        names = [f"{SIDE_WORDS[bone['side']]}{bone['base']}{bone['number']}{bone['suffix']}" for bone in self.bones]
+        if len(set(names)) != len(names):
+            raise ValueError(f"game bone names collide: {sorted(n for n in names if names.count(n) > 1)}")
+        parents = []
+        hips = self.hips
+        for index, bone in enumerate(self.bones):
+            if bone["start"] is None:  # the next bone of a chain
+                parents.append(index - 1)
+                continue
+            node = bone["start"]
+            edge = arriving.get(node)
+            owner = self.node_owner.get(node) if edge is not None else None
+            if owner is None and edge is not None:
+                owner = self.edge_owner.get(edge)
+            if owner is None or owner == index:
+                owner = hips if hips is not None and hips != index else -1
+            parents.append(owner)
+        heads = np.array([bone["head"] for bone in self.bones])
+        tails = np.array([bone["tail"] for bone in self.bones])
+        return names, heads, tails, parents, [bone["role"] for bone in self.bones]
+
+    def owners(self, count):
+        """The game bone owning each of Rigger's ``count`` bones."""
+        owners = [-1] * count
+        for edge, (a, b, bone, _) in enumerate(self.graph.edges):
+            if bone < 0:
+                continue
+            owner = self.edge_owner.get(edge)  # an edge closing a loop has none: its ends' holders take it
+            owners[bone] = owner if owner is not None else self.node_owner.get(a, self.node_owner.get(b, self.hips))
+        return owners
+
+
+def _point_at(points, arc, at):
+    """The point at arc length ``at`` along the polyline ``points`` (cumulative lengths ``arc``)."""
+    k = int(np.clip(np.searchsorted(arc, at, side="right") - 1, 0, len(points) - 2))
+    span = arc[k + 1] - arc[k]
+    share = 0.0 if span <= 0 else (at - arc[k]) / span
+    return points[k] + np.clip(share, 0.0, 1.0) * (points[k + 1] - points[k])
+
+
+def _finger_spans(points, real):
+    """(low, high) node spans of a finger's game bones: one per bone up to ``FINGER_BONES``, else cut at the joints
+    nearest the thirds of its length."""
+    count = len(points) - 1
+    if sum(real) <= FINGER_BONES:
+        return [(k, k + 1) for k in range(count) if real[k]] or [(0, count)]
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    cuts = [0]
+    for share in np.arange(1, FINGER_BONES) / FINGER_BONES:
+        best = int(np.argmin(np.abs(arc - share * arc[-1])))
+        cuts.append(min(max(best, cuts[-1] + 1), count - (FINGER_BONES - len(cuts))))
+    cuts.append(count)
+    return list(zip(cuts, cuts[1:]))
+
+
+def _mirrored_twins(names, heads, tails, plane, size):
+    """Heads and tails with every ``Left…``/``Right…`` pair that mirrors within ``TWIN_TOLERANCE`` of ``size`` made
+    exact mirror images (their mean across the plane): the method's mirror plane, else the plane fitted to the
+    pairs."""
+    pairs = [(names.index(name), names.index("Right" + name[4:])) for name in names
+             if name.startswith("Left") and "Right" + name[4:] in names]
+    if not pairs:
+        return heads, tails
+    left = np.concatenate([heads[[a for a, _ in pairs]], tails[[a for a, _ in pairs]]])
+    right = np.concatenate([heads[[b for _, b in pairs]], tails[[b for _, b in pairs]]])
+    if plane is not None:
+        normal, offset = np.asarray(plane.normal, float), float(plane.offset)
+    else:
+        normal = (left - right).sum(axis=0)
+        if not np.linalg.norm(normal) > 0:
+            return heads, tails
+        normal /= np.linalg.norm(normal)
+        offset = float(np.mean(0.5 * (left + right) @ normal))
+
+    def reflect(points):
+        return points - 2 * ((points @ normal) - offset)[..., None] * normal
+
+    heads, tails = heads.copy(), tails.copy()
+    for a, b in pairs:
+        for points in (heads, tails):
+            image = reflect(points[b])
+            if np.linalg.norm(points[a] - image) <= TWIN_TOLERANCE * size:
+                points[a] = 0.5 * (points[a] + image)
+                points[b] = reflect(points[a])
+    return heads, tails

@@ -1,0 +1,114 @@
+"""The game target's skeleton (``rigger.core.game``) and the mocap mapping (``rigger.core.retarget``), bpy-free."""
+import numpy as np
+import pytest
+
+import rigger
+from characters import load_character
+from rigger.core.game import game_skeleton
+from rigger.core.retarget import RetargetError, aliases, map_joints, normalised
+from rigger.core.roles import named_joints
+from rigger.core.targets import choose_target
+
+MIXAMO = {"Hips", "Spine", "Spine1", "Spine2", "Neck", "Head"} | {
+    f"{side}{word}" for side in ("Left", "Right")
+    for word in ("Shoulder", "Arm", "ForeArm", "Hand", "UpLeg", "Leg", "Foot")}
+CMU = ["Hips", "LHipJoint", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "RHipJoint", "RightUpLeg", "RightLeg",
+       "RightFoot", "RightToeBase", "LowerBack", "Spine", "Spine1", "Neck", "Neck1", "Head", "LeftShoulder", "LeftArm",
+       "LeftForeArm", "LeftHand", "LeftFingerBase", "LeftHandIndex1", "LThumb", "RightShoulder", "RightArm",
+       "RightForeArm", "RightHand", "RightFingerBase", "RightHandIndex1", "RThumb"]
+CMU_PARENTS = [-1, 0, 1, 2, 3, 4, 0, 6, 7, 8, 9, 0, 11, 12, 13, 14, 15, 13, 17, 18, 19, 20, 21, 20, 13, 24, 25, 26,
+               27, 28, 27]
+
+
+def rigged(name):
+    vertices, triangles = load_character(name)
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    return skeleton, game_skeleton(skeleton, vertices), vertices
+
+
+def test_the_sample_humanoid_gets_mixamo_names_under_one_root_on_the_ground():
+    skeleton, game, vertices = rigged("humanoid")
+    bones = game.skeleton
+    assert MIXAMO <= set(bones.names)
+    assert bones.roots == (bones.names.index("root"),)
+    parent = {name: bones.names[p] if p >= 0 else None for name, p in zip(bones.names, bones.parents)}
+    assert parent["Hips"] == "root" and parent["Spine"] == "Hips" and parent["Spine2"] == "Spine1"
+    assert parent["LeftUpLeg"] == "Hips" and parent["LeftShoulder"] == "Spine2" and parent["Neck"] == "Spine2"
+    assert parent["LeftForeArm"] == "LeftArm" and parent["Head"] == "Neck"
+    root, hips = bones.heads[bones.names.index("root")], bones.heads[bones.names.index("Hips")]
+    assert root[2] == pytest.approx(vertices[:, 2].min()) and root[:2] == pytest.approx(hips[:2])
+
+
+def test_game_joints_are_the_named_joints_and_every_bone_is_taken_over():
+    skeleton, game, _ = rigged("humanoid")
+    joints = named_joints(skeleton)
+    bones = game.skeleton
+    for name, key in (("LeftUpLeg", ("thigh", "L", None)), ("RightLeg", ("shin", "R", None)),
+                      ("LeftFoot", ("foot", "L", None)), ("LeftArm", ("upper_arm", "L", None)),
+                      ("RightForeArm", ("forearm", "R", None)), ("LeftHand", ("hand", "L", None)),
+                      ("Neck", ("neck", None, None)), ("Head", ("head", None, None)),
+                      ("Hips", ("hips", None, None)), ("Spine", ("spine", None, None)),
+                      ("Spine2", ("chest", None, None))):
+        assert bones.heads[bones.names.index(name)] == pytest.approx(joints[key], abs=1e-9), name
+    assert len(game.owners) == len(skeleton) and min(game.owners) >= 1  # every Rigger bone has a game bone (not root)
+    for bone, owner in enumerate(game.owners):  # ... that lies along it
+        middle = 0.5 * (skeleton.heads[bone] + skeleton.tails[bone])
+        head, tail = bones.heads[owner], bones.tails[owner]
+        along = np.clip((middle - head) @ (tail - head) / ((tail - head) @ (tail - head)), 0, 1)
+        assert np.linalg.norm(head + along * (tail - head) - middle) < 0.1
+
+
+@pytest.mark.parametrize("name", ["humanoid", "humanoid_a_pose", "quadruped"])
+def test_twins_mirror_across_the_mirror_plane(name):
+    _, game, _ = rigged(name)
+    bones = game.skeleton
+    pairs = [(k, bones.names.index("Right" + n[4:])) for k, n in enumerate(bones.names) if n.startswith("Left")]
+    assert pairs
+    for left, right in pairs:
+        for points in (bones.heads, bones.tails):
+            assert points[left] * [-1, 1, 1] == pytest.approx(points[right], abs=1e-6)
+
+
+def test_a_quadruped_follows_the_same_scheme_from_its_hips():
+    _, game, _ = rigged("quadruped")
+    names = set(game.skeleton.names)
+    assert {"root", "Hips", "Spine", "Spine1", "Spine2", "Neck", "Head", "Tail1", "Tail2", "LeftUpLeg", "RightLeg",
+            "LeftArm", "RightForeArm"} <= names
+    bones = game.skeleton
+    assert bones.roots == (bones.names.index("root"),)
+    assert bones.parents[bones.names.index("Hips")] == bones.names.index("root")
+    assert bones.parents[bones.names.index("Tail1")] == bones.names.index("Hips")
+
+
+def test_a_plan_the_game_target_cannot_fill_falls_back_to_plain_saying_why():
+    vertices, triangles = load_character("octopus")
+    plan = rigger.rig_mesh(vertices, triangles).body_plan
+    assert plan.kind == "other"
+    target, warning = choose_target("game", plan)
+    assert target.name == "plain" and "game target" in warning and "other" in warning
+
+
+def test_cmu_and_mixamo_joints_map_onto_the_game_names():
+    game = ["root", *sorted(MIXAMO), "LeftToeBase"]
+    mapping = map_joints(CMU, CMU_PARENTS, game)
+    by_name = {name: CMU[joint] for name, joint in mapping.driven.items()}
+    assert by_name["Hips"] == "Hips" and by_name["LeftUpLeg"] == "LeftUpLeg" and by_name["RightForeArm"] == \
+        "RightForeArm"
+    assert [by_name[name] for name in ("Spine", "Spine1", "Spine2")] == ["LowerBack", "Spine", "Spine1"]
+    assert by_name["Neck"] == "Neck" and by_name["Head"] == "Head" and by_name["LeftToeBase"] == "LeftToeBase"
+    assert "LHipJoint" in mapping.unused and not mapping.undriven
+    mixamo = [f"mixamorig:{name}" for name in ("Hips", "Spine", "Spine1", "Spine2", "Neck", "Head", "LeftUpLeg",
+                                               "LeftLeg", "LeftFoot", "RightUpLeg", "RightLeg", "RightFoot",
+                                               "LeftArm", "LeftForeArm", "RightArm", "RightForeArm")]
+    parents = [-1, 0, 1, 2, 3, 4, 0, 6, 7, 0, 9, 10, 3, 12, 3, 14]
+    mapping = map_joints(mixamo, parents, game)
+    assert {name: mixamo[j].split(":")[1] for name, j in mapping.driven.items() if name.startswith("Spine")} == \
+        {"Spine": "Spine", "Spine1": "Spine1", "Spine2": "Spine2"}
+    assert normalised("mixamorig1_Left_Hand") == "lefthand" and "lthigh" in aliases("LeftUpLeg")
+
+
+def test_a_motion_that_cannot_drive_the_legs_names_the_bones_and_joints():
+    with pytest.raises(RetargetError) as error:
+        map_joints(["Bone", "Bone1", "Bone2"], [-1, 0, 1], ["root", *sorted(MIXAMO)])
+    message = str(error.value)
+    assert "LeftUpLeg" in message and "Hips" in message and "Bone1" in message

@@ -1,0 +1,173 @@
+"""The game target in Blender: the armature, its weights, glTF and FBX round trips, and ``rig --animate`` end to end
+(on a short BVH written here; ``../shared/anim`` is not needed)."""
+import json
+import math
+import pathlib
+
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+import rigger  # noqa: E402
+from characters import load_character  # noqa: E402
+from rigger.blender.game import INFLUENCES  # noqa: E402
+from rigger.blender.pipeline import rig_object, skin_meshes  # noqa: E402
+from rigger.blender.samples import build_character  # noqa: E402
+from rigger.blender.scenefiles import save_scene  # noqa: E402
+from rigger.core.game import ROOT  # noqa: E402
+from test_cli import Y_UP_TO_Z_UP, run, write_obj  # noqa: E402
+
+FRAMES = 12
+
+
+def game_character(name="humanoid"):
+    rigger.register()
+    obj = build_character(name, subdivisions=1)
+    result = rig_object(obj, "silhouette", target="game")
+    outcomes, _ = skin_meshes([obj], result.armature)
+    return obj, result, outcomes[obj.name]
+
+
+def vertex_weights(obj):
+    names = {group.index: group.name for group in obj.vertex_groups}
+    return [{names[e.group]: e.weight for e in vertex.groups if e.weight > 0} for vertex in obj.data.vertices]
+
+
+def bones_of(armature):
+    matrix = np.array(armature.matrix_world)
+    return {bone.name: ((matrix @ np.r_[bone.head_local, 1])[:3], bone.parent.name if bone.parent else None)
+            for bone in armature.data.bones}
+
+
+def test_game_armature_weights_and_mirrored_rolls(scene):
+    obj, result, report = game_character()
+    armature = result.armature
+    assert result.target.name == "game" and armature["rigger_target"] == "game"
+    assert not armature.data.bones[ROOT].use_deform and ROOT in result.bones.names
+    weights = vertex_weights(obj)
+    assert all(weights) and max(len(w) for w in weights) <= INFLUENCES
+    assert max(abs(sum(w.values()) - 1) for w in weights) < 1e-5
+    assert not any(ROOT in w for w in weights)
+    assert report.stages[-1].name == f"at most {INFLUENCES} influences"
+    bpy.context.view_layer.objects.active = armature
+    bpy.ops.object.mode_set(mode='EDIT')
+    axes = {bone.name: (bone.roll, np.array(bone.z_axis)) for bone in armature.data.edit_bones}
+    bpy.ops.object.mode_set(mode='OBJECT')
+    twins = [name for name in axes if name.startswith("Left")]
+    assert len(twins) >= 7
+    for name in twins:
+        roll, z_axis = axes[name]
+        twin_roll, twin_z = axes["Right" + name[4:]]
+        assert twin_roll == pytest.approx(-roll, abs=1e-4)
+        assert twin_z * [-1, 1, 1] == pytest.approx(z_axis, abs=1e-4)
+
+
+@pytest.mark.parametrize("suffix", [".glb", ".fbx"])
+def test_names_hierarchy_and_weights_survive_glb_and_fbx(scene, tmp_path, suffix):
+    obj, result, _ = game_character()
+    bones, weights = bones_of(result.armature), vertex_weights(obj)
+    path = tmp_path / f"game{suffix}"
+    save_scene(path, [obj, result.armature])
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    if suffix == ".glb":
+        bpy.ops.import_scene.gltf(filepath=str(path))
+    else:
+        bpy.ops.import_scene.fbx(filepath=str(path))
+    armature = next(o for o in bpy.data.objects if o.type == 'ARMATURE')
+    mesh = next(o for o in bpy.data.objects if o.type == 'MESH' and o.vertex_groups)
+    back = bones_of(armature)
+    assert set(back) == set(bones)
+    for name, (head, parent) in bones.items():
+        assert back[name][1] == parent
+        assert back[name][0] == pytest.approx(head, abs=1e-4)
+    back_weights = vertex_weights(mesh)
+    assert len(back_weights) == len(weights)
+    for mine, theirs in zip(weights, back_weights):  # glTF stores weights as 16-bit fractions
+        assert all(theirs.get(name, 0) == pytest.approx(mine.get(name, 0), abs=1e-3) for name in {*mine, *theirs})
+
+
+def short_bvh(path, names=None):
+    """A 12-frame BVH with CMU's joint names (or ``names`` for its 19 joints): a step forward, the left knee bending,
+    the arms swinging down from a T-pose."""
+    names = names or ["Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "RightUpLeg", "RightLeg",
+                      "RightFoot", "RightToeBase", "Spine", "Spine1", "Neck", "Head", "LeftShoulder", "LeftArm",
+                      "LeftForeArm", "RightShoulder", "RightArm", "RightForeArm"]
+    offsets = [(0, 0, 0), (1.8, -1.7, 0.8), (2.0, -6.8, 0), (2.0, -7.0, 0), (0.2, -0.5, 2.0), (-1.8, -1.7, 0.8),
+               (-2.0, -6.8, 0), (-2.0, -7.0, 0), (-0.2, -0.5, 2.0), (0, 2.2, 0), (0, 2.2, 0), (0, 2.5, 0),
+               (0, 1.5, 0), (1.0, 1.5, 0), (3.0, 0, 0), (5.0, 0, 0), (-1.0, 1.5, 0), (-3.0, 0, 0), (-5.0, 0, 0)]
+    parents = [-1, 0, 1, 2, 3, 0, 5, 6, 7, 0, 9, 10, 11, 10, 13, 14, 10, 16, 17]
+    children = {k: [c for c, p in enumerate(parents) if p == k] for k in range(len(names))}
+    lines = ["HIERARCHY"]
+
+    def joint(k, depth):
+        pad = "\t" * depth
+        lines.append(f"{pad}{'ROOT' if k == 0 else 'JOINT'} {names[k]}")
+        lines.append(f"{pad}{{")
+        lines.append(f"{pad}\tOFFSET {' '.join(f'{v:.4f}' for v in offsets[k])}")
+        lines.append(f"{pad}\tCHANNELS " + ("6 Xposition Yposition Zposition " if k == 0 else "3 ")
+                     + "Zrotation Yrotation Xrotation")
+        for child in children[k]:
+            joint(child, depth + 1)
+        if not children[k]:
+            lines.extend([f"{pad}\tEnd Site", f"{pad}\t{{", f"{pad}\t\tOFFSET 0 1 0", f"{pad}\t}}"])
+        lines.append(f"{pad}}}")
+
+    joint(0, 0)
+    lines += ["MOTION", f"Frames: {FRAMES}", "Frame Time: 0.0333333"]
+    for frame in range(FRAMES):
+        values = np.zeros((len(names), 3))
+        phase = math.sin(2 * math.pi * frame / FRAMES)
+        values[1] = (0, 0, -20 * phase)  # left thigh swings (about X: the last channel)
+        values[2] = (0, 0, 30 * max(phase, 0))  # left knee bends back
+        values[14] = (-60, 0, 0)  # left arm down from the T-pose (about Z)
+        values[17] = (60, 0, 0)
+        row = [0.0, 16.0, 2.0 * frame] + [v for k in range(len(names)) for v in values[k]]
+        lines.append(" ".join(f"{v:.4f}" for v in row))
+    pathlib.Path(path).write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.fixture(scope="module")
+def humanoid_file(tmp_path_factory):
+    vertices, triangles = load_character("humanoid")
+    return write_obj(tmp_path_factory.mktemp("game") / "humanoid.obj", vertices @ Y_UP_TO_Z_UP, triangles)
+
+
+def test_rig_animate_bakes_the_motion_into_the_glb(humanoid_file, tmp_path):
+    bvh = short_bvh(tmp_path / "step.bvh")
+    output, report = tmp_path / "step.glb", tmp_path / "step.json"
+    result = run("rig", humanoid_file, "--animate", bvh, "-o", output, "--report", report)
+    assert result.returncode == 0, result.stderr
+    data = json.loads(report.read_text())
+    assert data["target"] == "game" and data["animation"]["frames"] == FRAMES
+    assert data["animation"]["undriven"] == [] or "Neck" not in data["animation"]["undriven"]
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    bpy.ops.import_scene.gltf(filepath=str(output))
+    armature = next(o for o in bpy.data.objects if o.type == 'ARMATURE')
+    assert armature.animation_data is not None and armature.animation_data.action is not None
+    scene = bpy.context.scene
+    heads = []
+    for frame in (int(scene.frame_start), int(scene.frame_end)):
+        scene.frame_set(frame)
+        pose = armature.pose.bones
+        heads.append({name: np.array(armature.matrix_world @ pose[name].head) for name in ("Hips", "LeftHand")})
+    # glTF is Y up: the hips walked forward (the BVH's +Z is the character's front, Blender's -Y) ...
+    assert np.linalg.norm(heads[1]["Hips"] - heads[0]["Hips"]) > 0.05
+    # ... and the arms hang down, not out as at rest
+    assert heads[0]["LeftHand"][2] < heads[0]["Hips"][2] + 0.3
+
+
+def test_an_unmappable_bvh_names_what_it_could_not_place(humanoid_file, tmp_path):
+    bvh = short_bvh(tmp_path / "odd.bvh", [f"Bone{k}" for k in range(19)])
+    output = tmp_path / "odd.glb"
+    result = run("rig", humanoid_file, "--animate", bvh, "-o", output)
+    assert result.returncode == 1 and not output.exists()
+    error = result.stderr.strip().splitlines()[-1]
+    assert error.startswith("rigger: error:") and "LeftUpLeg" in error and "Bone3" in error
+
+
+def test_animate_needs_the_game_target(humanoid_file, tmp_path):
+    bvh = short_bvh(tmp_path / "step.bvh")
+    result = run("rig", humanoid_file, "--animate", bvh, "--target", "plain", "-o", tmp_path / "x.glb")
+    assert result.returncode == 1 and "game target" in result.stderr
