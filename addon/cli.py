@@ -171,8 +171,8 @@ def _run_rig(args):
 
     from .batch.work import FileFailed, prepare, rig_to_files
 
-    prepare()
     try:
+        prepare()
         report = rig_to_files(source, output, args.report, settings)
     except FileFailed as error:
         raise CliError(str(error)) from None
@@ -253,10 +253,12 @@ def _run_batch(args):
     def found():
         return inputs.sources(args.inputs, args.output, args.format, INPUTS)
 
+    running = False  # whether the driver runs, and so writes a summary when interrupted
     try:
-        # counted first for the progress bar (and the files whose frame is fixed); found again as they go
-        suffixes = [source.path.suffix.lower() for source in found()]
-        total, fixed = len(suffixes), sum(suffix not in AXIS_SUFFIXES for suffix in suffixes)
+        total = fixed = 0  # counted first for the progress bar (and the files whose frame is fixed); found again
+        for source in found():  # as they go
+            total += 1
+            fixed += source.path.suffix.lower() not in AXIS_SUFFIXES
         if not total:
             raise CliError(f"no model files ({', '.join(INPUTS)}) in {' '.join(args.inputs)}")
         if fixed and (args.up or args.forward):
@@ -266,12 +268,13 @@ def _run_batch(args):
         # which the rows give too) goes to stderr with the progress bar
         with contextlib.redirect_stdout(sys.stderr), _engine(args, settings) as engine:
             args.output.mkdir(parents=True, exist_ok=True)
+            running = True
             rows = driver.run(found(), total, engine, args.output, args.format, settings, resume=args.resume)
     except BatchError as error:
         raise CliError(str(error)) from None
     except KeyboardInterrupt:
-        print(f"rigger: interrupted; {args.output / driver.SUMMARY} lists the files done so far, and the same "
-              f"command with --resume goes on from there", file=sys.stderr)
+        done = f"{args.output / driver.SUMMARY} lists the files done so far, and " if running else ""
+        print(f"rigger: interrupted; {done}the same command with --resume goes on from there", file=sys.stderr)
         return EXIT_INTERRUPTED
     print(driver.summary_table(rows))
     return EXIT_FAILED if any(row["status"] != "ok" for row in rows) else 0

@@ -360,7 +360,7 @@ def crack(posed, pairs):
     return float(gaps[worst]), worst
 
 
-def leaf_chains(positions, parents):
+def leaf_chains(parents):
     """The joint chains of a joint tree from a branch joint (or a root) to a leaf: lists of joint indices."""
     parents = np.asarray(parents)
     children = np.bincount(parents[parents >= 0], minlength=len(parents))
@@ -393,7 +393,7 @@ def limb_recall(joint_positions, joint_parents, heads, tails, parents, size, tol
     A chain is followed when its points (every ``step`` * ``size``) lie within ``tolerance`` * ``size`` on average of
     one path of bones from a leaf bone up to its root. Returns (share followed, list of (chain, followed) pairs).
     """
-    chains = [chain for chain in leaf_chains(joint_positions, joint_parents) if len(chain) > 1]
+    chains = [chain for chain in leaf_chains(joint_parents) if len(chain) > 1]
     if not chains:
         return float("nan"), []
     outcome = [(chain, closest_path(chain_points(joint_positions, chain, step * size), heads, tails, parents)[0]

@@ -77,11 +77,6 @@ def chain_parent(skeleton, chain):
     return int(skeleton.parents[chain[0]])
 
 
-def chain_of(skeleton, bone):
-    """The chain (:func:`chains`) that holds ``bone``."""
-    return next(chain for chain in chains(skeleton) if bone in chain)
-
-
 def chains_in_ball(skeleton, centre, radius, min_inside=0.5, step=0.005):
     """The chains of which at least ``min_inside`` * ``radius`` of bone length lies inside the ball (``centre``,
     ``radius``): how many chains run through a part, such as a head (a trunk ending at the neck grazes it)."""
@@ -143,7 +138,7 @@ def limbs(truth, skeleton, size, step=CHAIN_STEP):
     joint, or the root, to a leaf joint (the bones leaving one root joint branch there)."""
     positions, parents, bone_of_joint = _joint_tree(truth)
     result = {}
-    for chain in posing_math.leaf_chains(positions, parents):
+    for chain in posing_math.leaf_chains(parents):
         if len(chain) < 2:
             continue
         points = posing_math.chain_points(positions, chain, step * size)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from characters import load_character, strictly_inside_fraction, write_obj
-from commands import run_cli as run
+from commands import files_below, run_cli as run
 
 bpy = pytest.importorskip("bpy")
 
@@ -127,7 +127,7 @@ def test_outputs_never_overwrite_the_input_or_each_other(rigged_glb, tmp_path):
         result = run("rig", source, *extra)
         assert result.returncode == 1 and message in result.stderr, result.stderr
     assert source.read_bytes() == (rigged_glb[1] / "humanoid.glb").read_bytes()
-    assert sorted(leaves_nothing(tmp_path)) == ["a_file", "model.glb", "taken.glb"]
+    assert sorted(files_below(tmp_path)) == ["a_file", "model.glb", "taken.glb"]
 
 
 def test_no_skin_and_fbx_output(humanoid_obj, tmp_path):
@@ -135,10 +135,6 @@ def test_no_skin_and_fbx_output(humanoid_obj, tmp_path):
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "out.fbx").read_bytes()[:18] == b"Kaydara FBX Binary"
     assert json.loads((tmp_path / "r.json").read_text())["skinning"]["summary"].startswith("not skinned")
-
-
-def leaves_nothing(folder):
-    return [path.name for path in folder.iterdir()]
 
 
 @pytest.mark.parametrize("case, message", [
@@ -176,13 +172,13 @@ def test_errors_exit_non_zero_with_a_message_and_write_nothing(case, message, hu
     out = tmp_path / "out"
     out.mkdir()
     output = out / ("rig.txt" if case == "bad_output" else "rig.blend")
-    before = set(leaves_nothing(tmp_path))
+    before = set(files_below(tmp_path))
     result = run("rig", source, "-o", output, "--report", out / "report.json", *extra)
     assert result.returncode != 0
     assert message in result.stderr, result.stderr
     assert "Traceback" not in result.stderr
-    assert leaves_nothing(out) == []
-    assert set(leaves_nothing(tmp_path)) == before
+    assert files_below(out) == []
+    assert set(files_below(tmp_path)) == before
 
 
 # --up and --forward (issue 28, defect 8)
@@ -308,3 +304,7 @@ def test_methods_lists_every_method_and_its_parameters():
     result = run("methods")
     assert result.returncode == 0
     assert "silhouette:" in result.stdout and "--set bone_length=VALUE" in result.stdout
+    assert "tuning (" not in result.stdout
+    tuned = run("methods", "--tuning")
+    assert tuned.returncode == 0 and "tuning (rigger.methods.silhouette.tuning." in tuned.stdout
+    assert "body plan and bone roles (after every method):" in tuned.stdout and "knee_at = " in tuned.stdout

@@ -19,7 +19,7 @@ import time
 
 from ..axes import axes_field, file_axes
 from ..core.files import remove_leftover_folders, remove_leftovers, replaced_on_success
-from .work import rigged_row
+from .work import input_stamp, rigged_row
 
 SUMMARY = "summary.json"
 # The first bytes of a complete model file of each output format: .blend plain or zstd-compressed, binary glTF, FBX.
@@ -79,7 +79,7 @@ def run(sources, total, engine, output, fmt, settings, resume=False, progress=sy
                 row["finished_at"] = round(time.time(), 3)
                 running.remove(job)
                 if row["status"] != "ok":
-                    discard(job)
+                    discard(job, output)
                 if crashed and job.attempt == 1:
                     retries.append(dataclasses.replace(job, attempt=2))
                     continue
@@ -90,7 +90,7 @@ def run(sources, total, engine, output, fmt, settings, resume=False, progress=sy
     except BaseException:
         engine.stop()
         for job in running:
-            discard(job)
+            discard(job, output)
         bar.close()
         with contextlib.suppress(OSError):  # the interruption matters more than a summary that cannot be written
             write_summary(output, rows)
@@ -110,18 +110,19 @@ def _row(job, fields):
 
 def finished_report(job, settings):
     """The report of the file a previous run rigged into ``job``'s output and report with ``settings``, or None when
-    either is missing or incomplete, or they were made with another method, other parameters, another target asked
-    for, other axes or skinning."""
+    either is missing or incomplete, or they were made from another version of the input file (``input_stamp``), with
+    another method, other parameters, another target asked for, other axes or skinning."""
     output, report = job.output, job.report
     try:
         with open(output, "rb") as model:
             head = model.read(32)
         data = json.loads(pathlib.Path(report).read_text(encoding="utf-8"))
+        stamp = input_stamp(job.source.path)
     except (OSError, ValueError):
         return None
     axes = file_axes(job.source.path.suffix, *settings.axes_for(job.source.path))
     expected = {"method": settings.method, "params": json.loads(json.dumps(settings.params)),
-                "asked_target": settings.target, "axes": axes_field(axes)}
+                "asked_target": settings.target, "axes": axes_field(axes), "input_stamp": stamp}
     if not (isinstance(data, dict) and head.startswith(MAGIC.get(pathlib.Path(output).suffix.lower(), ()))
             and all(data.get(key) == value for key, value in expected.items())
             and isinstance(data.get("bones"), list) and isinstance(data.get("skinning"), dict)
@@ -130,11 +131,19 @@ def finished_report(job, settings):
     return data
 
 
-def discard(job):
-    """Remove whatever an attempt at ``job`` left: its model, its report and their half-written folders."""
+def discard(job, output):
+    """Remove whatever an attempt at ``job`` left: its model, its report, their half-written folders, and the
+    folders below ``output`` made for them that are empty then."""
     for path in (job.output, job.report):
         remove_leftovers(path)
         path.unlink(missing_ok=True)
+    folder, root = job.output.parent, pathlib.Path(output)
+    while folder != root and root in folder.parents:
+        try:
+            folder.rmdir()
+        except OSError:  # not empty: another file's results are there
+            break
+        folder = folder.parent
 
 
 def write_summary(output, rows):

@@ -4,8 +4,9 @@ An input is a folder (searched recursively; hidden files and folders, and the ou
 are skipped), a model file, a text file listing model files one per line (relative paths are relative to the list's
 folder; blank lines and lines starting with # are ignored), or a glob pattern (``**`` matches any depth). Results
 mirror each file's path below its input's folder (the list's folder, the glob's fixed leading folders); a listed
-file outside that folder gets its whole path below the output folder. Each file's result names depend on the file
-and its folder alone, so a resumed run finds them again however the inputs are ordered or split.
+file outside that folder gets its whole path below the output folder. Each file's result names depend on the file,
+its folder and the input that named it (and, where two files would share a name, on which came first), so a resumed
+run with the same inputs finds them again.
 """
 import collections
 import dataclasses

@@ -48,14 +48,22 @@ class LocalEngine:
         self._pool.shutdown(wait=True, cancel_futures=True)
 
     def _rig(self, job):
-        """(row, crashed) for one file rigged in a child process."""
+        """(row, crashed) for one file rigged in a child process; a failed row, never an exception, when the child
+        cannot even be started (no memory or file handles left) or its report is not one."""
+        try:
+            return self._run_child(job)
+        except Exception as error:
+            return {"status": "failed", "message": f"{type(error).__name__}: {error}", "seconds": 0.0}, False
+
+    def _run_child(self, job):
         command = [sys.executable, "-m", __package__.rpartition(".")[0], "rig", str(job.source.path),
                    "-o", str(job.output), "--report", str(job.report), *self._settings.options(job.source.path)]
         start = time.perf_counter()
         with self._lock:
             if self._stopping:
                 return {"status": "failed", "message": "stopped", "seconds": 0.0}, False
-            child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                     encoding="utf-8", errors="replace")  # Blender may echo paths in any encoding
             self._children.add(child)
         timed_out = False
         try:
@@ -75,7 +83,7 @@ class LocalEngine:
                 child.returncode < 0
         try:
             row = rigged_row(json.loads(job.report.read_text()))
-        except (OSError, ValueError, KeyError) as error:
+        except (OSError, ValueError, KeyError, TypeError) as error:
             row = {"status": "failed", "message": f"finished without a readable report: {error}"}
         return {**row, "seconds": seconds}, False
 

@@ -38,15 +38,19 @@ class RayEngine:
         except (ConnectionError, RuntimeError, ValueError) as error:
             where = f"the Ray cluster at {address}" if address else "a local Ray instance"
             raise BatchError(f"cannot start or reach {where}: {error}") from None
-        self.slots = jobs or max(1, int(ray.cluster_resources().get("CPU", 1)))
-        self._timeout = timeout
-        self._actor = ray.remote(Worker).options(num_cpus=1, max_restarts=0)
-        self._settings = settings
-        self._queue = collections.deque()
-        self._last_news = time.monotonic()
-        self._workers = [_Slot() for _ in range(self.slots)]
-        for worker in self._workers:
-            self._replace(worker)
+        try:  # the instance started above goes down again if the pool cannot be set up
+            self.slots = jobs or max(1, int(ray.cluster_resources().get("CPU", 1)))
+            self._timeout = timeout
+            self._actor = ray.remote(Worker).options(num_cpus=1, max_restarts=0)
+            self._settings = settings
+            self._queue = collections.deque()
+            self._started = False  # whether any worker has ever started
+            self._workers = [_Slot() for _ in range(self.slots)]
+            for worker in self._workers:
+                self._replace(worker)
+        except BaseException:
+            ray.shutdown()
+            raise
 
     def __enter__(self):
         return self
@@ -65,7 +69,6 @@ class RayEngine:
             waiting = {worker.ref: worker for worker in self._workers if worker.ref is not None}
             ready, _ = ray.wait(list(waiting), num_returns=1, timeout=self._wait_seconds())
             if ready:
-                self._last_news = time.monotonic()
                 ready, _ = ray.wait(list(waiting), num_returns=len(waiting), timeout=0)
             for ref in ready:
                 results += self._collect(waiting[ref])
@@ -101,24 +104,33 @@ class RayEngine:
                 worker.ref = worker.actor.rig.remote(str(job.source.path), str(job.output), str(job.report))
 
     def _collect(self, worker):
-        """The driver's results from ``worker``'s finished call: none when it finished starting."""
+        """The driver's results from ``worker``'s finished call: none when it finished starting. A worker that
+        fails to start stops the batch while none ever has (nothing could rig a file); after that it is started
+        again (a node lost, say)."""
         exceptions = self._ray.exceptions
         job, seconds = worker.job, round(time.monotonic() - worker.since, 2)
         try:
             value = self._ray.get(worker.ref)
         except exceptions.RayTaskError as error:  # an exception from Rigger's own code; the worker lives on
             if job is None:
-                raise BatchError(f"a Ray worker could not start: {_last_line(error)}") from None
+                return self._not_started(worker, _last_line(error))
             worker.ref = worker.job = None
             return [(job, {"status": "failed", "message": _last_line(error), "seconds": seconds}, False)]
         except exceptions.RayError as error:  # the worker process died (killed, segfault, out of memory, lost node)
             if job is None:
-                raise BatchError(f"a Ray worker could not start: {_reason(error)}") from None
+                return self._not_started(worker, _reason(error))
             self._replace(worker)
             return [(job, {"status": "failed", "message": f"the worker process died mid-file ({_reason(error)})",
                            "seconds": seconds}, True)]
         worker.ref = worker.job = None
+        self._started = True
         return [] if job is None else [(job, {**value, "seconds": seconds}, False)]
+
+    def _not_started(self, worker, reason):
+        if not self._started:
+            raise BatchError(f"a Ray worker could not start: {reason}")
+        self._replace(worker)
+        return []
 
     def _expire(self):
         """Kill and replace the workers whose file has run past the timeout; their files' failed rows."""
@@ -142,8 +154,9 @@ class RayEngine:
     def _check_started(self):
         """BatchError when files wait while every worker has been starting for START_LIMIT seconds (a cluster
         without free CPUs, or whose nodes cannot import bpy and Rigger and say nothing)."""
-        starting = all(worker.job is None and worker.ref is not None for worker in self._workers)
-        if self._queue and starting and time.monotonic() - self._last_news > START_LIMIT:
+        now = time.monotonic()
+        if self._queue and all(worker.job is None and worker.ref is not None and now - worker.since > START_LIMIT
+                               for worker in self._workers):
             raise BatchError(f"no Ray worker started within {START_LIMIT:g} s; the cluster has "
                              f"{self._ray.cluster_resources().get('CPU', 0):g} CPUs, and every node needs bpy and "
                              f"Rigger installed as on this one")

@@ -58,10 +58,14 @@ class Settings:
 
 
 def prepare():
-    """Once per process before its first file: import bpy and register the properties Rigger keeps on scenes and
-    objects."""
+    """Once per process before its first file: import bpy and register the add-on (the properties Rigger keeps on
+    scenes and objects). FileFailed when Rigger's compiled modules do not load here."""
     from .. import register
+    from ..compat import compiled_problem
 
+    problem = compiled_problem()
+    if problem:
+        raise FileFailed(problem)
     register()
 
 
@@ -75,10 +79,12 @@ def rig_to_files(source, output, report, settings):
 
     start, cpu = time.perf_counter(), time.process_time()
     try:
+        stamp = input_stamp(source)  # before reading: an input changed meanwhile is rigged again on --resume
         up, forward = settings.axes_for(source)
         data = scenefiles.rig_file(source, output, settings.method, settings.params, target=settings.target,
                                    skin=settings.skin, up=up, forward=forward, animate=settings.animate)
         data["timings"].update(file=time.perf_counter() - start, file_cpu=time.process_time() - cpu)
+        data["input_stamp"] = stamp
         if report is not None:
             with replaced_on_success(report) as path:
                 _test_hooks(source)
@@ -90,6 +96,12 @@ def rig_to_files(source, output, report, settings):
     except OSError as error:  # a folder that cannot be written, a full disk
         raise FileFailed(f"{error.filename or output}: {error.strerror or error}") from None
     return data
+
+
+def input_stamp(source):
+    """What tells a model file's versions apart without reading it: its size and modification time."""
+    status = os.stat(source)
+    return {"bytes": status.st_size, "modified_ns": status.st_mtime_ns}
 
 
 def _test_hooks(source):

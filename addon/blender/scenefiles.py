@@ -14,7 +14,6 @@ from .pipeline import METHOD_PROPERTY, TARGET_PROPERTY, rig_object, skin_meshes,
 from .properties import ARMATURE_POINTER
 
 
-
 def rig_file(source, output, method, params, *, target="plain", skin=True, up=None, forward=None, animate=None):
     """Rig the meshes of model file ``source`` together as output target ``target`` (``core.targets``), skin them,
     save them with their armature to ``output`` and return the report (bones in the file's frame, the axes it was
@@ -116,8 +115,8 @@ def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warn
     confidence, reason, parts), bones (the built armature's deforming bones, with their roles and sides where the
     target keeps them; mapped from Blender's world into the frame named ``frame`` by the inverse of ``to_world``),
     the (up, forward) ``axes`` the file was read with (None: Blender's importer chose), timings, the skinning outcome
-    per mesh (``outcomes``: mesh name → skinning report, or None when not skinned) and warnings (``warnings`` first,
-    then the rig's own, then one when the body plan was not recognised).
+    per mesh (``outcomes``: mesh name → skinning report, or None when not skinned) and warnings (``warnings``, the
+    rig's own, meshes rigged together, the skinning's, and last why the body plan was not recognised).
 
     Timings are plain floats whatever number type the method recorded (numpy scalars are not JSON).
     """

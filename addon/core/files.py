@@ -8,15 +8,15 @@ import shutil
 import tempfile
 
 
-_LEFTOVER = ".{}."  # the prefix of the temporary folder beside the final file
-_LEFTOVER_NAME = re.compile(r"\..+\.[a-z0-9_]{8}")  # that prefix and the eight random characters tempfile adds
+_LEFTOVER = ".rigger-partial.{}."  # the prefix of the temporary folder beside the final file
+_LEFTOVER_NAME = re.compile(r"\.rigger-partial\..+\.[a-z0-9_]{8}")  # ... and tempfile's eight random characters
 
 
 @contextlib.contextmanager
 def replaced_on_success(final):
     """A temporary path to write ``final`` to, renamed to ``final`` when the block ends without an error (and
-    removed otherwise). It lies in a fresh folder ".<name>.*" beside ``final``: the same file system for the rename,
-    no existing file for Blender to back up as .blend1, and the usual permissions."""
+    removed otherwise). It lies in a fresh folder ".rigger-partial.<name>.*" beside ``final``: the same file system
+    for the rename, no existing file for Blender to back up as .blend1, and the usual permissions."""
     final = pathlib.Path(final)
     final.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=_LEFTOVER.format(final.name), dir=final.parent) as folder:

@@ -32,6 +32,7 @@ class MirrorTuning(TuningTable):
     rough_twin_tolerance: float = tuned(0.1, "on such a body, the twin tolerance (share of the size) for naming "
                                              "twins")
 
+
 @dataclass(frozen=True)
 class Symmetry:
     """A mirror ``plane`` (axis 0, 1 or 2, offset), the ``tolerance`` (mesh units) within which chains mirror each

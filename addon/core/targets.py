@@ -36,6 +36,21 @@ TARGETS = {target.name: target for target in (
 )}
 
 
+def _check_fallbacks(targets):
+    """ValueError unless every target that does not fill every plan falls back, without a cycle, to one that does."""
+    for target in targets.values():
+        seen = [target.name]
+        while target.plans is not None:
+            if target.fallback not in targets or target.fallback in seen:
+                raise ValueError(f"target {seen[0]!r} falls back to {target.fallback!r} after {seen}: fallbacks "
+                                 f"must end in a target that fills every plan")
+            target = targets[target.fallback]
+            seen.append(target.name)
+
+
+_check_fallbacks(TARGETS)
+
+
 def check_target(name):
     """The :class:`Target` called ``name``; ValueError naming the targets there are otherwise."""
     if name not in TARGETS:
