@@ -99,7 +99,8 @@ MIXAMO = {"mixamorig_Hips_01": "hips", "mixamorig_Spine_02": "spine", "mixamorig
 # first segment). RigNet's humanoids follow one pattern: root at the pelvis, a hip, knee and ankle per leg, one or
 # two spine joints up to the neck's base where the arms hang, then a shoulder, elbow and wrist per arm; the last joint
 # of a chain (a wrist, an ankle) has no bone after it but marks where the next would start. Left out: joints whose
-# place is unclear (the head's leaf joints, an ankle that may be a toe tip, the four-armed monster's two elbows).
+# place is unclear (the head's leaf joints, an ankle that may be a toe tip, the four-armed monster's two elbows, the
+# robot's joint1 just above its hips, from which both its arms and its one bone up to the head start).
 NAMED = {
     "magicarticulate_0a59c5ff": MIXAMO,
     "CesiumMan": {"Skeleton_torso_joint_1": "hips", "Skeleton_torso_joint_2": "spine", "torso_joint_3": "neck",
@@ -108,7 +109,7 @@ NAMED = {
                   "Skeleton_arm_joint_L__2_": "hand", "Skeleton_arm_joint_R__3_": "hand",
                   "leg_joint_L_1": "thigh", "leg_joint_R_1": "thigh", "leg_joint_L_2": "shin", "leg_joint_R_2": "shin",
                   "leg_joint_L_3": "foot", "leg_joint_R_3": "foot"},
-    "BrainStem": {"joint0": "hips", "joint1": "neck", "joint3": "upper_arm", "joint5": "upper_arm",
+    "BrainStem": {"joint0": "hips", "joint3": "upper_arm", "joint5": "upper_arm",
                   "joint4": "forearm", "joint6": "forearm", "joint10": "thigh", "joint14": "thigh", "joint11": "shin",
                   "joint15": "shin", "joint12": "foot", "joint16": "foot"},
     "rignet_1347": {"root": "hips", "joint_8": "neck", "joint_4": "upper_arm", "joint_14": "upper_arm",
@@ -230,13 +231,13 @@ def role_key(role):
 
 
 def found_joints(skeleton, middle, size):
-    """{(role, side): point} of ``rigger.core.roles.named_joints``, sides by geometry (a joint on the plane, where
-    a leg or an arm leaves the body, by its role's side: ``L`` on the +X side, as Rigger's names and Blender have
-    it for a character facing -Y)."""
+    """{(role, side): point} of ``rigger.core.roles.named_joints``: a role without a side on the plane, the others
+    on their side by geometry (on the plane, where a leg or an arm leaves the body, by the role's side: ``L`` on the
+    +X side, as Rigger's names and Blender have it for a character facing -Y)."""
     joints = {}
     for (role, side, digit), point in named_joints(skeleton).items():
         key = f"finger:{digit}" if role == "finger" and digit else role
-        where = int(side_of(point, middle, size)) or {"L": 1, "R": -1, None: 0}[side]  # on the plane: its side
+        where = 0 if side is None else int(side_of(point, middle, size)) or {"L": 1, "R": -1}[side]
         joints.setdefault((key, where), point)
     return joints
 

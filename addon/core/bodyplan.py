@@ -19,12 +19,12 @@ The rules, in order (``Body`` gives the up axis, the mirror plane, the spine and
 The confidence multiplies how the up axis was found (legs on the ground, a flat bottom, or only the preferred up),
 where the mirror plane came from and how clearly the deciding rule held.
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from .body import AXES, BodyTuning, read_body
-from .roles import RoleTuning, assign_roles
+from .roles import RoleTuning, assign_roles, joint_places
 from .stages import MirrorPlane
 from .tuning import tuned
 
@@ -73,6 +73,7 @@ class BodyPlan:
     reason: str
     parts: dict = field(default_factory=dict)
     up: tuple = (0.0, 0.0, 1.0)
+    joints: dict = field(default_factory=dict, repr=False)
 
     def to_dict(self):
         """JSON-ready: kind, confidence, reason and parts (``up`` is in the world's frame, so left out)."""
@@ -138,7 +139,8 @@ def recognise(skeleton, mesh, *, plane=None, prefer_up=AXES[2], tuning=BodyPlanT
         plane = MirrorPlane(plane.axis, plane.offset * factor, plane.normal)
     body = read_body(at_unit_size, mesh.at_unit_size(), tuning, plane, prefer_up / np.linalg.norm(prefer_up))
     layout = lay_out(body, tuning)
-    return layout.plan, assign_roles(skeleton, body, layout, tuning)
+    roles = assign_roles(skeleton, body, layout, tuning)
+    return replace(layout.plan, joints=joint_places(at_unit_size, body, layout, tuning)), roles
 
 
 def lay_out(body, tuning=BodyPlanTuning()):

@@ -90,6 +90,16 @@ class RoleTuning(TuningTable):
     head_share: float = tuned(0.25, "a fish's head: this share of its spine's length from the head end")
     tail_share: float = tuned(0.35, "a fish's tail: this share from the tail end")
     tail_length: float = tuned(0.08, "spine behind the hips this long (a share of the size) is a tail, not hips")
+    hip_rise: float = tuned(0.89, "a leg's hip joint lies this share of the height from its ankle up to where the "
+                                  "leg hangs from the spine")
+    toe_at: float = tuned(0.5, "the ball of the foot: this share of the way from the ankle to the toe's tip")
+    hips_at: float = tuned(0.25, "a humanoid's hips joint: this share of the height from its hip joints to its "
+                                 "shoulder joints")
+    spine_at: float = tuned(0.45, "its spine joint: this share of that height")
+    chest_at: float = tuned(0.65, "its chest joint: this share")
+    neck_at: float = tuned(0.85, "its neck joint: this share")
+    spine_fall: float = tuned(0.02, "... on its spine up to where it falls this share of the height (a hunched "
+                                    "figure's head hanging forward)")
 
 
 def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
@@ -426,14 +436,35 @@ CHAINS = (("hips", "spine", "chest", "neck", "head"), ("shoulder", "upper_arm", 
 
 
 def named_joints(skeleton, roles=None):
-    """{(role, side, digit): point}: where each role begins on ``skeleton`` (with ``roles``, default its own) — the
-    end of the bones of the role before it in its chain (a knee where the thigh ends, a hip joint where a leg's hips
-    bone ends; a leg's thigh follows its own side's hips, else the body's), else the start of its first bone (a
-    finger's base); and where a chain's role has no bone, after a last bone with nothing beyond it, that bone's end
-    (the wrist of an arm whose forearm ends there). Roles ``other`` have none."""
+    """{(role, side, digit): point}: where each role begins on ``skeleton``. With its own roles (``roles`` None) and
+    the places its body plan found (``BodyPlan.joints``: points along the bones, see :func:`joint_places`), those
+    places, which follow the skeleton when it is moved; else, and for roles without a place, the role boundaries of
+    :func:`boundary_joints`. Roles ``other`` have none."""
+    own = roles is None
     roles = skeleton.roles if roles is None else roles
     if roles is None or len(roles) != len(skeleton):
         raise ValueError("named_joints needs one role per bone (recognise the body plan first)")
+    places = boundary_joints(skeleton, roles)
+    plan = skeleton.body_plan
+    if (own or tuple(roles) == skeleton.roles) and plan is not None and all(
+            0 <= bone < len(skeleton) for place in plan.joints.values() for bone, _, _ in place):
+        places.update(plan.joints)
+    return {key: point_of(skeleton, place) for key, place in places.items()}
+
+
+def point_of(skeleton, place):
+    """The point a place (``((bone, share, weight), ...)``: the weights of points ``share`` of the way along
+    bones, summing to 1) stands for on ``skeleton``."""
+    return sum(weight * (skeleton.heads[bone] + share * (skeleton.tails[bone] - skeleton.heads[bone]))
+               for bone, share, weight in place)
+
+
+def boundary_joints(skeleton, roles):
+    """{(role, side, digit): place} where each role begins at a bone boundary: the end of the bones of the role
+    before it in its chain (a knee where the thigh ends, a hip joint where a leg's hips bone ends; a leg's thigh
+    follows its own side's hips, else the body's), else the start of its first bone (a finger's base); and where a
+    chain's role has no bone, after a last bone with nothing beyond it, that bone's end (the wrist of an arm whose
+    forearm ends there)."""
     first, last = {}, {}  # (role, side, digit) -> bone
     for bone, role in enumerate(roles):
         if role.role == "other":
@@ -445,7 +476,7 @@ def named_joints(skeleton, roles=None):
             last[key] = bone
     is_leaf = np.ones(len(skeleton), dtype=bool)
     is_leaf[skeleton.parents[skeleton.parents >= 0]] = False
-    joints = {key: skeleton.heads[bone] for key, bone in first.items()}
+    joints = {key: ((bone, 0.0, 1.0),) for key, bone in first.items()}
     for chain in CHAINS:
         for side in ("L", "R", None):
             for before, role in zip(chain, chain[1:]):
@@ -453,8 +484,180 @@ def named_joints(skeleton, roles=None):
                 if previous is None:
                     continue
                 if (role, side, None) in first or is_leaf[last[previous]]:
-                    joints[(role, side, None)] = skeleton.tails[last[previous]]
+                    joints[(role, side, None)] = ((last[previous], 1.0, 1.0),)
     return joints
+
+
+# Places of named joints along the bones.
+
+def joint_places(skeleton, body, layout, tuning=RoleTuning()):
+    """{(role, side, digit): place} of the joints the body's geometry places between bone ends (see the module
+    docstring): on legs and arms, and on an upright humanoid's spine. ``skeleton`` is the one ``body`` was read
+    from. A place is ``((bone, share, weight), ...)`` (:func:`point_of`)."""
+    if layout.plan.kind == "other":
+        return {}
+    graph = body.graph
+    ends = {}
+    for bone in range(len(skeleton)):
+        ends.setdefault(int(graph.head_node[bone]), (bone, 0.0))
+        ends[int(graph.tail_node[bone])] = (bone, 1.0)
+    left = _left_sign(body, layout)
+    places = {}
+    for k, limb in enumerate(body.limbs):
+        part = layout.parts[k]
+        if part not in ("leg", "arm") or len(limb.main) < 2:
+            continue
+        side = _limb_side(skeleton, graph, limb, left)
+        points = _twin_points(body, limb)
+        found = _leg_places(body, points, layout.front[k], tuning) if part == "leg" else \
+            _arm_places(body, limb, points, tuning)
+        for role, spots in found.items():
+            places[(role, side, None)] = _on_bones(graph, ends, list(limb.main), spots)
+    if layout.plan.kind == "humanoid" and len(layout.spine) >= 2:
+        places.update(_spine_places(skeleton, body, layout, places, ends, tuning))
+    return places
+
+
+def _spine_places(skeleton, body, layout, places, ends, tuning):
+    """{role: place} of a humanoid's hips, spine, chest and neck: on its spine where it reaches ``hips_at``,
+    ``spine_at``, ``chest_at`` and ``neck_at`` of the height from its hip joints (else where the spine leaves the
+    legs) to its shoulder joints (else where the arms hang); below the spine's start, on the way from there to the
+    hip joints."""
+    graph = body.graph
+    spine = list(layout.spine)[max(layout.hips, 0):]
+    points = graph.points[spine]
+    heights = body.height(points)
+    hips = [places[key] for key in places if key[0] == "thigh"]
+    shoulders = [places[key] for key in places if key[0] == "upper_arm"]
+    low = float(np.mean([body.height(point_of(skeleton, place)) for place in hips])) if hips else heights[0]
+    chest = spine.index(layout.spine[layout.chest]) if 0 <= layout.chest and layout.spine[layout.chest] in spine \
+        else len(spine) - 1
+    high = float(np.mean([body.height(point_of(skeleton, place)) for place in shoulders])) if shoulders \
+        else heights[chest]
+    falls = np.flatnonzero(heights[1:] < np.maximum.accumulate(heights)[:-1] - tuning.spine_fall)
+    if len(falls):  # a head hanging forward: the spine falls from there on
+        spine, points, heights = spine[:falls[0] + 1], points[:falls[0] + 1], heights[:falls[0] + 1]
+    if len(spine) < 2 or not high > low:
+        return {}
+    arc = _arc(points)
+    result = {}
+    for role, share in (("hips", tuning.hips_at), ("spine", tuning.spine_at), ("chest", tuning.chest_at),
+                        ("neck", tuning.neck_at)):
+        level = low + share * (high - low)
+        if level >= heights[0] or not hips:
+            result[(role, None, None)] = _on_bones(graph, ends, spine, ((_up_to(heights, arc, level), 1.0),))
+        else:  # between the spine's start and the middle of the hip joints
+            weight = (heights[0] - level) / max(heights[0] - low, 1e-300)
+            start = _on_bones(graph, ends, spine, ((0.0, 1.0 - weight),))
+            result[(role, None, None)] = start + tuple((bone, at, part * weight / len(hips)) for place in hips
+                                                       for bone, at, part in place)
+    return result
+
+
+def _up_to(heights, arc, level):
+    """Arc position where a path with these ``heights`` first rises to ``level`` (its end when it never does)."""
+    return _down_to(-heights, arc, -level)
+
+
+def _on_bones(graph, ends, nodes, spots):
+    """The place of ``spots`` (``((arc position on the path through nodes, weight), ...)``): points on the path's
+    links, each a share of the way along a bone, or between two bones' ends where a link has no bone."""
+    points = graph.points[nodes]
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    place = []
+    for at, weight in spots:
+        k = int(np.clip(np.searchsorted(arc, at, side="right") - 1, 0, len(nodes) - 2))
+        share = float(np.clip((at - arc[k]) / max(arc[k + 1] - arc[k], 1e-300), 0.0, 1.0))
+        a, b = nodes[k], nodes[k + 1]
+        bone = graph.bone_between(a, b)
+        if bone >= 0:
+            place.append((bone, share if graph.head_node[bone] == a else 1.0 - share, weight))
+        else:
+            place += [(*ends[a], weight * (1.0 - share)), (*ends[b], weight * share)]
+    return tuple(place)
+
+
+def _arc(points):
+    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+
+
+def _down_to(heights, arc, level):
+    """Arc position where a path with these ``heights`` first comes down to ``level`` (its end when it never
+    does; its start when it starts below)."""
+    below = np.flatnonzero(heights <= level)
+    if not len(below):
+        return float(arc[-1])
+    i = int(below[0])
+    if i == 0:
+        return 0.0
+    drop = heights[i - 1] - heights[i]
+    return float(arc[i - 1] + (arc[i] - arc[i - 1]) * (heights[i - 1] - level) / max(drop, 1e-300))
+
+
+def _leg_places(body, points, front, tuning):
+    """{role: spots} along a leg's path: the ankle where it comes down to ``ankle_height``, the hip joint at
+    ``hip_rise`` of the height from the ankle to where the leg hangs, on the line of the thigh (the path from the
+    knee halfway up to the hip, carried on up: the path may reach the hip slanting in from the body's middle), the
+    knee at ``knee_at`` of the way between (a bend near there winning), the toe at ``toe_at`` of the way from the
+    ankle to the tip."""
+    heights = body.height(points)
+    arc = _arc(points)
+    ankle = _down_to(heights, arc, tuning.ankle_height)
+    ankle_height = float(np.interp(ankle, arc, heights))
+    hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
+    hip = _down_to(heights, arc, hip_height)
+    knee = _bent(points, arc, hip, hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
+    toe = ankle + tuning.toe_at * (arc[-1] - ankle)
+    thigh = 0.5 * (hip + knee)
+    rise = float(np.interp(thigh, arc, heights) - np.interp(knee, arc, heights))
+    reach = (hip_height - float(np.interp(thigh, arc, heights))) / rise if rise > 0 else 0.0
+    hip_spots = ((thigh, 1.0 + reach), (knee, -reach)) if 0 < reach <= 2 else ((hip, 1.0),)
+    names = ("upper_arm", "forearm", "hand", None) if front else ("thigh", "shin", "foot", "toe")
+    return {name: spots for name, spots in zip(names, (hip_spots, ((knee, 1.0),), ((ankle, 1.0),), ((toe, 1.0),)))
+            if name}
+
+
+def _arm_places(body, limb, points, tuning):
+    """{role: spots} along an arm's path: the shoulder joint as :func:`_shoulder` finds it, the elbow and the wrist
+    at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the reach (a bend near the elbow winning;
+    the wrist no farther than where the fingers fork)."""
+    nodes = list(limb.main)
+    arc = _arc(points)
+    total = arc[-1] + _reach(body, points)
+    shoulder = float(arc[min(_shoulder(body, nodes, arc, total, tuning), len(nodes) - 1)])
+    rest = total - shoulder
+    elbow, wrist = (shoulder + share * rest for share in (tuning.elbow_at, tuning.wrist_at))
+    elbow = _bent(points, arc, shoulder, elbow, wrist, rest, tuning)
+    forks = [arc[_fork(path, nodes)] for path in _paths(limb)[1:]]
+    if forks and min(forks) > elbow:
+        wrist = min(wrist, min(forks))
+    return {"upper_arm": ((shoulder, 1.0),), "forearm": ((elbow, 1.0),), "hand": ((min(wrist, arc[-1]), 1.0),)}
+
+
+def _bent(points, arc, start, middle, end, length, tuning):
+    """Arc position of a limb's middle joint (an elbow, a knee) between ``start`` and ``end``: the joint within
+    ``bend_window`` of the limb's ``length`` from ``middle`` where the limb bends most, when it bends by ``bend`` or
+    more seen from both ends (short bones zigzagging along a straight limb make no bend), else ``middle``."""
+    first, last = _along(points, arc, start), _along(points, arc, end)
+    best, turn = middle, tuning.bend
+    for i in range(1, len(points) - 1):
+        if start < arc[i] < end and abs(arc[i] - middle) <= tuning.bend_window * length:
+            a, b = points[i] - first, last - points[i]
+            angle = np.degrees(np.arccos(np.clip(a @ b / max(np.linalg.norm(a) * np.linalg.norm(b), 1e-300), -1, 1)))
+            if angle >= turn:
+                best, turn = float(arc[i]), angle
+    return best
+
+
+def _along(points, arc, at):
+    k = int(np.clip(np.searchsorted(arc, at, side="right") - 1, 0, len(points) - 2))
+    share = (at - arc[k]) / max(arc[k + 1] - arc[k], 1e-300)
+    return points[k] + np.clip(share, 0.0, 1.0) * (points[k + 1] - points[k])
+
+
+def _radii_at(points, vertices):
+    """Distance from each point to the nearest of ``vertices``."""
+    return np.sqrt(((points[:, None] - vertices[None]) ** 2).sum(axis=2).min(axis=1))
 
 
 @dataclass(frozen=True, eq=False)
