@@ -340,9 +340,10 @@ def _mirror(skeleton, graph, mesh, size, tuning, given):
 
 def _fitted_plane(graph, mesh, size, tuning):
     """The axis plane across which the most joints off it have another joint near their mirror image (at least
-    ``plane_pairs``), or None. The planes tried run midway between two leaf tips that could be twins; two joints of
-    one limb (a hand's fingers) never pair: the skeleton joins twins through the body, more than ``contact_apart``
-    apart."""
+    ``plane_pairs``) and whose joints on it span ``min_limb`` or more (a body runs along its mirror plane; a plane
+    across a lying body's line of joints pairs them all), or None. The planes tried run midway between two leaf tips
+    that could be twins; two joints of one limb (a hand's fingers) never pair: the skeleton joins twins through the
+    body, more than ``contact_apart`` apart."""
     points = graph.points
     tips = points[graph.leaves()]
     distance = np.array([[graph.search(node)[0][other] for other in range(len(points))]
@@ -363,9 +364,16 @@ def _fitted_plane(graph, mesh, size, tuning):
             gaps = np.linalg.norm(plane.reflect(points[off])[:, None] - points[None], axis=2)
             gaps[~apart[off]] = np.inf
             pairs = int((gaps.min(axis=1, initial=np.inf) <= tuning.plane_fit * size).sum())
-            if pairs > best_pairs:
+            if pairs > best_pairs and _span(points[~off]) >= tuning.min_limb * size:
                 best, best_pairs = plane, pairs
     return best
+
+
+def _span(points):
+    """The largest distance between two of ``points`` (0 for fewer than two)."""
+    if len(points) < 2:
+        return 0.0
+    return float(np.linalg.norm(points[:, None] - points[None], axis=2).max())
 
 
 # Up.

@@ -26,6 +26,7 @@ from .tuning import TuningTable, tuned
 ROLES = ("root", "hips", "spine", "chest", "neck", "head", "jaw", "shoulder", "upper_arm", "forearm", "hand", "finger",
          "thigh", "shin", "foot", "toe", "tail", "ear", "wing", "fin", "other")
 DIGITS = ("thumb", "index", "middle", "ring", "pinky")
+LANDMARKS = ("head_top", "hand_tip", "finger_tip", "toe_tip", "heel")
 SIDES = ("L", "R", None)
 
 
@@ -92,7 +93,13 @@ class RoleTuning(TuningTable):
     tail_length: float = tuned(0.08, "spine behind the hips this long (a share of the size) is a tail, not hips")
     hip_rise: float = tuned(0.89, "a leg's hip joint lies this share of the height from its ankle up to where the "
                                   "leg hangs from the spine")
+    heel_width: float = tuned(0.03, "the heel is the hindmost point of the mesh this close to the foot's line "
+                                    "(half a foot's width)")
+    thigh_lean: float = tuned(30.0, "degrees: a thigh leaning at most this far from up carries the hip joint on its "
+                                    "line (a standing biped's)")
     toe_at: float = tuned(0.5, "the ball of the foot: this share of the way from the ankle to the toe's tip")
+    clavicle_at: float = tuned(0.25, "an arm's collarbone starts this share of the way from where the arm hangs to "
+                                     "its shoulder joint (Rigify's and Mixamo's near the body's middle)")
     hips_at: float = tuned(0.25, "a humanoid's hips joint: this share of the height from its hip joints to its "
                                  "shoulder joints")
     spine_at: float = tuned(0.45, "its spine joint: this share of that height")
@@ -437,22 +444,44 @@ CHAINS = (("hips", "spine", "chest", "neck", "head"), ("shoulder", "upper_arm", 
 
 def named_joints(skeleton, roles=None):
     """{(role, side, digit): point}: where each role begins on ``skeleton``. With its own roles (``roles`` None) and
-    the places its body plan found (``BodyPlan.joints``: points along the bones, see :func:`joint_places`), those
-    places, which follow the skeleton when it is moved; else, and for roles without a place, the role boundaries of
-    :func:`boundary_joints`. Roles ``other`` have none."""
+    the places its body plan found (``BodyPlan.joints``), those places, which follow the skeleton when it is moved;
+    else, and for roles without a place, the role boundaries of :func:`boundary_joints`. Roles ``other`` have
+    none."""
     own = roles is None
     roles = skeleton.roles if roles is None else roles
     if roles is None or len(roles) != len(skeleton):
         raise ValueError("named_joints needs one role per bone (recognise the body plan first)")
     places = boundary_joints(skeleton, roles)
+    if own or tuple(roles) == skeleton.roles:
+        places.update((key, place) for key, place in _plan_places(skeleton).items() if key[0] in ROLES)
+    return {key: _point_of(skeleton, place) for key, place in places.items()}
+
+
+def landmarks(skeleton):
+    """{(landmark, side, digit): point} of the body's ends that begin no role (``LANDMARKS``): the top of the head,
+    the end of each hand's reach and each finger's tip, the tip of each foot's toes (the mesh beyond the last joints
+    included) and each heel (on the ground under the back of the foot). Empty before the body plan is recognised."""
+    if skeleton.roles is None:
+        return {}
+    found = {key: _point_of(skeleton, place) for key, place in _plan_places(skeleton).items() if key[0] in LANDMARKS}
+    tips = {}
+    for bone, role in enumerate(skeleton.roles):
+        if role.role == "finger" and role.digit and role.index >= tips.get((role.side, role.digit), (-1, 0))[0]:
+            tips[(role.side, role.digit)] = (role.index, bone)
+    found.update({("finger_tip", side, digit): skeleton.tails[bone] for (side, digit), (_, bone) in tips.items()})
+    return found
+
+
+def _plan_places(skeleton):
+    """The places the skeleton's body plan found (``BodyPlan.joints``), when they are places on this skeleton."""
     plan = skeleton.body_plan
-    if (own or tuple(roles) == skeleton.roles) and plan is not None and all(
-            0 <= bone < len(skeleton) for place in plan.joints.values() for bone, _, _ in place):
-        places.update(plan.joints)
-    return {key: point_of(skeleton, place) for key, place in places.items()}
+    joints = {} if plan is None else plan.joints
+    if all(0 <= bone < len(skeleton) for place in joints.values() for bone, _, _ in place):
+        return joints
+    return {}
 
 
-def point_of(skeleton, place):
+def _point_of(skeleton, place):
     """The point a place (``((bone, share, weight), ...)``: the weights of points ``share`` of the way along
     bones, summing to 1) stands for on ``skeleton``."""
     return sum(weight * (skeleton.heads[bone] + share * (skeleton.tails[bone] - skeleton.heads[bone]))
@@ -493,7 +522,7 @@ def boundary_joints(skeleton, roles):
 def joint_places(skeleton, body, layout, tuning=RoleTuning()):
     """{(role, side, digit): place} of the joints the body's geometry places between bone ends (see the module
     docstring): on legs and arms, and on an upright humanoid's spine. ``skeleton`` is the one ``body`` was read
-    from. A place is ``((bone, share, weight), ...)`` (:func:`point_of`)."""
+    from. A place is ``((bone, share, weight), ...)`` (``_point_of``)."""
     if layout.plan.kind == "other":
         return {}
     graph = body.graph
@@ -513,8 +542,13 @@ def joint_places(skeleton, body, layout, tuning=RoleTuning()):
             _arm_places(body, limb, points, tuning)
         for role, spots in found.items():
             places[(role, side, None)] = _on_bones(graph, ends, list(limb.main), spots)
-    if layout.plan.kind == "humanoid" and len(layout.spine) >= 2:
+    spine = list(layout.spine)
+    if layout.plan.kind == "humanoid" and len(spine) >= 2:
         places.update(_spine_places(skeleton, body, layout, places, ends, tuning))
+    if layout.plan.kind != "fish" and len(spine) >= 2:
+        points = graph.points[spine]
+        places[("head_top", None, None)] = _on_bones(graph, ends, spine, ((_arc(points)[-1] + _reach(body, points),
+                                                                           1.0),))
     return places
 
 
@@ -529,10 +563,10 @@ def _spine_places(skeleton, body, layout, places, ends, tuning):
     heights = body.height(points)
     hips = [places[key] for key in places if key[0] == "thigh"]
     shoulders = [places[key] for key in places if key[0] == "upper_arm"]
-    low = float(np.mean([body.height(point_of(skeleton, place)) for place in hips])) if hips else heights[0]
+    low = float(np.mean([body.height(_point_of(skeleton, place)) for place in hips])) if hips else heights[0]
     chest = spine.index(layout.spine[layout.chest]) if 0 <= layout.chest and layout.spine[layout.chest] in spine \
         else len(spine) - 1
-    high = float(np.mean([body.height(point_of(skeleton, place)) for place in shoulders])) if shoulders \
+    high = float(np.mean([body.height(_point_of(skeleton, place)) for place in shoulders])) if shoulders \
         else heights[chest]
     falls = np.flatnonzero(heights[1:] < np.maximum.accumulate(heights)[:-1] - tuning.spine_fall)
     if len(falls):  # a head hanging forward: the spine falls from there on
@@ -561,13 +595,15 @@ def _up_to(heights, arc, level):
 
 def _on_bones(graph, ends, nodes, spots):
     """The place of ``spots`` (``((arc position on the path through nodes, weight), ...)``): points on the path's
-    links, each a share of the way along a bone, or between two bones' ends where a link has no bone."""
+    links (or on past its end, along its last link), each a share of the way along a bone, or between two bones'
+    ends where a link has no bone."""
     points = graph.points[nodes]
     arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
     place = []
     for at, weight in spots:
         k = int(np.clip(np.searchsorted(arc, at, side="right") - 1, 0, len(nodes) - 2))
-        share = float(np.clip((at - arc[k]) / max(arc[k + 1] - arc[k], 1e-300), 0.0, 1.0))
+        share = float(np.clip((at - arc[k]) / max(arc[k + 1] - arc[k], 1e-300), 0.0,
+                              1.0 if k < len(nodes) - 2 else np.inf))  # on past the last joint: a tip
         a, b = nodes[k], nodes[k + 1]
         bone = graph.bone_between(a, b)
         if bone >= 0:
@@ -596,8 +632,9 @@ def _down_to(heights, arc, level):
 
 def _leg_places(body, points, front, tuning):
     """{role: spots} along a leg's path: the ankle where it comes down to ``ankle_height``, the hip joint at
-    ``hip_rise`` of the height from the ankle to where the leg hangs, on the line of the thigh (the path from the
-    knee halfway up to the hip, carried on up: the path may reach the hip slanting in from the body's middle), the
+    ``hip_rise`` of the height from the ankle to where the leg hangs, on the line of the thigh when that stands
+    within ``thigh_lean`` of up (the path from the knee halfway up to the hip, carried on up: the path may reach the
+    hip slanting in from the body's middle; a bent hind leg's thigh line leads elsewhere), the
     knee at ``knee_at`` of the way between (a bend near there winning), the toe at ``toe_at`` of the way from the
     ankle to the tip."""
     heights = body.height(points)
@@ -609,16 +646,50 @@ def _leg_places(body, points, front, tuning):
     knee = _bent(points, arc, hip, hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
     toe = ankle + tuning.toe_at * (arc[-1] - ankle)
     thigh = 0.5 * (hip + knee)
-    rise = float(np.interp(thigh, arc, heights) - np.interp(knee, arc, heights))
-    reach = (hip_height - float(np.interp(thigh, arc, heights))) / rise if rise > 0 else 0.0
-    hip_spots = ((thigh, 1.0 + reach), (knee, -reach)) if 0 < reach <= 2 else ((hip, 1.0),)
-    names = ("upper_arm", "forearm", "hand", None) if front else ("thigh", "shin", "foot", "toe")
-    return {name: spots for name, spots in zip(names, (hip_spots, ((knee, 1.0),), ((ankle, 1.0),), ((toe, 1.0),)))
-            if name}
+    line = _along(points, arc, thigh) - _along(points, arc, knee)
+    rise = float(line @ body.up)
+    reach = (hip_height - float(np.interp(thigh, arc, heights))) / rise * (body.high - body.low) if rise > 0 else 0
+    upright = rise >= np.cos(np.radians(tuning.thigh_lean)) * np.linalg.norm(line)
+    hip_spots = ((thigh, 1.0 + reach), (knee, -reach)) if upright and 0 < reach <= 2 else ((hip, 1.0),)
+    tip = arc[-1] + _reach(body, points)
+    names = ("upper_arm", "forearm", "hand", None, "hand_tip") if front else \
+        ("thigh", "shin", "foot", "toe", "toe_tip")
+    places = {name: spots for name, spots in zip(names, (hip_spots, ((knee, 1.0),), ((ankle, 1.0),), ((toe, 1.0),),
+                                                         ((tip, 1.0),))) if name}
+    heel = None if front else _heel(body, points, arc, knee, ankle, tip, tuning)
+    if heel is not None:
+        places["heel"] = heel
+    return places
+
+
+def _heel(body, points, arc, knee, ankle, tip, tuning):
+    """Spots of the heel: on the ground under the back of the foot (the mesh's hindmost vertex there, along the
+    foot's way from the ankle to the toe's tip, within ``heel_width`` of its line), as weights of the knee, the ankle
+    and the toe's tip (the leg's own plane); None when they are in line or the foot points nowhere."""
+    corners = np.array([_along(points, arc, at) for at in (knee, ankle, tip)])
+    ankle_point, up = corners[1], body.up
+    forward = corners[2] - ankle_point
+    forward -= (forward @ up) * up
+    if not np.linalg.norm(forward) > 0:
+        return None
+    forward /= np.linalg.norm(forward)
+    across = np.cross(up, forward)
+    offsets = body.vertices - ankle_point
+    near = (np.abs(offsets @ across) <= tuning.heel_width * body.size) & (offsets @ up <= 0) \
+        & (np.abs(offsets @ forward) <= np.linalg.norm(corners[2] - ankle_point))
+    if not near.any():
+        return None
+    heel = ankle_point + float((offsets[near] @ forward).min()) * forward + (body.low - ankle_point @ up) * up
+    sides = np.stack([corners[0] - corners[2], corners[1] - corners[2]], axis=1)
+    weights, _, rank, _ = np.linalg.lstsq(sides, heel - corners[2], rcond=None)
+    if rank < 2:
+        return None
+    return ((knee, float(weights[0])), (ankle, float(weights[1])), (tip, float(1.0 - weights.sum())))
 
 
 def _arm_places(body, limb, points, tuning):
-    """{role: spots} along an arm's path: the shoulder joint as :func:`_shoulder` finds it, the elbow and the wrist
+    """{role: spots} along an arm's path: the collarbone's start ``clavicle_at`` of the way to the shoulder joint,
+    the shoulder joint as :func:`_shoulder` finds it, the elbow and the wrist
     at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the reach (a bend near the elbow winning;
     the wrist no farther than where the fingers fork)."""
     nodes = list(limb.main)
@@ -631,7 +702,8 @@ def _arm_places(body, limb, points, tuning):
     forks = [arc[_fork(path, nodes)] for path in _paths(limb)[1:]]
     if forks and min(forks) > elbow:
         wrist = min(wrist, min(forks))
-    return {"upper_arm": ((shoulder, 1.0),), "forearm": ((elbow, 1.0),), "hand": ((min(wrist, arc[-1]), 1.0),)}
+    return {"shoulder": ((tuning.clavicle_at * shoulder, 1.0),), "upper_arm": ((shoulder, 1.0),),
+            "forearm": ((elbow, 1.0),), "hand": ((min(wrist, arc[-1]), 1.0),), "hand_tip": ((total, 1.0),)}
 
 
 def _bent(points, arc, start, middle, end, length, tuning):
