@@ -49,6 +49,8 @@ class BodyTuning(TuningTable):
                                        "only breaks ties")
     flat_bottom: float = tuned(0.02, "the mesh's bottom slab, where flat faces facing down count as ground area")
     flat_area: float = tuned(0.004, "a bottom with this share of the mesh's area flat on the ground stands on it")
+    flat_spread: float = tuned(0.2, "... when it spreads this share of the mesh's breadth across up (geometric mean of "
+                                    "both ways; a cartoon's soles 0.4, a flat patch atop a floating ghost's head 0.16)")
     min_limb: float = tuned(0.05, "a side branch of the midline shorter than this is part of the spine there, no "
                                   "limb (an exporter's helper joint, a stub)")
     twin_tolerance: float = tuned(0.12, "limbs whose tips and starts mirror within this are twins (posed figures "
@@ -403,15 +405,20 @@ def _up_axis(graph, tips, radius, mesh, plane, size, tuning, prefer_up):
     ups = np.array(candidates)
     heights = mesh.used_vertices @ ups.T  # (N, C)
     lows, highs = heights.min(axis=0), heights.max(axis=0)
-    tops = (corners @ ups.T).max(axis=1)  # (T, C): each triangle's highest corner along each candidate
+    tops = np.maximum(np.maximum(corners[:, 0] @ ups.T, corners[:, 1] @ ups.T), corners[:, 2] @ ups.T)  # (T, C):
+    # each triangle's highest corner along each candidate (three plain products: a stack of 3x3 ones is slow)
     facing = -(normals @ ups.T) >= 0.7 * areas[:, None]
     bottom = tops <= lows + tuning.flat_bottom * size
     flats = (areas[:, None] * (bottom & facing)).sum(axis=0) / total_area
+    spreads = np.array([_spread(corners[bottom[:, k] & facing[:, k]].reshape(-1, 3), mesh.used_vertices, up)
+                        for k, up in enumerate(candidates)])
+    flats[spreads < tuning.flat_spread] = 0.0  # a base spreads under the body: a patch atop a floating head is none
+    bases = flats * spreads
     measures = [(_contacts(graph, radius, tips, up, low, high, size, tuning), float(flat), high - low)
                 for up, low, high, flat in zip(candidates, lows, highs, flats)]
-    best_flat = max(max(flat for _, flat, _ in measures), tuning.flat_area)
-    scores = [tuning.leg_weight * (contacts >= 2) + flat / best_flat + tuning.prefer_weight * float(up @ prefer_up)
-              for up, (contacts, flat, _) in zip(candidates, measures)]
+    best_base = max(float(bases.max()), tuning.flat_area * tuning.flat_spread)
+    scores = [tuning.leg_weight * (contacts >= 2) + base / best_base + tuning.prefer_weight * float(up @ prefer_up)
+              for up, (contacts, _, _), base in zip(candidates, measures, bases)]
     best = int(np.argmax(scores))
     up, (contacts, flat, _) = candidates[best], measures[best]
     name = _axis_name(up)
@@ -420,6 +427,16 @@ def _up_axis(graph, tips, radius, mesh, plane, size, tuning, prefer_up):
     if flat >= tuning.flat_area:
         return up, "flat", f"up {name}: the mesh rests on a flat bottom ({flat:.1%} of its area)"
     return up, "preferred", f"up {name}: nothing touches the ground clearly, so the preferred up"
+
+
+def _spread(base, vertices, up):
+    """How far ``base`` points spread across ``up`` as a share of how far the ``vertices`` do: the geometric mean
+    over the two directions across (0 without points)."""
+    if not len(base):
+        return 0.0
+    across = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]
+    shares = np.ptp(base @ across, axis=0) / np.maximum(np.ptp(vertices @ across, axis=0), 1e-300)
+    return float(np.sqrt(shares.prod()))
 
 
 def _contacts(graph, radius, tips, up, low, high, size, tuning):

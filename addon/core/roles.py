@@ -97,7 +97,8 @@ class RoleTuning(TuningTable):
                                     "(half a foot's width)")
     thigh_lean: float = tuned(30.0, "degrees: a thigh leaning at most this far from up carries the hip joint on its "
                                     "line (a standing biped's)")
-    toe_at: float = tuned(0.5, "the ball of the foot: this share of the way from the ankle to the toe's tip")
+    toe_at: float = tuned(0.65, "the ball of the foot: this share of the way from the ankle to the tip of the toes "
+                                "(the mesh's; a human foot's ball two thirds of the way)")
     clavicle_at: float = tuned(0.25, "an arm's collarbone starts this share of the way from where the arm hangs to "
                                      "its shoulder joint (Rigify's and Mixamo's near the body's middle)")
     hips_at: float = tuned(0.25, "a humanoid's hips joint: this share of the height from its hip joints to its "
@@ -538,17 +539,18 @@ def joint_places(skeleton, body, layout, tuning=RoleTuning()):
             continue
         side = _limb_side(skeleton, graph, limb, left)
         points = _twin_points(body, limb)
-        found = _leg_places(body, points, layout.front[k], tuning) if part == "leg" else \
-            _arm_places(body, limb, points, tuning)
+        arc = _arc(points)
+        found = _leg_places(body, points, arc, layout.front[k], tuning) if part == "leg" else \
+            _arm_places(body, limb, points, arc, tuning)
         for role, spots in found.items():
-            places[(role, side, None)] = _on_bones(graph, ends, list(limb.main), spots)
+            places[(role, side, None)] = _on_bones(graph, ends, list(limb.main), arc, spots)
     spine = list(layout.spine)
     if layout.plan.kind == "humanoid" and len(spine) >= 2:
         places.update(_spine_places(skeleton, body, layout, places, ends, tuning))
     if layout.plan.kind != "fish" and len(spine) >= 2:
         points = graph.points[spine]
-        places[("head_top", None, None)] = _on_bones(graph, ends, spine, ((_arc(points)[-1] + _reach(body, points),
-                                                                           1.0),))
+        arc = _arc(points)
+        places[("head_top", None, None)] = _on_bones(graph, ends, spine, arc, ((arc[-1] + _reach(body, points), 1.0),))
     return places
 
 
@@ -579,10 +581,10 @@ def _spine_places(skeleton, body, layout, places, ends, tuning):
                         ("neck", tuning.neck_at)):
         level = low + share * (high - low)
         if level >= heights[0] or not hips:
-            result[(role, None, None)] = _on_bones(graph, ends, spine, ((_up_to(heights, arc, level), 1.0),))
+            result[(role, None, None)] = _on_bones(graph, ends, spine, arc, ((_up_to(heights, arc, level), 1.0),))
         else:  # between the spine's start and the middle of the hip joints
             weight = (heights[0] - level) / max(heights[0] - low, 1e-300)
-            start = _on_bones(graph, ends, spine, ((0.0, 1.0 - weight),))
+            start = _on_bones(graph, ends, spine, arc, ((0.0, 1.0 - weight),))
             result[(role, None, None)] = start + tuple((bone, at, part * weight / len(hips)) for place in hips
                                                        for bone, at, part in place)
     return result
@@ -593,17 +595,17 @@ def _up_to(heights, arc, level):
     return _down_to(-heights, arc, -level)
 
 
-def _on_bones(graph, ends, nodes, spots):
-    """The place of ``spots`` (``((arc position on the path through nodes, weight), ...)``): points on the path's
-    links (or on past its end, along its last link), each a share of the way along a bone, or between two bones'
-    ends where a link has no bone."""
-    points = graph.points[nodes]
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+def _on_bones(graph, ends, nodes, arc, spots):
+    """The place of ``spots`` (``((arc position, weight), ...)`` along the path through ``nodes``, measured on
+    points whose arc lengths are ``arc``: a twin's mirror-averaged ones): the same shares of the path's own links (or
+    on past its end, along its last link), each a share of the way along a bone, or between two bones' ends where a
+    link has no bone."""
     place = []
+    last = len(nodes) - 2
     for at, weight in spots:
-        k = int(np.clip(np.searchsorted(arc, at, side="right") - 1, 0, len(nodes) - 2))
-        share = float(np.clip((at - arc[k]) / max(arc[k + 1] - arc[k], 1e-300), 0.0,
-                              1.0 if k < len(nodes) - 2 else np.inf))  # on past the last joint: a tip
+        k = min(max(int(np.searchsorted(arc, at, side="right")) - 1, 0), last)
+        share = max((at - arc[k]) / max(arc[k + 1] - arc[k], 1e-300), 0.0)
+        share = float(share if k == last else min(share, 1.0))  # on past the last joint: a tip
         a, b = nodes[k], nodes[k + 1]
         bone = graph.bone_between(a, b)
         if bone >= 0:
@@ -630,7 +632,7 @@ def _down_to(heights, arc, level):
     return float(arc[i - 1] + (arc[i] - arc[i - 1]) * (heights[i - 1] - level) / max(drop, 1e-300))
 
 
-def _leg_places(body, points, front, tuning):
+def _leg_places(body, points, arc, front, tuning):
     """{role: spots} along a leg's path: the ankle where it comes down to ``ankle_height``, the hip joint at
     ``hip_rise`` of the height from the ankle to where the leg hangs, on the line of the thigh when that stands
     within ``thigh_lean`` of up (the path from the knee halfway up to the hip, carried on up: the path may reach the
@@ -638,20 +640,19 @@ def _leg_places(body, points, front, tuning):
     knee at ``knee_at`` of the way between (a bend near there winning), the toe at ``toe_at`` of the way from the
     ankle to the tip."""
     heights = body.height(points)
-    arc = _arc(points)
     ankle = _down_to(heights, arc, tuning.ankle_height)
     ankle_height = float(np.interp(ankle, arc, heights))
     hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
     hip = _down_to(heights, arc, hip_height)
     knee = _bent(points, arc, hip, hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
-    toe = ankle + tuning.toe_at * (arc[-1] - ankle)
+    tip = arc[-1] + _reach(body, points)
+    toe = ankle + tuning.toe_at * (tip - ankle)
     thigh = 0.5 * (hip + knee)
     line = _along(points, arc, thigh) - _along(points, arc, knee)
     rise = float(line @ body.up)
     reach = (hip_height - float(np.interp(thigh, arc, heights))) / rise * (body.high - body.low) if rise > 0 else 0
     upright = rise >= np.cos(np.radians(tuning.thigh_lean)) * np.linalg.norm(line)
     hip_spots = ((thigh, 1.0 + reach), (knee, -reach)) if upright and 0 < reach <= 2 else ((hip, 1.0),)
-    tip = arc[-1] + _reach(body, points)
     names = ("upper_arm", "forearm", "hand", None, "hand_tip") if front else \
         ("thigh", "shin", "foot", "toe", "toe_tip")
     places = {name: spots for name, spots in zip(names, (hip_spots, ((knee, 1.0),), ((ankle, 1.0),), ((toe, 1.0),),
@@ -687,13 +688,12 @@ def _heel(body, points, arc, knee, ankle, tip, tuning):
     return ((knee, float(weights[0])), (ankle, float(weights[1])), (tip, float(1.0 - weights.sum())))
 
 
-def _arm_places(body, limb, points, tuning):
+def _arm_places(body, limb, points, arc, tuning):
     """{role: spots} along an arm's path: the collarbone's start ``clavicle_at`` of the way to the shoulder joint,
     the shoulder joint as :func:`_shoulder` finds it, the elbow and the wrist
     at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the reach (a bend near the elbow winning;
     the wrist no farther than where the fingers fork)."""
     nodes = list(limb.main)
-    arc = _arc(points)
     total = arc[-1] + _reach(body, points)
     shoulder = float(arc[min(_shoulder(body, nodes, arc, total, tuning), len(nodes) - 1)])
     rest = total - shoulder
