@@ -8,8 +8,8 @@ with ``rigger.core.bodyplan.recognise``: geometry only, since its bones are rena
 turns Rigger's skeleton and the mesh back into the file's own frame and recognises them with Blender's +Z still
 preferred: for the Y-up files, up must then come from the geometry alone.
 
-Named joints: ``rigger.core.roles.named_joints``, where each role begins (a knee where the thigh ends, a shoulder
-joint where the upper arm starts, a wrist where an arm without a hand bone ends). The artists' joints are named by hand
+Named joints: ``rigger.core.roles.named_joints``, where each role begins (a knee, a shoulder joint, a wrist), points
+placed along Rigger's bones at recognition, not only at their ends. The artists' joints are named by hand
 below (``NAMED``, role per joint name; a joint is left out when the rig has no such joint or it is not clear
 which it is). Sides are compared by geometry (the side of the mirror plane a joint lies on), so no naming
 convention matters. Errors are in units of the mesh's largest extent.
@@ -377,8 +377,8 @@ def report(records, summary, run):
         f"{summary['artist_role_agreement'][0]} / {summary['artist_role_agreement'][1]} named joints. Rigger names "
         f"no joint for {summary['named_missing']} of the {summary['named_missing'] + summary['named_scored']} named "
         f"artist joints (not in the error). The nearest joint of Rigger's skeleton, whatever its role, lies "
-        f"{summary['named_floor']:.4f} from the scored artist joints on average: the floor any naming of Rigger's "
-        f"joints could reach. Recognition takes {summary['plan_ms_median']:.0f} ms (median; at most "
+        f"{summary['named_floor']:.4f} from the scored artist joints on average: the floor of naming Rigger's own "
+        f"joints, which named joints placed along the bones may go below. Recognition takes {summary['plan_ms_median']:.0f} ms (median; at most "
         f"{summary['plan_ms_max']:.0f} ms) on top of the rig.", "",
     ]
     for source, title in (("rigger", "Rigger's skeletons (what `rig_mesh` reports)"),
@@ -438,7 +438,7 @@ def failure_notes(records, summary):
     far = [row for row in summary["over_max"] if nearest[row[:2]] > TARGET_MAX_ERROR]
     notes.append(f"- {len(summary['over_max'])} named joints lie more than {TARGET_MAX_ERROR} from the artist's; for "
                  f"{len(far)} of them no joint of Rigger's skeleton lies within {TARGET_MAX_ERROR} (the skeleton has "
-                 f"no joint there), for the others a joint does but the roles begin elsewhere:")
+                 f"no joint there), for the others a joint does but the named joint lies elsewhere:")
     for model, joint, error in summary["over_max"]:
         notes.append(f"  - {model} {joint}: {error:.3f} of the size from the artist's joint; Rigger's nearest joint "
                      f"{nearest[(model, joint)]:.3f}.")

@@ -6,11 +6,12 @@ The pieces, in the order :func:`read_body` finds them:
 - the joint graph: bone ends closer than ``joint_merge`` are one joint; a bone whose head is not its parent's tail
   hangs from it by a link without a bone, and parts of a forest hang from the nearest joint of the largest part;
 - the mirror plane: the method's own (its ``mirror_plane`` stage), else the mesh's (``core.mirror.mirror_plane``),
-  else the axis plane that pairs the most leaf tips of the skeleton with mirror images (a posed or hand-made
-  figure, whose mesh is not symmetric within 1%);
+  else the axis plane that pairs the most leaf tips of the skeleton with mirror images and runs along the body (a
+  posed or hand-made figure, whose mesh is not symmetric within 1%);
 - up: the world axis, perpendicular to the plane's normal, along which the most separate leaf tips touch the
-  ground with the mesh's centre above them (legs), then the one with the most flat area at the bottom (soles, a
-  belly), then +Z (Blender's up) and +Y (the OBJ convention);
+  ground with the mesh's centre above them (legs), then the one standing on the broadest flat bottom (its flat area
+  times how far it spreads across: soles, a belly; a small flat patch atop a floating figure's head is none), then
+  +Z (Blender's up) and +Y (the OBJ convention);
 - the midline and the limbs: leaf chains whose tips lie off the plane are stripped, round after round (fingers,
   then the arm they hang from), and grouped into limbs, each hanging from one joint of what stays, the midline.
   The spine is the midline's longest path; side branches of the midline are limbs on the plane (a jaw, a fin).

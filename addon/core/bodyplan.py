@@ -16,6 +16,9 @@ The rules, in order (``Body`` gives the up axis, the mirror plane, the spine and
   short beside it (fins, or none) and that tapers, curves or has fins is a fish or a serpent (not a plain log or
   column); anything else is ``other``.
 
+Recognition also places the named joints along the chains (``core.roles``: a knee between bone ends where the
+artists' rigs have it) and keeps them in ``BodyPlan.joints``.
+
 The confidence multiplies how the up axis was found (legs on the ground, a flat bottom, or only the preferred up),
 where the mirror plane came from and how clearly the deciding rule held.
 """
@@ -66,7 +69,9 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
 @dataclass(frozen=True)
 class BodyPlan:
     """A recognised body plan: ``kind`` (one of ``KINDS``), ``confidence`` in [0, 1], a one-line ``reason``, counts
-    of its ``parts`` ({"legs": 2, "arms": 2, ...}), and the world ``up`` it stands along."""
+    of its ``parts`` ({"legs": 2, "arms": 2, ...}), the world ``up`` it stands along, and where its named joints and
+    landmarks lie on the skeleton it was recognised on (``joints``: ``core.roles.joint_places``; read them with
+    ``core.roles.named_joints`` and ``landmarks``)."""
 
     kind: str
     confidence: float

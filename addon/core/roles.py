@@ -15,6 +15,19 @@ the same joints (on their mirror-averaged points). Wings, fins, ears, tails and 
 every bone. A body plan that is ``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when
 a limb's bones have them, else the side of the mirror plane, left being the character's left when its front is known
 (Blender's +X for a character facing -Y).
+
+Roles are whole bones; named joints are points (:func:`named_joints`: where each role begins, ``{(role, side,
+digit): point}``), placed along the chains where the artists' rigs have them rather than at the nearest bone end
+(:func:`joint_places`, at recognition, stored in ``BodyPlan.joints``): on a leg the ankle where it comes down to
+``ankle_height``, the hip joint at ``hip_rise`` of the height from there to where the leg hangs (on the thigh's line
+when the thigh stands upright), the knee ``knee_at`` of the way between (a bend there winning) and the ball of the
+foot ``toe_at`` of the way to the toes' tip; on an arm the shoulder joint where the arm leaves the torso, the elbow
+and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the hand (the mesh beyond the last
+joint included; a bend winning for the elbow), the collarbone's start ``clavicle_at`` of the way in; on an upright
+humanoid's spine the hips, spine, chest and neck at ``hips_at`` ... ``neck_at`` of the height from the hip joints to
+the shoulder joints. :func:`landmarks` gives the ends no role begins at, placed the same way: head top, hand and
+toe tips, finger tips, heels. A place is a weighted sum of points on bones, so named joints and landmarks follow
+the skeleton when it is moved (``Skeleton.transformed``).
 """
 from dataclasses import dataclass
 
@@ -444,15 +457,15 @@ CHAINS = (("hips", "spine", "chest", "neck", "head"), ("shoulder", "upper_arm", 
 
 
 def named_joints(skeleton, roles=None):
-    """{(role, side, digit): point}: where each role begins on ``skeleton``. With its own roles (``roles`` None) and
-    the places its body plan found (``BodyPlan.joints``), those places, which follow the skeleton when it is moved;
-    else, and for roles without a place, the role boundaries of :func:`boundary_joints`. Roles ``other`` have
-    none."""
+    """{(role, side, digit): point}: where each role begins on ``skeleton``. With its own roles (``roles`` None, or
+    equal to them) the places its body plan found (``BodyPlan.joints``, see the module docstring); else, and for
+    roles without a place, the role boundaries (a knee where the thigh's last bone ends). Roles ``other`` have none.
+    ValueError without one role per bone."""
     own = roles is None
     roles = skeleton.roles if roles is None else roles
     if roles is None or len(roles) != len(skeleton):
         raise ValueError("named_joints needs one role per bone (recognise the body plan first)")
-    places = boundary_joints(skeleton, roles)
+    places = _boundaries(skeleton, roles)
     if own or tuple(roles) == skeleton.roles:
         places.update((key, place) for key, place in _plan_places(skeleton).items() if key[0] in ROLES)
     return {key: _point_of(skeleton, place) for key, place in places.items()}
@@ -460,8 +473,9 @@ def named_joints(skeleton, roles=None):
 
 def landmarks(skeleton):
     """{(landmark, side, digit): point} of the body's ends that begin no role (``LANDMARKS``): the top of the head,
-    the end of each hand's reach and each finger's tip, the tip of each foot's toes (the mesh beyond the last joints
-    included) and each heel (on the ground under the back of the foot). Empty before the body plan is recognised."""
+    the end of each hand's reach and each finger's tip (digit named), the tip of each foot's toes (the mesh beyond
+    the last joints included) and each heel (on the ground under the back of the foot). Those the plan has; empty
+    before the body plan is recognised."""
     if skeleton.roles is None:
         return {}
     found = {key: _point_of(skeleton, place) for key, place in _plan_places(skeleton).items() if key[0] in LANDMARKS}
@@ -483,13 +497,12 @@ def _plan_places(skeleton):
 
 
 def _point_of(skeleton, place):
-    """The point a place (``((bone, share, weight), ...)``: the weights of points ``share`` of the way along
-    bones, summing to 1) stands for on ``skeleton``."""
+    """The point a place (:func:`joint_places`) stands for on ``skeleton``."""
     return sum(weight * (skeleton.heads[bone] + share * (skeleton.tails[bone] - skeleton.heads[bone]))
                for bone, share, weight in place)
 
 
-def boundary_joints(skeleton, roles):
+def _boundaries(skeleton, roles):
     """{(role, side, digit): place} where each role begins at a bone boundary: the end of the bones of the role
     before it in its chain (a knee where the thigh ends, a hip joint where a leg's hips bone ends; a leg's thigh
     follows its own side's hips, else the body's), else the start of its first bone (a finger's base); and where a
@@ -521,9 +534,10 @@ def boundary_joints(skeleton, roles):
 # Places of named joints along the bones.
 
 def joint_places(skeleton, body, layout, tuning=RoleTuning()):
-    """{(role, side, digit): place} of the joints the body's geometry places between bone ends (see the module
-    docstring): on legs and arms, and on an upright humanoid's spine. ``skeleton`` is the one ``body`` was read
-    from. A place is ``((bone, share, weight), ...)`` (``_point_of``)."""
+    """{(name, side, digit): place} of the named joints (a role's name) and landmarks (``LANDMARKS``) the body's
+    geometry places between bone ends (see the module docstring): on legs and arms, on an upright humanoid's spine,
+    and the head's top. ``skeleton`` is the one ``body`` was read from. A place is ``((bone, share, weight), ...)``:
+    the weighted sum (weights summing to 1) of the points ``share`` of the way along those bones."""
     if layout.plan.kind == "other":
         return {}
     graph = body.graph
