@@ -405,8 +405,8 @@ def _digits(body, fingers, wrist, palm, elbow):
 
 def _pick(points, low, high, share, tuning, start=0, end=None, total=None, bends_only=False):
     """The joint in [low, high] for a joint at ``share`` of the way (by length) from joint ``start`` to joint ``end``
-    (or to ``total`` past ``start``): the sharpest bend within ``bend_window`` of it when one turns by ``bend`` or
-    more, else the nearest (None with ``bends_only``)."""
+    (or to ``total`` past ``start``): the sharpest bend (:func:`_bend`, seen from ``start`` and ``end``) within
+    ``bend_window`` of it when one turns by ``bend`` or more, else the nearest (None with ``bends_only``)."""
     end = len(points) - 1 if end is None else end
     arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
     span = (arc[end] - arc[start]) if total is None else total
@@ -415,18 +415,17 @@ def _pick(points, low, high, share, tuning, start=0, end=None, total=None, bends
     candidates = candidates[(candidates > 0) & (candidates < len(points))]
     if not len(candidates):
         return None if bends_only else int(low)
-    turns = np.array([_turn(points, i) for i in candidates])
+    turns = np.array([_bend(points[i], points[start], points[end]) for i in candidates])
     bent = (np.abs(at[candidates] - share) <= tuning.bend_window) & (turns >= tuning.bend)
     if bent.any():
         return int(candidates[bent][np.argmax(turns[bent])])
     return None if bends_only else int(candidates[np.argmin(np.abs(at[candidates] - share))])
 
 
-def _turn(points, i):
-    """Degrees the path turns at joint ``i`` (0 at its ends)."""
-    if i <= 0 or i >= len(points) - 1:
-        return 0.0
-    a, b = points[i] - points[i - 1], points[i + 1] - points[i]
+def _bend(point, first, last):
+    """Degrees a limb turns at ``point`` seen from its ends ``first`` and ``last`` (short bones zigzagging along a
+    straight limb make no bend; 0 where it cannot be told)."""
+    a, b = point - first, last - point
     norms = np.linalg.norm(a) * np.linalg.norm(b)
     return float(np.degrees(np.arccos(np.clip(a @ b / norms, -1, 1)))) if norms > 0 else 0.0
 
@@ -722,14 +721,13 @@ def _arm_places(body, limb, points, arc, tuning):
 
 def _bent(points, arc, start, middle, end, length, tuning):
     """Arc position of a limb's middle joint (an elbow, a knee) between ``start`` and ``end``: the joint within
-    ``bend_window`` of the limb's ``length`` from ``middle`` where the limb bends most, when it bends by ``bend`` or
-    more seen from both ends (short bones zigzagging along a straight limb make no bend), else ``middle``."""
+    ``bend_window`` of the limb's ``length`` from ``middle`` where the limb bends most (:func:`_bend`, seen from
+    ``start`` and ``end``), when it bends by ``bend`` or more, else ``middle``."""
     first, last = _along(points, arc, start), _along(points, arc, end)
     best, turn = middle, tuning.bend
     for i in range(1, len(points) - 1):
         if start < arc[i] < end and abs(arc[i] - middle) <= tuning.bend_window * length:
-            a, b = points[i] - first, last - points[i]
-            angle = np.degrees(np.arccos(np.clip(a @ b / max(np.linalg.norm(a) * np.linalg.norm(b), 1e-300), -1, 1)))
+            angle = _bend(points[i], first, last)
             if angle >= turn:
                 best, turn = float(arc[i]), angle
     return best
