@@ -411,8 +411,9 @@ def _up_axis(graph, tips, radius, mesh, plane, size, tuning, prefer_up):
     facing = -(normals @ ups.T) >= 0.7 * areas[:, None]
     bottom = tops <= lows + tuning.flat_bottom * size
     flats = (areas[:, None] * (bottom & facing)).sum(axis=0) / total_area
-    spreads = np.array([_spread(corners[bottom[:, k] & facing[:, k]].reshape(-1, 3), mesh.used_vertices, up)
-                        for k, up in enumerate(candidates)])
+    sample = _sampled(mesh.used_vertices, tuning.sample_vertices)
+    spreads = np.array([_spread(corners[bottom[:, k] & facing[:, k]].reshape(-1, 3), sample, up)
+                        if flats[k] >= tuning.flat_area else 0.0 for k, up in enumerate(candidates)])
     flats[spreads < tuning.flat_spread] = 0.0  # a base spreads under the body: a patch atop a floating head is none
     bases = flats * spreads
     measures = [(_contacts(graph, radius, tips, up, low, high, size, tuning), float(flat), high - low)
