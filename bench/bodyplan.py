@@ -378,8 +378,8 @@ def report(records, summary, run):
         f"no joint for {summary['named_missing']} of the {summary['named_missing'] + summary['named_scored']} named "
         f"artist joints (not in the error). The nearest joint of Rigger's skeleton, whatever its role, lies "
         f"{summary['named_floor']:.4f} from the scored artist joints on average: the floor of naming Rigger's own "
-        f"joints, which named joints placed along the bones may go below. Recognition takes {summary['plan_ms_median']:.0f} ms (median; at most "
-        f"{summary['plan_ms_max']:.0f} ms) on top of the rig.", "",
+        f"joints, which named joints placed along the bones may go below. Recognition takes "
+        f"{summary['plan_ms_median']:.0f} ms (median; at most {summary['plan_ms_max']:.0f} ms) on top of the rig.", "",
     ]
     for source, title in (("rigger", "Rigger's skeletons (what `rig_mesh` reports)"),
                           ("artist", "the artists' skeletons (geometry only)"),

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .polyline import segment_distances
+from .polyline import arc_lengths, length, segment_distances
 from .tuning import TuningTable, tuned
 
 AXES = np.eye(3)
@@ -289,11 +289,7 @@ class Body:
                     <= contact_height)
 
     def limb_length(self, limb):
-        return _path_length(self.graph.points[list(limb.main)])
-
-
-def _path_length(points):
-    return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum()) if len(points) > 1 else 0.0
+        return length(self.graph.points[list(limb.main)])
 
 
 def read_body(skeleton, mesh, tuning=BodyTuning(), plane=None, prefer_up=AXES[2]):
@@ -522,7 +518,7 @@ def _side_branches(graph, spine, allowed, limbs, plane, size, tuning):
             branch = _limb(graph, node, before, plane, size, tuning)
             for k in carried:
                 base[k] = node
-            if carried or _path_length(graph.points[list(branch.main)]) < tuning.min_limb * size:
+            if carried or length(graph.points[list(branch.main)]) < tuning.min_limb * size:
                 connectors.update({joint: node for joint in before})
             else:
                 own.append(branch)
@@ -636,7 +632,7 @@ def _flatness(limb, graph, vertices, segments, nearest, middle):
     links' overall direction). ``segments`` are the graph's links (a, b) and ``nearest`` the link nearest each
     vertex."""
     main = graph.points[list(limb.main)]
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(main, axis=0), axis=1))]
+    arc = arc_lengths(main)
     if len(main) < 2 or arc[-1] <= 0:
         return 1.0
     mid = 0.5 * (arc[1:] + arc[:-1]) / arc[-1]

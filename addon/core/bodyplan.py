@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .body import AXES, BodyTuning, read_body
+from .polyline import arc_lengths, length
 from .roles import RoleTuning, assign_roles, joint_places
 from .stages import MirrorPlane
 from .tuning import tuned
@@ -160,7 +161,7 @@ def lay_out(body, tuning=BodyPlanTuning()):
         legs, rows = [], []  # fins, stubs or a lone leg: not legs a biped stands on
     long_pairs = _long_pairs(body, lengths, legs, tuning)
     spine_points = body.graph.points[list(body.spine)]
-    spine_length = _length(spine_points)
+    spine_length = length(spine_points)
     confidence = _frame_confidence(body)
     parts = ["other"] * len(limbs)
     front = [False] * len(limbs)
@@ -377,7 +378,7 @@ def _quadruped_spine(body, rows, legs, lengths, tuning):
 def _head_score(body, spine, legs, lengths, tuning):
     """How much the last end of ``spine`` looks like a head: limbs (not legs) hanging near it, higher, thicker."""
     points = body.graph.points
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[spine], axis=0), axis=1))]
+    arc = arc_lengths(points[spine])
     near = arc >= arc[-1] * (1 - tuning.end_part)
     score = 2 * sum(1 for k in range(len(body.limbs)) if k not in legs and lengths[k] >= tuning.min_limb * body.size
                     and body.bases[k] in spine and near[spine.index(body.bases[k])])
@@ -391,7 +392,7 @@ def _end_thickness(body, spine, tuning):
     points = body.graph.points[spine]
     if len(spine) < 2:
         return (float(body.radius[spine[0]]),) * 2
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    arc = arc_lengths(points)
     radius = body.radius[spine]
     first = radius[arc <= arc[-1] * tuning.end_part]
     last = radius[arc >= arc[-1] * (1 - tuning.end_part)]
@@ -409,7 +410,7 @@ def _name_parts(body, parts, lengths, spine, hips, chest, kind, tuning):
     """Name the limbs that are not legs in ``parts``: arms or wings at the chest (the longest pair), ears on the head
     part of the spine, a jaw on the plane there, tails on the plane behind the hips, others ``other``."""
     points = body.graph.points
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[spine], axis=0), axis=1))] if len(spine) > 1 \
+    arc = arc_lengths(points[spine]) if len(spine) > 1 \
         else np.zeros(1)
     head_from = max(chest, hips, 0)
     for k, limb in enumerate(body.limbs):
@@ -458,7 +459,3 @@ def _frame_confidence(body):
     up = {"legs": 1.0, "flat": 0.85}.get(body.up_evidence, 0.65)
     plane = 0.8 if body.plane is None else 0.9 if body.plane.source == "fitted" else 1.0
     return up * plane
-
-
-def _length(points):
-    return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum()) if len(points) > 1 else 0.0

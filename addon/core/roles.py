@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .polyline import arc_lengths
 from .stages import Labels, Stage
 from .tuning import TuningTable, tuned
 
@@ -235,7 +236,7 @@ def _spine_roles(body, layout, tuning):
     if kind == "other":
         return ["other"] * count
     points = body.graph.points[spine]
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    arc = arc_lengths(points)
     middle = 0.5 * (arc[1:] + arc[:-1]) / max(arc[-1], 1e-300)
     if kind == "fish":
         return ["tail" if at < tuning.tail_share else "head" if at > 1 - tuning.head_share else "spine"
@@ -314,7 +315,7 @@ def _arm(body, limb, points, tuning, put):
     at the wrist), the elbow at a bend near its share; the fingers beyond the hand."""
     nodes = list(limb.main)
     last = len(nodes) - 1
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    arc = arc_lengths(points)
     total = arc[-1] + _reach(body, points)
     middle = 0.5 * (arc[1:] + arc[:-1])
     shoulder = _shoulder(body, nodes, arc, total, tuning)
@@ -408,7 +409,7 @@ def _pick(points, low, high, share, tuning, start=0, end=None, total=None, bends
     (or to ``total`` past ``start``): the sharpest bend (:func:`_bend`, seen from ``start`` and ``end``) within
     ``bend_window`` of it when one turns by ``bend`` or more, else the nearest (None with ``bends_only``)."""
     end = len(points) - 1 if end is None else end
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    arc = arc_lengths(points)
     span = (arc[end] - arc[start]) if total is None else total
     at = (arc - arc[start]) / max(span, 1e-300)
     candidates = np.arange(int(low), int(max(low, high)) + 1)
@@ -552,7 +553,7 @@ def joint_places(skeleton, body, layout, tuning=RoleTuning()):
             continue
         side = _limb_side(skeleton, graph, limb, left)
         points = _twin_points(body, limb)
-        arc = _arc(points)
+        arc = arc_lengths(points)
         found = _leg_places(body, points, arc, layout.front[k], tuning) if part == "leg" else \
             _arm_places(body, limb, points, arc, tuning)
         for role, spots in found.items():
@@ -562,7 +563,7 @@ def joint_places(skeleton, body, layout, tuning=RoleTuning()):
         places.update(_spine_places(skeleton, body, layout, places, ends, tuning))
     if layout.plan.kind != "fish" and len(spine) >= 2:
         points = graph.points[spine]
-        arc = _arc(points)
+        arc = arc_lengths(points)
         places[("head_top", None, None)] = _on_bones(graph, ends, spine, arc, ((arc[-1] + _reach(body, points), 1.0),))
     return places
 
@@ -576,9 +577,10 @@ def _spine_places(skeleton, body, layout, places, ends, tuning):
     spine = list(layout.spine)[max(layout.hips, 0):]
     points = graph.points[spine]
     heights = body.height(points)
-    hips = [places[key] for key in places if key[0] == "thigh"]
+    hip_joints = [places[key] for key in places if key[0] == "thigh"]
     shoulders = [places[key] for key in places if key[0] == "upper_arm"]
-    low = float(np.mean([body.height(_point_of(skeleton, place)) for place in hips])) if hips else heights[0]
+    low = float(np.mean([body.height(_point_of(skeleton, place)) for place in hip_joints])) if hip_joints \
+        else heights[0]
     chest = spine.index(layout.spine[layout.chest]) if 0 <= layout.chest and layout.spine[layout.chest] in spine \
         else len(spine) - 1
     high = float(np.mean([body.height(_point_of(skeleton, place)) for place in shoulders])) if shoulders \
@@ -588,17 +590,18 @@ def _spine_places(skeleton, body, layout, places, ends, tuning):
         spine, points, heights = spine[:falls[0] + 1], points[:falls[0] + 1], heights[:falls[0] + 1]
     if len(spine) < 2 or not high > low:
         return {}
-    arc = _arc(points)
+    arc = arc_lengths(points)
     result = {}
     for role, share in (("hips", tuning.hips_at), ("spine", tuning.spine_at), ("chest", tuning.chest_at),
                         ("neck", tuning.neck_at)):
         level = low + share * (high - low)
-        if level >= heights[0] or not hips:
+        if level >= heights[0] or not hip_joints:
             result[(role, None, None)] = _on_bones(graph, ends, spine, arc, ((_up_to(heights, arc, level), 1.0),))
         else:  # between the spine's start and the middle of the hip joints
             weight = (heights[0] - level) / max(heights[0] - low, 1e-300)
             start = _on_bones(graph, ends, spine, arc, ((0.0, 1.0 - weight),))
-            result[(role, None, None)] = start + tuple((bone, at, part * weight / len(hips)) for place in hips
+            share = weight / len(hip_joints)
+            result[(role, None, None)] = start + tuple((bone, at, part * share) for place in hip_joints
                                                        for bone, at, part in place)
     return result
 
@@ -626,10 +629,6 @@ def _on_bones(graph, ends, nodes, arc, spots):
         else:
             place += [(*ends[a], weight * (1.0 - share)), (*ends[b], weight * share)]
     return tuple(place)
-
-
-def _arc(points):
-    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
 
 
 def _down_to(heights, arc, level):
@@ -663,9 +662,9 @@ def _leg_places(body, points, arc, front, tuning):
     thigh = 0.5 * (hip + knee)
     line = _along(points, arc, thigh) - _along(points, arc, knee)
     rise = float(line @ body.up)
-    reach = (hip_height - float(np.interp(thigh, arc, heights))) / rise * (body.high - body.low) if rise > 0 else 0
+    carry = (hip_height - float(np.interp(thigh, arc, heights))) / rise * (body.high - body.low) if rise > 0 else 0
     upright = rise >= np.cos(np.radians(tuning.thigh_lean)) * np.linalg.norm(line)
-    hip_spots = ((thigh, 1.0 + reach), (knee, -reach)) if upright and 0 < reach <= 2 else ((hip, 1.0),)
+    hip_spots = ((thigh, 1.0 + carry), (knee, -carry)) if upright and 0 < carry <= 2 else ((hip, 1.0),)
     names = ("upper_arm", "forearm", "hand", None, "hand_tip") if front else \
         ("thigh", "shin", "foot", "toe", "toe_tip")
     places = {name: spots for name, spots in zip(names, (hip_spots, ((knee, 1.0),), ((ankle, 1.0),), ((toe, 1.0),),
@@ -734,14 +733,11 @@ def _bent(points, arc, start, middle, end, length, tuning):
 
 
 def _along(points, arc, at):
-    k = int(np.clip(np.searchsorted(arc, at, side="right") - 1, 0, len(points) - 2))
-    share = (at - arc[k]) / max(arc[k + 1] - arc[k], 1e-300)
-    return points[k] + np.clip(share, 0.0, 1.0) * (points[k + 1] - points[k])
-
-
-def _radii_at(points, vertices):
-    """Distance from each point to the nearest of ``vertices``."""
-    return np.sqrt(((points[:, None] - vertices[None]) ** 2).sum(axis=2).min(axis=1))
+    """The point at arc length ``at`` along ``points`` (whose arc lengths are ``arc``), on past the last point
+    along the last link as :func:`_on_bones` places it."""
+    k = min(max(int(np.searchsorted(arc, at, side="right")) - 1, 0), len(points) - 2)
+    share = max((at - arc[k]) / max(arc[k + 1] - arc[k], 1e-300), 0.0)
+    return points[k] + (share if k == len(points) - 2 else min(share, 1.0)) * (points[k + 1] - points[k])
 
 
 @dataclass(frozen=True, eq=False)
