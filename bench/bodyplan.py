@@ -8,8 +8,8 @@ with ``rigger.core.bodyplan.recognise``: geometry only, since its bones are rena
 turns Rigger's skeleton and the mesh back into the file's own frame and recognises them with Blender's +Z still
 preferred: for the Y-up files, up must then come from the geometry alone.
 
-Named joints: ``rigger.core.roles.named_joints``, where each role begins (a knee where the thigh ends, a shoulder
-joint where the upper arm starts, a wrist where an arm without a hand bone ends). The artists' joints are named by hand
+Named joints: ``rigger.core.roles.named_joints``, where each role begins (a knee, a shoulder joint, a wrist), points
+placed along Rigger's bones at recognition, not only at their ends. The artists' joints are named by hand
 below (``NAMED``, role per joint name; a joint is left out when the rig has no such joint or it is not clear
 which it is). Sides are compared by geometry (the side of the mirror plane a joint lies on), so no naming
 convention matters. Errors are in units of the mesh's largest extent.
@@ -99,7 +99,8 @@ MIXAMO = {"mixamorig_Hips_01": "hips", "mixamorig_Spine_02": "spine", "mixamorig
 # first segment). RigNet's humanoids follow one pattern: root at the pelvis, a hip, knee and ankle per leg, one or
 # two spine joints up to the neck's base where the arms hang, then a shoulder, elbow and wrist per arm; the last joint
 # of a chain (a wrist, an ankle) has no bone after it but marks where the next would start. Left out: joints whose
-# place is unclear (the head's leaf joints, an ankle that may be a toe tip, the four-armed monster's two elbows).
+# place is unclear (the head's leaf joints, an ankle that may be a toe tip, the four-armed monster's two elbows, the
+# robot's joint1 just above its hips, from which both its arms and its one bone up to the head start).
 NAMED = {
     "magicarticulate_0a59c5ff": MIXAMO,
     "CesiumMan": {"Skeleton_torso_joint_1": "hips", "Skeleton_torso_joint_2": "spine", "torso_joint_3": "neck",
@@ -108,7 +109,7 @@ NAMED = {
                   "Skeleton_arm_joint_L__2_": "hand", "Skeleton_arm_joint_R__3_": "hand",
                   "leg_joint_L_1": "thigh", "leg_joint_R_1": "thigh", "leg_joint_L_2": "shin", "leg_joint_R_2": "shin",
                   "leg_joint_L_3": "foot", "leg_joint_R_3": "foot"},
-    "BrainStem": {"joint0": "hips", "joint1": "neck", "joint3": "upper_arm", "joint5": "upper_arm",
+    "BrainStem": {"joint0": "hips", "joint3": "upper_arm", "joint5": "upper_arm",
                   "joint4": "forearm", "joint6": "forearm", "joint10": "thigh", "joint14": "thigh", "joint11": "shin",
                   "joint15": "shin", "joint12": "foot", "joint16": "foot"},
     "rignet_1347": {"root": "hips", "joint_8": "neck", "joint_4": "upper_arm", "joint_14": "upper_arm",
@@ -230,13 +231,13 @@ def role_key(role):
 
 
 def found_joints(skeleton, middle, size):
-    """{(role, side): point} of ``rigger.core.roles.named_joints``, sides by geometry (a joint on the plane, where
-    a leg or an arm leaves the body, by its role's side: ``L`` on the +X side, as Rigger's names and Blender have
-    it for a character facing -Y)."""
+    """{(role, side): point} of ``rigger.core.roles.named_joints``: a role without a side on the plane, the others
+    on their side by geometry (on the plane, where a leg or an arm leaves the body, by the role's side: ``L`` on the
+    +X side, as Rigger's names and Blender have it for a character facing -Y)."""
     joints = {}
     for (role, side, digit), point in named_joints(skeleton).items():
         key = f"finger:{digit}" if role == "finger" and digit else role
-        where = int(side_of(point, middle, size)) or {"L": 1, "R": -1, None: 0}[side]  # on the plane: its side
+        where = 0 if side is None else int(side_of(point, middle, size)) or {"L": 1, "R": -1}[side]
         joints.setdefault((key, where), point)
     return joints
 
@@ -376,9 +377,9 @@ def report(records, summary, run):
         f"{summary['artist_role_agreement'][0]} / {summary['artist_role_agreement'][1]} named joints. Rigger names "
         f"no joint for {summary['named_missing']} of the {summary['named_missing'] + summary['named_scored']} named "
         f"artist joints (not in the error). The nearest joint of Rigger's skeleton, whatever its role, lies "
-        f"{summary['named_floor']:.4f} from the scored artist joints on average: the floor any naming of Rigger's "
-        f"joints could reach. Recognition takes {summary['plan_ms_median']:.0f} ms (median; at most "
-        f"{summary['plan_ms_max']:.0f} ms) on top of the rig.", "",
+        f"{summary['named_floor']:.4f} from the scored artist joints on average: the floor of naming Rigger's own "
+        f"joints, which named joints placed along the bones may go below. Recognition takes "
+        f"{summary['plan_ms_median']:.0f} ms (median; at most {summary['plan_ms_max']:.0f} ms) on top of the rig.", "",
     ]
     for source, title in (("rigger", "Rigger's skeletons (what `rig_mesh` reports)"),
                           ("artist", "the artists' skeletons (geometry only)"),
@@ -437,7 +438,7 @@ def failure_notes(records, summary):
     far = [row for row in summary["over_max"] if nearest[row[:2]] > TARGET_MAX_ERROR]
     notes.append(f"- {len(summary['over_max'])} named joints lie more than {TARGET_MAX_ERROR} from the artist's; for "
                  f"{len(far)} of them no joint of Rigger's skeleton lies within {TARGET_MAX_ERROR} (the skeleton has "
-                 f"no joint there), for the others a joint does but the roles begin elsewhere:")
+                 f"no joint there), for the others a joint does but the named joint lies elsewhere:")
     for model, joint, error in summary["over_max"]:
         notes.append(f"  - {model} {joint}: {error:.3f} of the size from the artist's joint; Rigger's nearest joint "
                      f"{nearest[(model, joint)]:.3f}.")

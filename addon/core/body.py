@@ -6,11 +6,12 @@ The pieces, in the order :func:`read_body` finds them:
 - the joint graph: bone ends closer than ``joint_merge`` are one joint; a bone whose head is not its parent's tail
   hangs from it by a link without a bone, and parts of a forest hang from the nearest joint of the largest part;
 - the mirror plane: the method's own (its ``mirror_plane`` stage), else the mesh's (``core.mirror.mirror_plane``),
-  else the axis plane that pairs the most leaf tips of the skeleton with mirror images (a posed or hand-made
-  figure, whose mesh is not symmetric within 1%);
+  else the axis plane that pairs the most leaf tips of the skeleton with mirror images and runs along the body (a
+  posed or hand-made figure, whose mesh is not symmetric within 1%);
 - up: the world axis, perpendicular to the plane's normal, along which the most separate leaf tips touch the
-  ground with the mesh's centre above them (legs), then the one with the most flat area at the bottom (soles, a
-  belly), then +Z (Blender's up) and +Y (the OBJ convention);
+  ground with the mesh's centre above them (legs), then the one standing on the broadest flat bottom (its flat area
+  times how far it spreads across: soles, a belly; a small flat patch atop a floating figure's head is none), then
+  +Z (Blender's up) and +Y (the OBJ convention);
 - the midline and the limbs: leaf chains whose tips lie off the plane are stripped, round after round (fingers,
   then the arm they hang from), and grouped into limbs, each hanging from one joint of what stays, the midline.
   The spine is the midline's longest path; side branches of the midline are limbs on the plane (a jaw, a fin).
@@ -20,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .polyline import segment_distances
+from .polyline import arc_lengths, length, segment_distances
 from .tuning import TuningTable, tuned
 
 AXES = np.eye(3)
@@ -49,6 +50,8 @@ class BodyTuning(TuningTable):
                                        "only breaks ties")
     flat_bottom: float = tuned(0.02, "the mesh's bottom slab, where flat faces facing down count as ground area")
     flat_area: float = tuned(0.004, "a bottom with this share of the mesh's area flat on the ground stands on it")
+    flat_spread: float = tuned(0.2, "... when it spreads this share of the mesh's breadth across up (geometric mean of "
+                                    "both ways; a cartoon's soles 0.4, a flat patch atop a floating ghost's head 0.16)")
     min_limb: float = tuned(0.05, "a side branch of the midline shorter than this is part of the spine there, no "
                                   "limb (an exporter's helper joint, a stub)")
     twin_tolerance: float = tuned(0.12, "limbs whose tips and starts mirror within this are twins (posed figures "
@@ -286,11 +289,7 @@ class Body:
                     <= contact_height)
 
     def limb_length(self, limb):
-        return _path_length(self.graph.points[list(limb.main)])
-
-
-def _path_length(points):
-    return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum()) if len(points) > 1 else 0.0
+        return length(self.graph.points[list(limb.main)])
 
 
 def read_body(skeleton, mesh, tuning=BodyTuning(), plane=None, prefer_up=AXES[2]):
@@ -340,9 +339,10 @@ def _mirror(skeleton, graph, mesh, size, tuning, given):
 
 def _fitted_plane(graph, mesh, size, tuning):
     """The axis plane across which the most joints off it have another joint near their mirror image (at least
-    ``plane_pairs``), or None. The planes tried run midway between two leaf tips that could be twins; two joints of
-    one limb (a hand's fingers) never pair: the skeleton joins twins through the body, more than ``contact_apart``
-    apart."""
+    ``plane_pairs``) and whose joints on it span ``min_limb`` or more (a body runs along its mirror plane; a plane
+    across a lying body's line of joints pairs them all), or None. The planes tried run midway between two leaf tips
+    that could be twins; two joints of one limb (a hand's fingers) never pair: the skeleton joins twins through the
+    body, more than ``contact_apart`` apart."""
     points = graph.points
     tips = points[graph.leaves()]
     distance = np.array([[graph.search(node)[0][other] for other in range(len(points))]
@@ -363,9 +363,16 @@ def _fitted_plane(graph, mesh, size, tuning):
             gaps = np.linalg.norm(plane.reflect(points[off])[:, None] - points[None], axis=2)
             gaps[~apart[off]] = np.inf
             pairs = int((gaps.min(axis=1, initial=np.inf) <= tuning.plane_fit * size).sum())
-            if pairs > best_pairs:
+            if pairs > best_pairs and _span(points[~off]) >= tuning.min_limb * size:
                 best, best_pairs = plane, pairs
     return best
+
+
+def _span(points):
+    """The largest distance between two of ``points`` (0 for fewer than two)."""
+    if len(points) < 2:
+        return 0.0
+    return float(np.linalg.norm(points[:, None] - points[None], axis=2).max())
 
 
 # Up.
@@ -395,15 +402,21 @@ def _up_axis(graph, tips, radius, mesh, plane, size, tuning, prefer_up):
     ups = np.array(candidates)
     heights = mesh.used_vertices @ ups.T  # (N, C)
     lows, highs = heights.min(axis=0), heights.max(axis=0)
-    tops = (corners @ ups.T).max(axis=1)  # (T, C): each triangle's highest corner along each candidate
+    tops = np.maximum(np.maximum(corners[:, 0] @ ups.T, corners[:, 1] @ ups.T), corners[:, 2] @ ups.T)  # (T, C):
+    # each triangle's highest corner along each candidate (three plain products: a stack of 3x3 ones is slow)
     facing = -(normals @ ups.T) >= 0.7 * areas[:, None]
     bottom = tops <= lows + tuning.flat_bottom * size
     flats = (areas[:, None] * (bottom & facing)).sum(axis=0) / total_area
+    sample = _sampled(mesh.used_vertices, tuning.sample_vertices)
+    spreads = np.array([_spread(corners[bottom[:, k] & facing[:, k]].reshape(-1, 3), sample, up)
+                        if flats[k] >= tuning.flat_area else 0.0 for k, up in enumerate(candidates)])
+    flats[spreads < tuning.flat_spread] = 0.0  # a base spreads under the body: a patch atop a floating head is none
+    bases = flats * spreads
     measures = [(_contacts(graph, radius, tips, up, low, high, size, tuning), float(flat), high - low)
                 for up, low, high, flat in zip(candidates, lows, highs, flats)]
-    best_flat = max(max(flat for _, flat, _ in measures), tuning.flat_area)
-    scores = [tuning.leg_weight * (contacts >= 2) + flat / best_flat + tuning.prefer_weight * float(up @ prefer_up)
-              for up, (contacts, flat, _) in zip(candidates, measures)]
+    best_base = max(float(bases.max()), tuning.flat_area * tuning.flat_spread)
+    scores = [tuning.leg_weight * (contacts >= 2) + base / best_base + tuning.prefer_weight * float(up @ prefer_up)
+              for up, (contacts, _, _), base in zip(candidates, measures, bases)]
     best = int(np.argmax(scores))
     up, (contacts, flat, _) = candidates[best], measures[best]
     name = _axis_name(up)
@@ -412,6 +425,16 @@ def _up_axis(graph, tips, radius, mesh, plane, size, tuning, prefer_up):
     if flat >= tuning.flat_area:
         return up, "flat", f"up {name}: the mesh rests on a flat bottom ({flat:.1%} of its area)"
     return up, "preferred", f"up {name}: nothing touches the ground clearly, so the preferred up"
+
+
+def _spread(base, vertices, up):
+    """How far ``base`` points spread across ``up`` as a share of how far the ``vertices`` do: the geometric mean
+    over the two directions across (0 without points)."""
+    if not len(base):
+        return 0.0
+    across = np.linalg.svd(np.eye(3) - np.outer(up, up))[0][:, :2]
+    shares = np.ptp(base @ across, axis=0) / np.maximum(np.ptp(vertices @ across, axis=0), 1e-300)
+    return float(np.sqrt(shares.prod()))
 
 
 def _contacts(graph, radius, tips, up, low, high, size, tuning):
@@ -495,7 +518,7 @@ def _side_branches(graph, spine, allowed, limbs, plane, size, tuning):
             branch = _limb(graph, node, before, plane, size, tuning)
             for k in carried:
                 base[k] = node
-            if carried or _path_length(graph.points[list(branch.main)]) < tuning.min_limb * size:
+            if carried or length(graph.points[list(branch.main)]) < tuning.min_limb * size:
                 connectors.update({joint: node for joint in before})
             else:
                 own.append(branch)
@@ -609,7 +632,7 @@ def _flatness(limb, graph, vertices, segments, nearest, middle):
     links' overall direction). ``segments`` are the graph's links (a, b) and ``nearest`` the link nearest each
     vertex."""
     main = graph.points[list(limb.main)]
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(main, axis=0), axis=1))]
+    arc = arc_lengths(main)
     if len(main) < 2 or arc[-1] <= 0:
         return 1.0
     mid = 0.5 * (arc[1:] + arc[:-1]) / arc[-1]

@@ -16,15 +16,19 @@ The rules, in order (``Body`` gives the up axis, the mirror plane, the spine and
   short beside it (fins, or none) and that tapers, curves or has fins is a fish or a serpent (not a plain log or
   column); anything else is ``other``.
 
+Recognition also places the named joints along the chains (``core.roles``: a knee between bone ends where the
+artists' rigs have it) and keeps them in ``BodyPlan.joints``.
+
 The confidence multiplies how the up axis was found (legs on the ground, a flat bottom, or only the preferred up),
 where the mirror plane came from and how clearly the deciding rule held.
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from .body import AXES, BodyTuning, read_body
-from .roles import RoleTuning, assign_roles
+from .polyline import arc_lengths, length
+from .roles import RoleTuning, assign_roles, joint_places
 from .stages import MirrorPlane
 from .tuning import tuned
 
@@ -66,13 +70,16 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
 @dataclass(frozen=True)
 class BodyPlan:
     """A recognised body plan: ``kind`` (one of ``KINDS``), ``confidence`` in [0, 1], a one-line ``reason``, counts
-    of its ``parts`` ({"legs": 2, "arms": 2, ...}), and the world ``up`` it stands along."""
+    of its ``parts`` ({"legs": 2, "arms": 2, ...}), the world ``up`` it stands along, and where its named joints and
+    landmarks lie on the skeleton it was recognised on (``joints``: ``core.roles.joint_places``; read them with
+    ``core.roles.named_joints`` and ``landmarks``)."""
 
     kind: str
     confidence: float
     reason: str
     parts: dict = field(default_factory=dict)
     up: tuple = (0.0, 0.0, 1.0)
+    joints: dict = field(default_factory=dict, repr=False)
 
     def to_dict(self):
         """JSON-ready: kind, confidence, reason and parts (``up`` is in the world's frame, so left out)."""
@@ -138,7 +145,8 @@ def recognise(skeleton, mesh, *, plane=None, prefer_up=AXES[2], tuning=BodyPlanT
         plane = MirrorPlane(plane.axis, plane.offset * factor, plane.normal)
     body = read_body(at_unit_size, mesh.at_unit_size(), tuning, plane, prefer_up / np.linalg.norm(prefer_up))
     layout = lay_out(body, tuning)
-    return layout.plan, assign_roles(skeleton, body, layout, tuning)
+    roles = assign_roles(skeleton, body, layout, tuning)
+    return replace(layout.plan, joints=joint_places(at_unit_size, body, layout, tuning)), roles
 
 
 def lay_out(body, tuning=BodyPlanTuning()):
@@ -153,7 +161,7 @@ def lay_out(body, tuning=BodyPlanTuning()):
         legs, rows = [], []  # fins, stubs or a lone leg: not legs a biped stands on
     long_pairs = _long_pairs(body, lengths, legs, tuning)
     spine_points = body.graph.points[list(body.spine)]
-    spine_length = _length(spine_points)
+    spine_length = length(spine_points)
     confidence = _frame_confidence(body)
     parts = ["other"] * len(limbs)
     front = [False] * len(limbs)
@@ -370,7 +378,7 @@ def _quadruped_spine(body, rows, legs, lengths, tuning):
 def _head_score(body, spine, legs, lengths, tuning):
     """How much the last end of ``spine`` looks like a head: limbs (not legs) hanging near it, higher, thicker."""
     points = body.graph.points
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[spine], axis=0), axis=1))]
+    arc = arc_lengths(points[spine])
     near = arc >= arc[-1] * (1 - tuning.end_part)
     score = 2 * sum(1 for k in range(len(body.limbs)) if k not in legs and lengths[k] >= tuning.min_limb * body.size
                     and body.bases[k] in spine and near[spine.index(body.bases[k])])
@@ -384,7 +392,7 @@ def _end_thickness(body, spine, tuning):
     points = body.graph.points[spine]
     if len(spine) < 2:
         return (float(body.radius[spine[0]]),) * 2
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    arc = arc_lengths(points)
     radius = body.radius[spine]
     first = radius[arc <= arc[-1] * tuning.end_part]
     last = radius[arc >= arc[-1] * (1 - tuning.end_part)]
@@ -402,7 +410,7 @@ def _name_parts(body, parts, lengths, spine, hips, chest, kind, tuning):
     """Name the limbs that are not legs in ``parts``: arms or wings at the chest (the longest pair), ears on the head
     part of the spine, a jaw on the plane there, tails on the plane behind the hips, others ``other``."""
     points = body.graph.points
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[spine], axis=0), axis=1))] if len(spine) > 1 \
+    arc = arc_lengths(points[spine]) if len(spine) > 1 \
         else np.zeros(1)
     head_from = max(chest, hips, 0)
     for k, limb in enumerate(body.limbs):
@@ -451,7 +459,3 @@ def _frame_confidence(body):
     up = {"legs": 1.0, "flat": 0.85}.get(body.up_evidence, 0.65)
     plane = 0.8 if body.plane is None else 0.9 if body.plane.source == "fitted" else 1.0
     return up * plane
-
-
-def _length(points):
-    return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum()) if len(points) > 1 else 0.0

@@ -15,17 +15,32 @@ the same joints (on their mirror-averaged points). Wings, fins, ears, tails and 
 every bone. A body plan that is ``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when
 a limb's bones have them, else the side of the mirror plane, left being the character's left when its front is known
 (Blender's +X for a character facing -Y).
+
+Roles are whole bones; named joints are points (:func:`named_joints`: where each role begins, ``{(role, side,
+digit): point}``), placed along the chains where the artists' rigs have them rather than at the nearest bone end
+(:func:`joint_places`, at recognition, stored in ``BodyPlan.joints``): on a leg the ankle where it comes down to
+``ankle_height``, the hip joint at ``hip_rise`` of the height from there to where the leg hangs (on the thigh's line
+when the thigh stands upright), the knee ``knee_at`` of the way between (a bend there winning) and the ball of the
+foot ``toe_at`` of the way to the toes' tip; on an arm the shoulder joint where the arm leaves the torso, the elbow
+and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the hand (the mesh beyond the last
+joint included; a bend winning for the elbow), the collarbone's start ``clavicle_at`` of the way in; on an upright
+humanoid's spine the hips, spine, chest and neck at ``hips_at`` ... ``neck_at`` of the height from the hip joints to
+the shoulder joints. :func:`landmarks` gives the ends no role begins at, placed the same way: head top, hand and
+toe tips, finger tips, heels. A place is a weighted sum of points on bones, so named joints and landmarks follow
+the skeleton when it is moved (``Skeleton.transformed``).
 """
 from dataclasses import dataclass
 
 import numpy as np
 
+from .polyline import arc_lengths
 from .stages import Labels, Stage
 from .tuning import TuningTable, tuned
 
 ROLES = ("root", "hips", "spine", "chest", "neck", "head", "jaw", "shoulder", "upper_arm", "forearm", "hand", "finger",
          "thigh", "shin", "foot", "toe", "tail", "ear", "wing", "fin", "other")
 DIGITS = ("thumb", "index", "middle", "ring", "pinky")
+LANDMARKS = ("head_top", "hand_tip", "finger_tip", "toe_tip", "heel")
 SIDES = ("L", "R", None)
 
 
@@ -90,6 +105,23 @@ class RoleTuning(TuningTable):
     head_share: float = tuned(0.25, "a fish's head: this share of its spine's length from the head end")
     tail_share: float = tuned(0.35, "a fish's tail: this share from the tail end")
     tail_length: float = tuned(0.08, "spine behind the hips this long (a share of the size) is a tail, not hips")
+    hip_rise: float = tuned(0.89, "a leg's hip joint lies this share of the height from its ankle up to where the "
+                                  "leg hangs from the spine")
+    heel_width: float = tuned(0.03, "the heel is the hindmost point of the mesh this close to the foot's line "
+                                    "(half a foot's width)")
+    thigh_lean: float = tuned(30.0, "degrees: a thigh leaning at most this far from up carries the hip joint on its "
+                                    "line (a standing biped's)")
+    toe_at: float = tuned(0.65, "the ball of the foot: this share of the way from the ankle to the tip of the toes "
+                                "(the mesh's; a human foot's ball two thirds of the way)")
+    clavicle_at: float = tuned(0.25, "an arm's collarbone starts this share of the way from where the arm hangs to "
+                                     "its shoulder joint (Rigify's and Mixamo's near the body's middle)")
+    hips_at: float = tuned(0.25, "a humanoid's hips joint: this share of the height from its hip joints to its "
+                                 "shoulder joints")
+    spine_at: float = tuned(0.45, "its spine joint: this share of that height")
+    chest_at: float = tuned(0.65, "its chest joint: this share")
+    neck_at: float = tuned(0.85, "its neck joint: this share")
+    spine_fall: float = tuned(0.02, "... on its spine up to where it falls this share of the height (a hunched "
+                                    "figure's head hanging forward)")
 
 
 def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
@@ -204,7 +236,7 @@ def _spine_roles(body, layout, tuning):
     if kind == "other":
         return ["other"] * count
     points = body.graph.points[spine]
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    arc = arc_lengths(points)
     middle = 0.5 * (arc[1:] + arc[:-1]) / max(arc[-1], 1e-300)
     if kind == "fish":
         return ["tail" if at < tuning.tail_share else "head" if at > 1 - tuning.head_share else "spine"
@@ -283,7 +315,7 @@ def _arm(body, limb, points, tuning, put):
     at the wrist), the elbow at a bend near its share; the fingers beyond the hand."""
     nodes = list(limb.main)
     last = len(nodes) - 1
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    arc = arc_lengths(points)
     total = arc[-1] + _reach(body, points)
     middle = 0.5 * (arc[1:] + arc[:-1])
     shoulder = _shoulder(body, nodes, arc, total, tuning)
@@ -374,28 +406,27 @@ def _digits(body, fingers, wrist, palm, elbow):
 
 def _pick(points, low, high, share, tuning, start=0, end=None, total=None, bends_only=False):
     """The joint in [low, high] for a joint at ``share`` of the way (by length) from joint ``start`` to joint ``end``
-    (or to ``total`` past ``start``): the sharpest bend within ``bend_window`` of it when one turns by ``bend`` or
-    more, else the nearest (None with ``bends_only``)."""
+    (or to ``total`` past ``start``): the sharpest bend (:func:`_bend`, seen from ``start`` and ``end``) within
+    ``bend_window`` of it when one turns by ``bend`` or more, else the nearest (None with ``bends_only``)."""
     end = len(points) - 1 if end is None else end
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    arc = arc_lengths(points)
     span = (arc[end] - arc[start]) if total is None else total
     at = (arc - arc[start]) / max(span, 1e-300)
     candidates = np.arange(int(low), int(max(low, high)) + 1)
     candidates = candidates[(candidates > 0) & (candidates < len(points))]
     if not len(candidates):
         return None if bends_only else int(low)
-    turns = np.array([_turn(points, i) for i in candidates])
+    turns = np.array([_bend(points[i], points[start], points[end]) for i in candidates])
     bent = (np.abs(at[candidates] - share) <= tuning.bend_window) & (turns >= tuning.bend)
     if bent.any():
         return int(candidates[bent][np.argmax(turns[bent])])
     return None if bends_only else int(candidates[np.argmin(np.abs(at[candidates] - share))])
 
 
-def _turn(points, i):
-    """Degrees the path turns at joint ``i`` (0 at its ends)."""
-    if i <= 0 or i >= len(points) - 1:
-        return 0.0
-    a, b = points[i] - points[i - 1], points[i + 1] - points[i]
+def _bend(point, first, last):
+    """Degrees a limb turns at ``point`` seen from its ends ``first`` and ``last`` (short bones zigzagging along a
+    straight limb make no bend; 0 where it cannot be told)."""
+    a, b = point - first, last - point
     norms = np.linalg.norm(a) * np.linalg.norm(b)
     return float(np.degrees(np.arccos(np.clip(a @ b / norms, -1, 1)))) if norms > 0 else 0.0
 
@@ -426,14 +457,57 @@ CHAINS = (("hips", "spine", "chest", "neck", "head"), ("shoulder", "upper_arm", 
 
 
 def named_joints(skeleton, roles=None):
-    """{(role, side, digit): point}: where each role begins on ``skeleton`` (with ``roles``, default its own) — the
-    end of the bones of the role before it in its chain (a knee where the thigh ends, a hip joint where a leg's hips
-    bone ends; a leg's thigh follows its own side's hips, else the body's), else the start of its first bone (a
-    finger's base); and where a chain's role has no bone, after a last bone with nothing beyond it, that bone's end
-    (the wrist of an arm whose forearm ends there). Roles ``other`` have none."""
+    """{(role, side, digit): point}: where each role begins on ``skeleton``. With its own roles (``roles`` None, or
+    equal to them) the places its body plan found (``BodyPlan.joints``, see the module docstring); else, and for
+    roles without a place, the role boundaries (a knee where the thigh's last bone ends). Roles ``other`` have none.
+    ValueError without one role per bone."""
+    own = roles is None
     roles = skeleton.roles if roles is None else roles
     if roles is None or len(roles) != len(skeleton):
         raise ValueError("named_joints needs one role per bone (recognise the body plan first)")
+    places = _boundaries(skeleton, roles)
+    if own or tuple(roles) == skeleton.roles:
+        places.update((key, place) for key, place in _plan_places(skeleton).items() if key[0] in ROLES)
+    return {key: _point_of(skeleton, place) for key, place in places.items()}
+
+
+def landmarks(skeleton):
+    """{(landmark, side, digit): point} of the body's ends that begin no role (``LANDMARKS``): the top of the head,
+    the end of each hand's reach and each finger's tip (digit named), the tip of each foot's toes (the mesh beyond
+    the last joints included) and each heel (on the ground under the back of the foot). Those the plan has; empty
+    before the body plan is recognised."""
+    if skeleton.roles is None:
+        return {}
+    found = {key: _point_of(skeleton, place) for key, place in _plan_places(skeleton).items() if key[0] in LANDMARKS}
+    tips = {}
+    for bone, role in enumerate(skeleton.roles):
+        if role.role == "finger" and role.digit and role.index >= tips.get((role.side, role.digit), (-1, 0))[0]:
+            tips[(role.side, role.digit)] = (role.index, bone)
+    found.update({("finger_tip", side, digit): skeleton.tails[bone] for (side, digit), (_, bone) in tips.items()})
+    return found
+
+
+def _plan_places(skeleton):
+    """The places the skeleton's body plan found (``BodyPlan.joints``), when they are places on this skeleton."""
+    plan = skeleton.body_plan
+    joints = {} if plan is None else plan.joints
+    if all(0 <= bone < len(skeleton) for place in joints.values() for bone, _, _ in place):
+        return joints
+    return {}
+
+
+def _point_of(skeleton, place):
+    """The point a place (:func:`joint_places`) stands for on ``skeleton``."""
+    return sum(weight * (skeleton.heads[bone] + share * (skeleton.tails[bone] - skeleton.heads[bone]))
+               for bone, share, weight in place)
+
+
+def _boundaries(skeleton, roles):
+    """{(role, side, digit): place} where each role begins at a bone boundary: the end of the bones of the role
+    before it in its chain (a knee where the thigh ends, a hip joint where a leg's hips bone ends; a leg's thigh
+    follows its own side's hips, else the body's), else the start of its first bone (a finger's base); and where a
+    chain's role has no bone, after a last bone with nothing beyond it, that bone's end (the wrist of an arm whose
+    forearm ends there)."""
     first, last = {}, {}  # (role, side, digit) -> bone
     for bone, role in enumerate(roles):
         if role.role == "other":
@@ -445,7 +519,7 @@ def named_joints(skeleton, roles=None):
             last[key] = bone
     is_leaf = np.ones(len(skeleton), dtype=bool)
     is_leaf[skeleton.parents[skeleton.parents >= 0]] = False
-    joints = {key: skeleton.heads[bone] for key, bone in first.items()}
+    joints = {key: ((bone, 0.0, 1.0),) for key, bone in first.items()}
     for chain in CHAINS:
         for side in ("L", "R", None):
             for before, role in zip(chain, chain[1:]):
@@ -453,8 +527,217 @@ def named_joints(skeleton, roles=None):
                 if previous is None:
                     continue
                 if (role, side, None) in first or is_leaf[last[previous]]:
-                    joints[(role, side, None)] = skeleton.tails[last[previous]]
+                    joints[(role, side, None)] = ((last[previous], 1.0, 1.0),)
     return joints
+
+
+# Places of named joints along the bones.
+
+def joint_places(skeleton, body, layout, tuning=RoleTuning()):
+    """{(name, side, digit): place} of the named joints (a role's name) and landmarks (``LANDMARKS``) the body's
+    geometry places between bone ends (see the module docstring): on legs and arms, on an upright humanoid's spine,
+    and the head's top. ``skeleton`` is the one ``body`` was read from. A place is ``((bone, share, weight), ...)``:
+    the weighted sum (weights summing to 1) of the points ``share`` of the way along those bones."""
+    if layout.plan.kind == "other":
+        return {}
+    graph = body.graph
+    ends = {}
+    for bone in range(len(skeleton)):
+        ends.setdefault(int(graph.head_node[bone]), (bone, 0.0))
+        ends[int(graph.tail_node[bone])] = (bone, 1.0)
+    left = _left_sign(body, layout)
+    places = {}
+    for k, limb in enumerate(body.limbs):
+        part = layout.parts[k]
+        if part not in ("leg", "arm") or len(limb.main) < 2:
+            continue
+        side = _limb_side(skeleton, graph, limb, left)
+        points = _twin_points(body, limb)
+        arc = arc_lengths(points)
+        found = _leg_places(body, points, arc, layout.front[k], tuning) if part == "leg" else \
+            _arm_places(body, limb, points, arc, tuning)
+        for role, spots in found.items():
+            places[(role, side, None)] = _on_bones(graph, ends, list(limb.main), arc, spots)
+    spine = list(layout.spine)
+    if layout.plan.kind == "humanoid" and len(spine) >= 2:
+        places.update(_spine_places(skeleton, body, layout, places, ends, tuning))
+    if layout.plan.kind != "fish" and len(spine) >= 2:
+        points = graph.points[spine]
+        arc = arc_lengths(points)
+        places[("head_top", None, None)] = _on_bones(graph, ends, spine, arc, ((arc[-1] + _reach(body, points), 1.0),))
+    return places
+
+
+def _spine_places(skeleton, body, layout, places, ends, tuning):
+    """{role: place} of a humanoid's hips, spine, chest and neck: on its spine where it reaches ``hips_at``,
+    ``spine_at``, ``chest_at`` and ``neck_at`` of the height from its hip joints (else where the spine leaves the
+    legs) to its shoulder joints (else where the arms hang); below the spine's start, on the way from there to the
+    hip joints."""
+    graph = body.graph
+    spine = list(layout.spine)[max(layout.hips, 0):]
+    points = graph.points[spine]
+    heights = body.height(points)
+    hip_joints = [places[key] for key in places if key[0] == "thigh"]
+    shoulders = [places[key] for key in places if key[0] == "upper_arm"]
+    low = float(np.mean([body.height(_point_of(skeleton, place)) for place in hip_joints])) if hip_joints \
+        else heights[0]
+    chest = spine.index(layout.spine[layout.chest]) if 0 <= layout.chest and layout.spine[layout.chest] in spine \
+        else len(spine) - 1
+    high = float(np.mean([body.height(_point_of(skeleton, place)) for place in shoulders])) if shoulders \
+        else heights[chest]
+    falls = np.flatnonzero(heights[1:] < np.maximum.accumulate(heights)[:-1] - tuning.spine_fall)
+    if len(falls):  # a head hanging forward: the spine falls from there on
+        spine, points, heights = spine[:falls[0] + 1], points[:falls[0] + 1], heights[:falls[0] + 1]
+    if len(spine) < 2 or not high > low:
+        return {}
+    arc = arc_lengths(points)
+    result = {}
+    for role, share in (("hips", tuning.hips_at), ("spine", tuning.spine_at), ("chest", tuning.chest_at),
+                        ("neck", tuning.neck_at)):
+        level = low + share * (high - low)
+        if level >= heights[0] or not hip_joints:
+            result[(role, None, None)] = _on_bones(graph, ends, spine, arc, ((_up_to(heights, arc, level), 1.0),))
+        else:  # between the spine's start and the middle of the hip joints
+            weight = (heights[0] - level) / max(heights[0] - low, 1e-300)
+            start = _on_bones(graph, ends, spine, arc, ((0.0, 1.0 - weight),))
+            share = weight / len(hip_joints)
+            result[(role, None, None)] = start + tuple((bone, at, part * share) for place in hip_joints
+                                                       for bone, at, part in place)
+    return result
+
+
+def _up_to(heights, arc, level):
+    """Arc position where a path with these ``heights`` first rises to ``level`` (its end when it never does)."""
+    return _down_to(-heights, arc, -level)
+
+
+def _on_bones(graph, ends, nodes, arc, spots):
+    """The place of ``spots`` (``((arc position, weight), ...)`` along the path through ``nodes``, measured on
+    points whose arc lengths are ``arc``: a twin's mirror-averaged ones): the same shares of the path's own links (or
+    on past its end, along its last link), each a share of the way along a bone, or between two bones' ends where a
+    link has no bone."""
+    place = []
+    last = len(nodes) - 2
+    for at, weight in spots:
+        k = min(max(int(np.searchsorted(arc, at, side="right")) - 1, 0), last)
+        share = max((at - arc[k]) / max(arc[k + 1] - arc[k], 1e-300), 0.0)
+        share = float(share if k == last else min(share, 1.0))  # on past the last joint: a tip
+        a, b = nodes[k], nodes[k + 1]
+        bone = graph.bone_between(a, b)
+        if bone >= 0:
+            place.append((bone, share if graph.head_node[bone] == a else 1.0 - share, weight))
+        else:
+            place += [(*ends[a], weight * (1.0 - share)), (*ends[b], weight * share)]
+    return tuple(place)
+
+
+def _down_to(heights, arc, level):
+    """Arc position where a path with these ``heights`` first comes down to ``level`` (its end when it never
+    does; its start when it starts below)."""
+    below = np.flatnonzero(heights <= level)
+    if not len(below):
+        return float(arc[-1])
+    i = int(below[0])
+    if i == 0:
+        return 0.0
+    drop = heights[i - 1] - heights[i]
+    return float(arc[i - 1] + (arc[i] - arc[i - 1]) * (heights[i - 1] - level) / max(drop, 1e-300))
+
+
+def _leg_places(body, points, arc, front, tuning):
+    """{role: spots} along a leg's path: the ankle where it comes down to ``ankle_height``, the hip joint at
+    ``hip_rise`` of the height from the ankle to where the leg hangs, on the line of the thigh when that stands
+    within ``thigh_lean`` of up (the path from the knee halfway up to the hip, carried on up: the path may reach the
+    hip slanting in from the body's middle; a bent hind leg's thigh line leads elsewhere), the
+    knee at ``knee_at`` of the way between (a bend near there winning), the toe at ``toe_at`` of the way from the
+    ankle to the tip."""
+    heights = body.height(points)
+    ankle = _down_to(heights, arc, tuning.ankle_height)
+    ankle_height = float(np.interp(ankle, arc, heights))
+    hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
+    hip = _down_to(heights, arc, hip_height)
+    knee = _bent(points, arc, hip, hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
+    tip = arc[-1] + _reach(body, points)
+    toe = ankle + tuning.toe_at * (tip - ankle)
+    thigh = 0.5 * (hip + knee)
+    line = _along(points, arc, thigh) - _along(points, arc, knee)
+    rise = float(line @ body.up)
+    carry = (hip_height - float(np.interp(thigh, arc, heights))) / rise * (body.high - body.low) if rise > 0 else 0
+    upright = rise >= np.cos(np.radians(tuning.thigh_lean)) * np.linalg.norm(line)
+    hip_spots = ((thigh, 1.0 + carry), (knee, -carry)) if upright and 0 < carry <= 2 else ((hip, 1.0),)
+    names = ("upper_arm", "forearm", "hand", None, "hand_tip") if front else \
+        ("thigh", "shin", "foot", "toe", "toe_tip")
+    places = {name: spots for name, spots in zip(names, (hip_spots, ((knee, 1.0),), ((ankle, 1.0),), ((toe, 1.0),),
+                                                         ((tip, 1.0),))) if name}
+    heel = None if front else _heel(body, points, arc, knee, ankle, tip, tuning)
+    if heel is not None:
+        places["heel"] = heel
+    return places
+
+
+def _heel(body, points, arc, knee, ankle, tip, tuning):
+    """Spots of the heel: on the ground under the back of the foot (the mesh's hindmost vertex there, along the
+    foot's way from the ankle to the toe's tip, within ``heel_width`` of its line), as weights of the knee, the ankle
+    and the toe's tip (the leg's own plane); None when they are in line or the foot points nowhere."""
+    corners = np.array([_along(points, arc, at) for at in (knee, ankle, tip)])
+    ankle_point, up = corners[1], body.up
+    forward = corners[2] - ankle_point
+    forward -= (forward @ up) * up
+    if not np.linalg.norm(forward) > 0:
+        return None
+    forward /= np.linalg.norm(forward)
+    across = np.cross(up, forward)
+    offsets = body.vertices - ankle_point
+    near = (np.abs(offsets @ across) <= tuning.heel_width * body.size) & (offsets @ up <= 0) \
+        & (np.abs(offsets @ forward) <= np.linalg.norm(corners[2] - ankle_point))
+    if not near.any():
+        return None
+    heel = ankle_point + float((offsets[near] @ forward).min()) * forward + (body.low - ankle_point @ up) * up
+    sides = np.stack([corners[0] - corners[2], corners[1] - corners[2]], axis=1)
+    weights, _, rank, _ = np.linalg.lstsq(sides, heel - corners[2], rcond=None)
+    if rank < 2:
+        return None
+    return ((knee, float(weights[0])), (ankle, float(weights[1])), (tip, float(1.0 - weights.sum())))
+
+
+def _arm_places(body, limb, points, arc, tuning):
+    """{role: spots} along an arm's path: the collarbone's start ``clavicle_at`` of the way to the shoulder joint,
+    the shoulder joint as :func:`_shoulder` finds it, the elbow and the wrist
+    at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the reach (a bend near the elbow winning;
+    the wrist no farther than where the fingers fork)."""
+    nodes = list(limb.main)
+    total = arc[-1] + _reach(body, points)
+    shoulder = float(arc[min(_shoulder(body, nodes, arc, total, tuning), len(nodes) - 1)])
+    rest = total - shoulder
+    elbow, wrist = (shoulder + share * rest for share in (tuning.elbow_at, tuning.wrist_at))
+    elbow = _bent(points, arc, shoulder, elbow, wrist, rest, tuning)
+    forks = [arc[_fork(path, nodes)] for path in _paths(limb)[1:]]
+    if forks and min(forks) > elbow:
+        wrist = min(wrist, min(forks))
+    return {"shoulder": ((tuning.clavicle_at * shoulder, 1.0),), "upper_arm": ((shoulder, 1.0),),
+            "forearm": ((elbow, 1.0),), "hand": ((min(wrist, arc[-1]), 1.0),), "hand_tip": ((total, 1.0),)}
+
+
+def _bent(points, arc, start, middle, end, length, tuning):
+    """Arc position of a limb's middle joint (an elbow, a knee) between ``start`` and ``end``: the joint within
+    ``bend_window`` of the limb's ``length`` from ``middle`` where the limb bends most (:func:`_bend`, seen from
+    ``start`` and ``end``), when it bends by ``bend`` or more, else ``middle``."""
+    first, last = _along(points, arc, start), _along(points, arc, end)
+    best, turn = middle, tuning.bend
+    for i in range(1, len(points) - 1):
+        if start < arc[i] < end and abs(arc[i] - middle) <= tuning.bend_window * length:
+            angle = _bend(points[i], first, last)
+            if angle >= turn:
+                best, turn = float(arc[i]), angle
+    return best
+
+
+def _along(points, arc, at):
+    """The point at arc length ``at`` along ``points`` (whose arc lengths are ``arc``), on past the last point
+    along the last link as :func:`_on_bones` places it."""
+    k = min(max(int(np.searchsorted(arc, at, side="right")) - 1, 0), len(points) - 2)
+    share = max((at - arc[k]) / max(arc[k + 1] - arc[k], 1e-300), 0.0)
+    return points[k] + (share if k == len(points) - 2 else min(share, 1.0)) * (points[k + 1] - points[k])
 
 
 @dataclass(frozen=True, eq=False)
