@@ -5,10 +5,10 @@ The naming scheme (one for every body plan; the README says the same for users):
 
 - ``root``: the hierarchy's single root, on the ground under the hips (the mesh's lowest point along the plan's up),
   pointing up; it deforms nothing. ``Hips`` hangs from it and everything else from ``Hips``.
-- The trunk, from the hips joint (where the legs hang) to where the neck begins: ``Hips`` up to the spine joint (where
-  Rigger's ``spine`` role begins), then ``Spine``, ``Spine1``, ``Spine2``, the last from the chest joint (where
-  ``chest`` begins). A missing joint is put where Mixamo's humanoids have it: the spine joint at ``SPINE_AT`` and the
-  chest joint at ``CHEST_AT`` of the trunk's length; ``Spine1`` halfway between them.
+- The trunk, from the hips joint (where the legs hang) to where the neck begins: ``Hips`` up to the spine joint (the
+  named joint where the ``spine`` role begins), then ``Spine``, ``Spine1``, ``Spine2``, the last from the chest joint
+  (where ``chest`` begins). A missing joint is put where Mixamo's humanoids have it: the spine joint at ``SPINE_AT``
+  and the chest joint at ``CHEST_AT`` of the trunk's length; ``Spine1`` halfway between them.
 - Every other role is one bone per chain of that role, Rigger's bones of the chain merged into it, named with
   Mixamo's word for the role: ``Neck``, ``Head``, ``Jaw``, ``Shoulder``, ``Arm`` (upper arm), ``ForeArm``, ``Hand``,
   ``UpLeg`` (thigh), ``Leg`` (shin), ``Foot``, ``ToeBase``; sided ones get ``Left`` / ``Right`` before the word
@@ -22,6 +22,10 @@ The naming scheme (one for every body plan; the README says the same for users):
 - A second chain of the same name (a second pair of arms) gets ``_2`` after the name (``LeftArm_2``), a third ``_3``:
   chains are numbered from the highest start down.
 
+Each bone with a Mixamo name begins at its role's named joint (``core.roles.named_joints``: a knee where the artists'
+rigs have it, which may lie inside a bone of Rigger's), the bones ending there moved with it, unless that would all
+but remove a bone (``_Bones.at_named_joints``).
+
 The hierarchy is Rigger's read from the hips outwards (Rigger may root a quadruped at its neck): a chain hangs from the
 game bone that holds the joint it starts from. Twins (``Left…`` and ``Right…`` bones that mirror each other within
 ``TWIN_TOLERANCE`` of the size) get exactly mirrored points across the mirror plane.
@@ -30,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .roles import BoneRole
+from .roles import BoneRole, named_joints
 from .skeleton import Skeleton
 
 ROOT = "root"
@@ -38,6 +42,7 @@ SPINE_AT = 0.2  # share of the trunk from the hips joint to the neck where Mixam
 CHEST_AT = 0.7  # ... and Spine2 (0.7)
 TWIN_TOLERANCE = 0.02  # twins whose points mirror within this share of the size are mirrored exactly
 ROOT_LENGTH = 0.1  # the root bone's length, a share of the size
+KEEP_LENGTH = 0.5  # a bone keeps at least this share of its length when its end moves to a named joint
 MERGE_TOLERANCE = 1e-9  # points this close (a share of the size) are one joint
 
 WORDS = {"hips": "Hips", "neck": "Neck", "head": "Head", "jaw": "Jaw", "shoulder": "Shoulder", "upper_arm": "Arm",
@@ -72,7 +77,8 @@ def game_skeleton(skeleton, vertices):
     start = graph.hips_node()
     order, arriving = graph.oriented(start)
     chains = graph.chains(order, arriving)
-    bones = _Bones(graph)
+    joints = named_joints(skeleton)
+    bones = _Bones(graph, joints)
     trunk = next((chain for chain in chains if chain.key == ("trunk", None, None) and chain.nodes[0] == start), None)
     if trunk is not None:
         bones.trunk(trunk)
@@ -80,9 +86,10 @@ def game_skeleton(skeleton, vertices):
         if chain is not trunk:
             bones.chain(chain)
     bones.name_instances(up)
+    bones.at_named_joints(MERGE_TOLERANCE * size)
     names, heads, tails, parents, roles = bones.finished(start, arriving)
     heads, tails = _mirrored_twins(names, heads, tails, skeleton.stages.get("mirror_plane"), size)
-    hips = graph.points[start]
+    hips = heads[bones.hips] if bones.hips is not None else graph.points[start]
     ground = float((vertices @ up).min()) if len(vertices) else float(hips @ up)
     foot = hips - (hips @ up - ground) * up
     names = [ROOT, *names]
@@ -247,8 +254,9 @@ class _Chain:
 class _Bones:
     """Game bones being made: name parts, points, the chain they come from and which graph edges they own."""
 
-    def __init__(self, graph):
+    def __init__(self, graph, joints):
         self.graph = graph
+        self.joints = joints  # named joints, {(role, side, digit): point}
         self.bones = []  # dicts: base, number, side, points (head, tail), role, start node, chain id
         self.edge_owner = {}  # graph edge -> game bone index
         self.node_owner = {}  # graph node -> the game bone that holds it (children hang from it)
@@ -274,8 +282,11 @@ class _Bones:
         role_at = [roles[graph.edges[edge][2]].role if graph.edges[edge][2] >= 0 else None for edge in chain.edges]
 
         def begins(names, share):
+            named = next((self.joints[(name, None, None)] for name in names if (name, None, None) in self.joints),
+                         None)
             at = next((k for k, role in enumerate(role_at) if role in names), None)
-            return arc[at] if at is not None and 0 < arc[at] < total else share * total
+            along = _arc_nearest(points, arc, named) if named is not None else arc[at] if at is not None else None
+            return along if along is not None and 0 < along < total else share * total
 
         spine = begins(("spine", "chest"), SPINE_AT)
         chest = begins(("chest",), CHEST_AT)
@@ -342,6 +353,26 @@ class _Bones:
                     if bone["chain"] == chain:
                         bone["suffix"] = f"_{count}"
 
+    def at_named_joints(self, tolerance):
+        """Move the head of each first bone of a Mixamo name to its role's named joint, with the bones ending there
+        (siblings starting there have joints of their own). A named joint farther than the bone's length, or one that
+        would shrink a bone below ``KEEP_LENGTH`` of its length, is not this chain's: those ends stay."""
+        for bone in self.bones:
+            role = bone["role"]
+            key = (role.role, role.side, None)
+            if bone["number"] or bone["suffix"] or role.index or key not in self.joints:
+                continue
+            old, new = bone["head"].copy(), np.asarray(self.joints[key], float)
+            ending = [other for other in self.bones if np.linalg.norm(other["tail"] - old) <= tolerance]
+            if not tolerance < np.linalg.norm(new - old) <= np.linalg.norm(bone["tail"] - old):
+                continue
+            if any(np.linalg.norm(end - start) < KEEP_LENGTH * np.linalg.norm(end - old)
+                   for end, start in [(bone["tail"], new)] + [(other["head"], new) for other in ending]):
+                continue  # a bone would all but vanish: the joint is not this chain's
+            bone["head"] = new.copy()
+            for other in ending:
+                other["tail"] = new.copy()
+
     def finished(self, start, arriving):
         """(names, heads, tails, parents, roles): each bone hangs from the game bone holding the joint its chain
         starts at (the Hips at the hips node), or from the bone before it in its chain."""
@@ -383,6 +414,16 @@ def _point_at(points, arc, at):
     span = arc[k + 1] - arc[k]
     share = 0.0 if span <= 0 else (at - arc[k]) / span
     return points[k] + np.clip(share, 0.0, 1.0) * (points[k + 1] - points[k])
+
+
+def _arc_nearest(points, arc, point):
+    """The arc length along the polyline ``points`` (cumulative lengths ``arc``) of its point nearest ``point``."""
+    starts, steps = points[:-1], np.diff(points, axis=0)
+    lengths = np.einsum("ij,ij->i", steps, steps)
+    shares = np.clip(np.einsum("ij,ij->i", point - starts, steps) / np.where(lengths > 0, lengths, 1), 0, 1)
+    distances = np.linalg.norm(starts + shares[:, None] * steps - point, axis=1)
+    k = int(np.argmin(distances))
+    return float(arc[k] + shares[k] * (arc[k + 1] - arc[k]))
 
 
 def _finger_spans(points, real):
