@@ -6,6 +6,7 @@ import bpy
 
 from ..core.skeleton import Skeleton
 from .armature import build_armature
+from .rigify import build_rigify
 
 
 @dataclass
@@ -19,15 +20,16 @@ class Built:
     warnings: list = field(default_factory=list)
 
 
-def build(target, skeleton, name, collection, frame):
+def build(target, skeleton, name, collection, frame, mesh=None):
     """Build ``skeleton`` as ``target``'s armature (a ``core.targets.Target``) named ``name`` in ``collection``;
-    ``frame`` is the rigged object's rotation (``armature.build_armature``). A :class:`Built`."""
-    return BUILDERS[target.name](skeleton, name, collection, frame)
+    ``frame`` is the rigged object's rotation (``armature.build_armature``), ``mesh`` the rigged (vertices,
+    triangles) in the world. A :class:`Built`."""
+    return BUILDERS[target.name](skeleton, name, collection, frame, mesh)
 
 
-def _plain(skeleton, name, collection, frame):
+def _plain(skeleton, name, collection, frame, mesh=None):
     """The method's bones as they are."""
     return Built(build_armature(skeleton, name, collection, frame=frame), skeleton)
 
 
-BUILDERS = {"plain": _plain}
+BUILDERS = {"plain": _plain, "rigify": build_rigify}

@@ -30,6 +30,8 @@ class Target:
 
 TARGETS = {target.name: target for target in (
     Target("plain", "Plain", "The method's bones as they are, named by part (trunk, limbs, sides)"),
+    Target("rigify", "Rigify", "Rigify's control rig (IK/FK, editable metarig) from its metarig fitted to the mesh",
+           ("humanoid", "quadruped"), "plain"),
 )}
 
 
