@@ -20,11 +20,12 @@ import bpy
 import numpy as np
 from mathutils import Matrix, Vector
 
-from ..core.metarig import MetaBone, choose_metarig, fit_metarig
+from ..core.metarig import METARIGS, MetaBone, choose_metarig, fit_metarig
 from ..core.skeleton import Skeleton
 
 ADDON = "rigify"
 METARIG_PROPERTY = "rigger_metarig"  # custom property on the generated rig: its metarig object
+KIND_PROPERTY = "rigger_metarig_kind"  # custom property on the metarig: which of Rigify's metarigs it is
 DEFORM_PREFIX, ORIGINAL_PREFIX = "DEF-", "ORG-"  # Rigify's deforming bones and the metarig's bones in the rig
 
 
@@ -85,7 +86,7 @@ def _object_mode():
 
 def add_metarig(metarig_name, name, collection):
     """Rigify's metarig ``metarig_name`` (``human``, ``basic_quadruped``, ...) as a new object ``name`` at the origin,
-    in ``collection`` only."""
+    in ``collection`` only, with the bones ``core.metarig`` adds to it (``MetarigSpec.added``)."""
     operator = getattr(bpy.ops.object, f"armature_{metarig_name}_metarig_add", None)
     if operator is None:
         raise ValueError(f"Rigify has no {metarig_name} metarig in this Blender")
@@ -94,11 +95,37 @@ def add_metarig(metarig_name, name, collection):
         operator()
     metarig = next(obj for obj in bpy.data.objects if obj not in before and obj.type == 'ARMATURE')
     metarig.name = metarig.data.name = name
+    metarig[KIND_PROPERTY] = metarig_name
     for other in list(metarig.users_collection):
         other.objects.unlink(metarig)
     collection.objects.link(metarig)
     metarig.matrix_world = Matrix.Identity(4)
+    added = METARIGS[metarig_name].added
+    if added:
+        _edit(metarig, lambda bones: [_new_bone(bones, bone) for bone, _ in added])
+        for bone, rig_type in added:
+            metarig.pose.bones[bone.name].rigify_type = rig_type
     return metarig
+
+
+def _new_bone(bones, data):
+    bone = bones.new(data.name)
+    bone.head, bone.tail = Vector(data.head), Vector(data.tail)
+    bone.align_roll(Vector(data.z_axis))
+    bone.parent = bones[data.parent]
+    bone.use_connect = data.connected
+
+
+def _edit(armature, change):
+    """Run ``change(edit_bones)`` on ``armature`` in Edit Mode, back in Object Mode after."""
+    view_layer = bpy.context.view_layer
+    view_layer.objects.active = armature
+    armature.select_set(True)
+    bpy.ops.object.mode_set(mode='EDIT')
+    try:
+        change(armature.data.edit_bones)
+    finally:
+        bpy.ops.object.mode_set(mode='OBJECT')
 
 
 def read_metarig(metarig):
@@ -113,20 +140,16 @@ def read_metarig(metarig):
 
 def place_bones(metarig, fit):
     """Move the metarig's bones where ``fit`` (a ``core.metarig.Fit``) puts them, remove the ones it removed (their
-    children hang from the nearest kept bone above) and roll each as the metarig rolled it, in Edit Mode."""
-    view_layer = bpy.context.view_layer
-    view_layer.objects.active = metarig
-    metarig.select_set(True)
-    bpy.ops.object.mode_set(mode='EDIT')
-    try:
-        bones = metarig.data.edit_bones
+    children hang from the nearest kept bone above) and roll each as the metarig rolled it; a bone stays connected
+    to its parent where its head still lies on the parent's tail."""
+    def change(bones):
         connected = {bone.name for bone in bones if bone.use_connect}
+        ends = np.array([end for name in fit.heads for end in (fit.heads[name], fit.tails[name])])
+        size = max(float(np.ptp(ends, axis=0).max()), 1e-300)
         removed = set(fit.removed)
         for bone in bones:
             bone.use_connect = False
         for bone in bones:
-            if bone.name in removed:
-                continue
             parent = bone.parent
             while parent is not None and parent.name in removed:
                 parent = parent.parent
@@ -138,10 +161,11 @@ def place_bones(metarig, fit):
             bone.head, bone.tail = Vector(fit.heads[name]), Vector(fit.tails[name])
             bone.align_roll(Vector(fit.z_axes[name]))
         for bone in bones:
-            if bone.name in connected and bone.parent is not None and (bone.head - bone.parent.tail).length < 1e-6:
+            if bone.name in connected and bone.parent is not None and \
+                    (bone.head - bone.parent.tail).length <= 1e-6 * size:
                 bone.use_connect = True
-    finally:
-        bpy.ops.object.mode_set(mode='OBJECT')
+
+    _edit(metarig, change)
 
 
 def generate(metarig, rig):

@@ -4,14 +4,16 @@ mesh. The Blender layer (``rigger.blender.rigify``) adds the real metarig, reads
 moves them where the fit says and lets Rigify generate the control rig.
 
 The metarigs (:data:`METARIGS`): a humanoid whose hands show named fingers gets Rigify's ``human`` (palms and three
-bones a finger), other humanoids ``basic_human``; a quadruped ``basic_quadruped`` (the metarig whose every bone the
-skeleton can place: Rigify's wolf, cat and horse add faces, manes and hooves no skeleton shows); a bird ``bird``.
-Fish and serpents get none (Rigify's shark fits a shark, and a body plan cannot tell it from a snake).
+bones a finger), other humanoids ``basic_human``; a quadruped ``basic_quadruped``, the generic one (paws, whose every
+bone the skeleton can place: Rigify's wolf, cat and horse add faces, manes and hooves no skeleton shows), with ears and
+a jaw added as Rigify's horse has them (two-bone simple tentacles on the head) when the skeleton shows them; a bird
+``bird`` (a bird with legs: a bird in flight whose skeleton is two wings has no body to hang a rig from). Fish and
+serpents get none (Rigify's shark fits a shark, and a body plan cannot tell it from a snake).
 
 How the bones are placed, in order:
 
-- The character's frame: up is the body plan's; the front is where the feet point (from the ankle to the toe tip),
-  else, for an animal, from the tail end of the spine to the head end, else the front of a figure whose left is its
+- The character's frame: up is the body plan's; the front is, for an animal, from the torso's middle to the head,
+  for a humanoid where the feet point (from the ankle to the toe tip), else the front of a figure whose left is its
   ``.L`` side (Blender's convention); left = up x front. Rigify expects Z up and the front at -Y in the armature's own
   space, so the metarig gets this frame as its rotation and its bones are placed in it. A skeleton whose ``.L`` limbs
   lie on the character's right has its sides swapped: Rigify's ``.L`` bones go on the character's left.
@@ -21,18 +23,27 @@ How the bones are placed, in order:
 - On that path, a metarig joint between bones of two roles sits where the skeleton's next role begins (a knee where
   the shin begins), or where the one before ends when the next is missing; the other joints divide the stretch
   between such joints in the metarig's own proportions and move onto a skeleton joint near them (the skeleton's
-  joints sit where the mesh bends): a skeleton without a toe gets its foot split at the metarig's ball.
+  joints sit where the mesh bends): a skeleton without a toe gets its foot split at the metarig's ball. A chain
+  whose last roles the skeleton lacks goes on into the mesh, as long as the metarig's proportions make them, when
+  the mesh goes on there (an arm ending at the wrist gets its hand); else they share the stretch of the last role
+  (a leg whose shin reaches the ground gets its foot and toe from the shin's lower part).
 - Limbs that Rigify bends with IK (legs, arms, paws): the joint between their first two bones is moved, when it does
   not already bend that way by ``bend`` of the limb's reach, so that knees bend forward and elbows backward (Rigify
-  takes the bend direction from the chain).
+  takes the bend direction from the chain); a limb bent sideways leans at most ``tilt`` from that. An animal's hind
+  leg whose first joint bends backward is read one joint down: that joint is its hock, and its knee (hidden in the
+  body) goes where the metarig has it relative to the hip and the hock. A joint the skeleton bends the wrong way by more than ``bend_move`` stays (the fit says so).
 - Twins that mirror within ``mirror_tolerance`` of the size are made exact mirror images across the midline.
 - The heel (Rigify's ``heel.02``, the foot's rocking edge) runs across the back of the foot on the ground, from the
   mesh: the foot's vertices below the ankle, their rearmost and their width.
 - Palms run from inside the hand (where the metarig's do, as a share of the way from the wrist) to their finger.
-- Derived bones (pelvis, breast: Rigify's deforming helpers) keep their place relative to the joints around them:
-  the metarig's position scaled per axis by how the nearest placed joints moved.
-- Bones whose part the skeleton lacks are removed with everything hanging from them: a tail, an arm, the fingers of a
-  hand that shows none, and the face of Rigify's human (a face rig needs eyes, lids and lips that no skeleton shows).
+- Chains start exactly where the metarig starts them on another chain (the neck at the torso's end, the tail at its
+  start): Rigify connects such chains only when their ends coincide.
+- Derived bones (pelvis, breast: Rigify's deforming helpers) keep their place among the joints around them: each
+  nearest placed joint carries the metarig's point at its own offset, scaled by how much the fit spread those
+  joints, weighted by inverse square distance.
+- Bones whose part the skeleton lacks are removed (what hangs from them hangs from the nearest kept bone above): a
+  tail, an arm, ears, the fingers of a hand that shows none, and the face of Rigify's human (a face rig needs eyes,
+  lids and lips that no skeleton shows).
 """
 from dataclasses import dataclass, field
 
@@ -55,6 +66,15 @@ class MetarigTuning(TuningTable):
     straight: float = tuned(0.05, "a limb whose middle joint lies less than this share of its reach sideways off the "
                                   "plane of its bend is straight there: Rigify's IK then bends it exactly the way it "
                                   "bends (a limb bent more keeps its pose)")
+    tilt: float = tuned(30.0, "degrees: a limb's bend leans at most this far sideways from the way it should bend "
+                              "(further, IK bends it more sideways than forward)")
+    bend_move: float = tuned(0.2, "a limb's middle joint moves at most this share of its reach to bend the right "
+                                  "way; a skeleton bending it further the wrong way keeps its joint (its roles are "
+                                  "likely wrong there; the ../shared models need up to 0.18, then 0.3 and more)")
+    extend: float = tuned(0.4, "a chain whose last roles the skeleton lacks (an arm ending at the wrist) goes on "
+                                "into the mesh when the mesh goes on for at least this share of what the metarig's "
+                                "proportions give them; else they share the last role's stretch (a leg reaching the "
+                                "ground)")
     snap: float = tuned(0.3, "a joint placed by the metarig's proportions moves onto a skeleton joint within this "
                              "share of the shorter of its two bones")
     mirror_tolerance: float = tuned(0.03, "twin chains whose joints mirror within this are made exact mirror images "
@@ -85,13 +105,16 @@ class Chain:
     """A run of metarig ``bones`` (``{s}`` stands for the side, ``L`` or ``R``, of a ``sided`` chain) and the roles
     each takes: a role name, or a tuple of role names the bone spans with its neighbours of the same tuple (the
     torso's hips, spine and chest). ``digit``: the finger whose bones the ``finger`` roles are; a chain whose first
-    role is ``palm`` starts at the wrist. ``bend``: ``FORWARD`` or ``BACKWARD`` for a limb Rigify bends with IK."""
+    role is ``palm`` starts at the wrist. ``bend``: ``FORWARD`` or ``BACKWARD`` for a limb Rigify bends with IK;
+    ``hock``: the roles its bones take instead when its first joint bends the other way (an animal's hind leg whose
+    first bend is the hock, its knee hidden in the body above)."""
 
     bones: tuple
     roles: tuple
     sided: bool = False
     bend: int = 0
     digit: str = None
+    hock: tuple = None
 
     def names(self, side):
         return tuple(bone.replace("{s}", side or "") for bone in self.bones)
@@ -100,11 +123,27 @@ class Chain:
 @dataclass(frozen=True)
 class MetarigSpec:
     """How a metarig's bones are placed: its ``chains``, the ``derived`` bones that keep their place among the
-    placed joints, and the ``heels`` placed from the mesh (``{s}``: the side)."""
+    placed joints, and the ``heels`` placed from the mesh (``{s}``: the side); ``added``: (``MetaBone``, Rigify rig
+    type or "") of bones Rigger adds to Rigify's metarig first."""
 
     chains: tuple
     derived: tuple = ()
     heels: tuple = ()
+    added: tuple = ()
+
+
+def _tentacle(name, points, parent, z_axis):
+    """``MetaBone`` data of a chain of bones ``name.01``, ``name.02``... along ``points`` hanging from ``parent``
+    (``{s}`` in ``name``: ``.L`` and ``.R`` twins, mirrored across X), the first with Rigify's simple tentacle."""
+    base, suffixes = (name[:-4], (".L", ".R")) if name.endswith(".{s}") else (name, ("",))
+    added = []
+    for suffix in suffixes:
+        flip = np.array([-1.0 if suffix == ".R" else 1.0, 1.0, 1.0])
+        for k, (head, tail) in enumerate(zip(points, points[1:]), start=1):
+            bone = MetaBone(f"{base}.{k:02d}{suffix}", tuple(np.multiply(head, flip)), tuple(np.multiply(tail, flip)),
+                            parent if k == 1 else f"{base}.{k - 1:02d}{suffix}", z_axis, k > 1)
+            added.append((bone, "limbs.simple_tentacle" if k == 1 else ""))
+    return tuple(added)
 
 
 def _human_chains(fingers):
@@ -134,10 +173,25 @@ METARIGS = {
         Chain(("shoulder.{s}",), ("shoulder",), sided=True),
         Chain(("front_thigh.{s}", "front_shin.{s}", "front_foot.{s}", "front_toe.{s}"),
               ("upper_arm", "forearm", "hand", "hand"), True, BACKWARD),
-        Chain(("thigh.{s}", "shin.{s}", "foot.{s}", "toe.{s}"), ("thigh", "shin", "foot", "toe"), True, FORWARD),
-    ), ("pelvis.{s}", "breast.{s}")),
+        Chain(("thigh.{s}", "shin.{s}", "foot.{s}", "toe.{s}"), ("thigh", "shin", "foot", "toe"), True, FORWARD,
+              hock=("thigh", "thigh", "shin", ("foot", "toe"))),
+        Chain(("ear.01.{s}", "ear.02.{s}"), ("ear", "ear"), sided=True),
+        Chain(("jaw.01", "jaw.02"), ("jaw", "jaw")),
+    ), ("pelvis.{s}", "breast.{s}"), added=(  # ears and a jaw as Rigify's horse metarig has them
+        *_tentacle("ear.{s}", ((0.05, -0.5, 0.93), (0.07, -0.51, 0.99), (0.09, -0.52, 1.05)), "spine.011",
+                   (0.0, -1.0, 0.0)),
+        *_tentacle("jaw", ((0.0, -0.5, 0.85), (0.0, -0.58, 0.82), (0.0, -0.66, 0.81)), "spine.011",
+                   (0.0, 0.0, 1.0)))),
+    "bird": MetarigSpec((
+        Chain(("spine.003", "spine.004", "spine.005", "spine.006"), (TORSO,) * 4),
+        Chain(("neck.001", "neck.002", "head"), ("neck", "neck", "head")),
+        Chain(("spine.002", "spine.001", "spine"), ("tail",) * 3),
+        Chain(("shoulder.{s}",), ("shoulder",), sided=True),
+        Chain(("Wing.{s}", "Wing.001.{s}", "Wing.002.{s}"), ("wing",) * 3, sided=True),
+        Chain(("thigh.{s}", "shin.{s}", "foot.{s}", "toe.{s}"), ("thigh", "shin", "foot", "toe"), True, BACKWARD),
+    ), ("pelvis.{s}",)),
 }
-PLAN_METARIGS = {"humanoid": ("human", "basic_human"), "quadruped": ("basic_quadruped",)}
+PLAN_METARIGS = {"humanoid": ("human", "basic_human"), "quadruped": ("basic_quadruped",), "bird": ("bird",)}
 
 
 def choose_metarig(skeleton):
@@ -200,8 +254,9 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
             anchors += [(np.asarray(meta[name].head, float), points[k]) for k, name in enumerate(names)]
             anchors.append((np.asarray(meta[names[-1]].tail, float), points[-1]))
     units = [chain.names("L") for chain in spec.chains if chain.sided]
-    midline = [name for chain in spec.chains if not chain.sided for name in chain.names(None)]
+    midline = [chain.names(None) for chain in spec.chains if not chain.sided]
     middle = _mirror_twins(fit, units, midline, tuning.mirror_tolerance * body.size)
+    _join_chains(fit, spec, meta)
     for template in spec.heels:
         for side in "LR":
             name = template.replace("{s}", side)
@@ -218,9 +273,11 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
                                                              tuning) for point in (bone.head, bone.tail))
     extra = [[template.replace("{s}", "L")] for template in spec.heels + spec.derived]
     _mirror_twins(fit, extra, (), tuning.mirror_tolerance * body.size, middle)
+    chained = {name for chain in spec.chains for side in _sides(chain) for name in chain.names(side)}
     for name in fit.heads:
         fit.z_axes[name] = np.asarray(meta[name].z_axis, dtype=np.float64)
-        _keep_length(fit, name, body.size * tuning.shortest)
+        if name not in chained:
+            _keep_length(fit, name, body.size * tuning.shortest)
     fit.removed = _removed(meta, fit.heads)
     fit.notes = _notes(spec, meta, fit, body)
     return fit
@@ -239,6 +296,7 @@ class _Body:
         ends = np.concatenate([skeleton.heads, skeleton.tails])
         self.size = float(np.ptp(np.concatenate([ends, vertices]), axis=0).max())
         self.tuning = tuning
+        self.notes = []  # what the fit could not do as it should, in words
         self.node = _merged_ends(ends, tuning.merge * self.size)
         count = len(skeleton)
         self.head_node, self.tail_node = self.node[:count], self.node[count:]
@@ -271,12 +329,16 @@ class _Body:
                 and (digit is None or role.digit == digit)]
 
     def _front(self):
-        """The character's front, across up: for an animal from the tail end of its spine to the head end, else
-        where its feet point, else (a humanoid without feet) the front of a figure whose ``.L`` side is its left,
+        """The character's front, across up: for an animal from the torso's middle to its head (else its neck,
+        else from its tail to the torso's middle, else from its hips to its chest), else where its feet point, else (a humanoid without feet) the front of a figure whose ``.L`` side is its left,
         else Blender's -Y."""
         animal = self.skeleton.body_plan.kind != "humanoid"
-        head, tail = self.bones_of(("head", "neck"), None), self.bones_of(("tail", "hips"), None)
-        spine = [self.middle(head) - self.middle(tail)] if animal and head and tail else []
+        spine = []
+        for ahead, behind in ((("head",), None), (("neck",), None), (None, ("tail",)), (("chest",), ("hips",))):
+            front_bones, back_bones = (self.bones_of(roles, None) if roles else None for roles in (ahead, behind))
+            if animal and front_bones != [] and back_bones != []:
+                spine.append((self.middle(front_bones) if front_bones else self.centre) -
+                             (self.middle(back_bones) if back_bones else self.centre))
         lefts, rights = (self.bones_of(("upper_arm", "forearm", "thigh", "shin"), side) for side in ("L", "R"))
         sides = [np.cross(self.middle(lefts) - self.middle(rights), self.up)] if lefts and rights else []
         for direction in spine + self._feet() + sides + [np.array([0.0, -1.0, 0.0]), np.array([0.0, 0.0, 1.0])]:
@@ -299,9 +361,9 @@ class _Body:
 
     def path(self, bones, order, side):
         """Points (K, 3) of the longest path through ``bones`` and the bone of each step, from the body outwards:
-        ``order(bone)`` ranks a bone's role along the chain (the path runs from low to high rank; the end nearer
-        the torso's middle first when all ranks tie). Of several pieces, the longest (on side ``side``, the one
-        farthest out on it)."""
+        ``order(bone)`` ranks a bone's role along the chain (the path runs from low to high rank; when all ranks
+        tie, from the end where the piece hangs from the rest of the skeleton, else from the end nearer the torso's
+        middle). Of several pieces, the longest (on side ``side``, the one farthest out on it)."""
         pieces = _pieces(bones, self.head_node, self.tail_node)
         if side is not None:
             sign = 1 if side == self.side_map["L"] else -1
@@ -316,11 +378,21 @@ class _Body:
         if np.ptp(ranks) > 0:
             flip = np.corrcoef(along, ranks)[0, 1] < 0 if len(steps) > 1 else False
         else:
+            attached = self._attached(piece)
             first, last = (np.linalg.norm(self.points[node] - self.centre) for node in (nodes[0], nodes[-1]))
-            flip = last < first
+            flip = nodes[-1] in attached if (nodes[0] in attached) != (nodes[-1] in attached) else last < first
         if flip:
             nodes, steps = nodes[::-1], steps[::-1]
         return self.points[nodes], steps
+
+    def _attached(self, piece):
+        """The joints where bones outside ``piece`` hang from it or it hangs from them (by parent links)."""
+        inside = set(piece)
+        parents = self.skeleton.parents
+        nodes = {int(self.head_node[bone]) for bone in piece if parents[bone] >= 0 and parents[bone] not in inside}
+        nodes |= {int(self.tail_node[parents[bone]]) for bone in range(len(parents))
+                  if bone not in inside and parents[bone] in inside}
+        return nodes
 
     def _length(self, bones):
         return float(np.linalg.norm(self.skeleton.tails[bones] - self.skeleton.heads[bones], axis=1).sum())
@@ -394,7 +466,7 @@ def _fit_chain(body, chain, side, names, meta, tuning):
     """The joints (n + 1, 3) in the metarig's frame of chain ``chain`` on side ``side`` (named ``names``), or None
     when the skeleton has none of its roles."""
     skeleton_side = body.side_map[side]
-    groups = [role if isinstance(role, tuple) else (role,) for role in chain.roles]
+    groups = _groups(chain.roles)
     wanted = sorted({role for group in groups for role in group} - {"palm"})
     bones = body.bones_of(wanted, skeleton_side, chain.digit)
     if not bones:
@@ -414,23 +486,50 @@ def _fit_chain(body, chain, side, names, meta, tuning):
     arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
     if arc[-1] <= 0:
         return None
+    lengths = np.array([np.linalg.norm(np.subtract(meta[name].tail, meta[name].head)) for name in names])
+    joints = _joints(body, groups, points, arc, step_roles, lengths, tuning)
+    if chain.hock and _bent(joints, chain.bend)[0] < 0:  # the first joint bends backward: it is the hock
+        joints = _joints(body, _groups(chain.hock), points, arc, step_roles, lengths, tuning)
+        joints[1] = _as_in_metarig(joints, [np.asarray(meta[name].head, float) for name in names[:3]], chain.bend)
+    if groups[0] == ("palm",):
+        joints[0] = _palm_head(joints, meta, names, side)
+    if chain.bend and not _bend(joints, chain.bend, tuning):
+        body.notes.append(f"the skeleton's {names[0]} bends too far the wrong way to move its joint: its IK bends "
+                          f"that way (move the metarig's {names[1]} head and regenerate)")
+    return joints
+
+
+def _groups(roles):
+    return [role if isinstance(role, tuple) else (role,) for role in roles]
+
+
+def _joints(body, groups, points, arc, step_roles, lengths, tuning):
+    """A chain's joints in the metarig's frame, its bones taking the role ``groups`` on the path ``points`` (arc
+    lengths ``arc``) whose steps have the roles ``step_roles``."""
     spans = []
     for group in groups:
         at = [k for k, role in enumerate(step_roles) if role in group]
         spans.append((arc[min(at)], arc[max(at) + 1]) if at else None)
-    lengths = np.array([np.linalg.norm(np.subtract(meta[name].tail, meta[name].head)) for name in names])
-    cuts = _cuts(groups, spans, arc, lengths, tuning)
-    joints = body.local(np.array([_at(points, arc, cut) for cut in cuts]))
-    if groups[0] == ("palm",):
-        joints[0] = _palm_head(joints, meta, names, side)
-    if chain.bend:
-        _bend(joints, chain.bend, tuning)
-    return joints
+    missing = next((k for k in range(len(groups)) if all(span is None for span in spans[k:])), len(groups))
+    if 0 < missing < len(groups):  # the chain's last roles are missing: the mesh may go on where they belong
+        present = [k for k in range(missing) if spans[k] is not None]
+        scale = (arc[-1] - spans[present[0]][0]) / lengths[present[0]:missing].sum()
+        wanted = scale * lengths[missing:].sum()
+        direction = points[-1] - points[-2]
+        direction = direction / max(np.linalg.norm(direction), 1e-300)
+        reach = _reach(body.vertices, points[-1], direction, wanted, body.size)
+        if reach >= tuning.extend * wanted:
+            points = np.vstack([points, points[-1] + min(reach, wanted) * direction])
+            arc = np.r_[arc, arc[-1] + min(reach, wanted)]
+            spans[missing] = (arc[-2], arc[-1])
+    cuts = _cuts(groups, spans, arc, lengths, tuning.shortest * body.size, tuning)
+    return body.local(np.array([_at(points, arc, cut) for cut in cuts]))
 
 
-def _cuts(groups, spans, arc, lengths, tuning):
+def _cuts(groups, spans, arc, lengths, shortest, tuning):
     """Arc positions of a chain's n + 1 joints along a path with joints at ``arc``: pinned where roles change
-    (see the module docstring), the rest in the metarig's proportions ``lengths``, snapped to nearby joints."""
+    (see the module docstring), the rest in the metarig's proportions ``lengths``, snapped to nearby joints; no two
+    closer than ``shortest``."""
     count = len(groups)
     pins = [0.0] + [None] * (count - 1) + [arc[-1]]
     for k in range(1, count):
@@ -460,6 +559,12 @@ def _cuts(groups, spans, arc, lengths, tuning):
                 nearest = inner[np.argmin(np.abs(inner - cuts[k]))]
                 if abs(nearest - cuts[k]) <= room:
                     cuts[k] = nearest
+    gap = min(shortest, arc[-1] / count)  # no bone shorter than ``shortest`` (a chain too short: all alike)
+    for k in range(1, count + 1):
+        cuts[k] = max(cuts[k], cuts[k - 1] + gap)
+    cuts[count] = arc[-1]
+    for k in range(count - 1, 0, -1):
+        cuts[k] = min(cuts[k], cuts[k + 1] - gap)
     return cuts
 
 
@@ -470,14 +575,26 @@ def _at(points, arc, position):
     return points[k] + np.clip(share, 0.0, 1.0) * (points[k + 1] - points[k])
 
 
+def _reach(vertices, point, direction, limit, size):
+    """How far the mesh goes on beyond ``point`` along ``direction`` (unit), up to twice ``limit``: its vertices
+    within a tube as thick as the mesh is at ``point``."""
+    offsets = vertices - point
+    along = offsets @ direction
+    across = np.linalg.norm(offsets - np.outer(along, direction), axis=1)
+    tube = max(2 * float(np.linalg.norm(offsets, axis=1).min()), 0.02 * size)
+    beyond = along[(along > 0) & (across <= tube) & (along <= 2 * limit)]
+    return float(beyond.max()) if len(beyond) else 0.0
+
+
 def _wrist(body, side, base):
-    """Where the hand of skeleton side ``side`` begins (its end nearer the forearm), for a palm reaching ``base``."""
-    hand = body.bones_of(("hand",), side)
-    if not hand:
-        return None
-    points, _ = body.path(hand, lambda bone: 0, side)
-    ends = (points[0], points[-1])
-    return max(ends, key=lambda end: np.linalg.norm(end - base))
+    """Where the hand of skeleton side ``side`` begins, for a palm reaching ``base``: the hand's end farther from
+    it, else (no hand bone) the forearm's end nearer it."""
+    for roles, pick in ((("hand",), max), (("forearm",), min)):
+        bones = body.bones_of(roles, side)
+        if bones:
+            points, _ = body.path(bones, lambda bone: 0, side)
+            return pick((points[0], points[-1]), key=lambda end: np.linalg.norm(end - base))
+    return None
 
 
 def _palm_head(joints, meta, names, side):
@@ -490,40 +607,60 @@ def _palm_head(joints, meta, names, side):
     return joints[0] + share * (joints[1] - joints[0])
 
 
-def _bend(joints, way, tuning):
-    """Move the joint between a limb's first two bones so that it bends ``way`` (the front is -Y) by at least
-    ``tuning.bend`` of the limb's reach; a limb bent sideways by less than ``tuning.straight`` of its reach loses
-    that sideways bend (Rigify's IK bends in the chain's plane)."""
+def _bent(joints, way):
+    """How a limb's first joint lies off the line from its root to the end of its second bone: (the offset the way
+    it should bend, the offset sideways, the reach, the unit vectors of both ways); the front is -Y."""
     root, middle, end = joints[0], joints[1], joints[2]
-    reach = end - root
-    length = np.linalg.norm(reach)
-    if not length > 0:
-        return
-    along = reach / length
+    length = float(np.linalg.norm(end - root))
+    along = (end - root) / max(length, 1e-300)
     front = np.array([0.0, -1.0, 0.0]) * way
     front = front - (front @ along) * along
-    if not np.linalg.norm(front) > 0:
-        return
-    front /= np.linalg.norm(front)
+    front /= max(np.linalg.norm(front), 1e-300)
     sideways = np.cross(along, front)
-    offset = middle - root
-    forward, aside = offset @ front, offset @ sideways
-    if abs(aside) < tuning.straight * length:
-        middle = middle - aside * sideways
-    joints[1] = middle + max(tuning.bend * length - forward, 0.0) * front
+    return float((middle - root) @ front), float((middle - root) @ sideways), length, front, sideways
+
+
+def _as_in_metarig(joints, meta_joints, way):
+    """Where the metarig has a limb's first joint relative to its root and the end of its second bone, in units of
+    that reach, placed on ``joints`` (a hidden knee above a hock)."""
+    forward, _, length, _, _ = _bent(np.array(meta_joints), way)
+    _, _, reach, front, _ = _bent(joints, way)
+    along = (meta_joints[1] - meta_joints[0]) @ (meta_joints[2] - meta_joints[0]) / max(length, 1e-300) ** 2
+    return joints[0] + along * (joints[2] - joints[0]) + forward / max(length, 1e-300) * reach * front
+
+
+def _bend(joints, way, tuning):
+    """Move the joint between a limb's first two bones so that it bends ``way``: at least ``bend`` of the limb's
+    reach that way, at most ``tilt`` degrees sideways from it (none when it lies less than ``straight`` sideways);
+    Rigify's IK bends the limb in the plane its chain bends in. A move longer than ``bend_move`` of the reach is not
+    made (the skeleton bends that limb another way: its IK will too). Returns whether the limb now bends ``way``."""
+    forward, aside, length, front, sideways = _bent(joints, way)
+    if not length > 0 or not np.linalg.norm(front) > 0:
+        return False
+    wanted = max(forward, tuning.bend * length)
+    limit = 0.0 if abs(aside) < tuning.straight * length else wanted * np.tan(np.radians(tuning.tilt))
+    move = (wanted - forward) * front + (np.clip(aside, -limit, limit) - aside) * sideways
+    if np.linalg.norm(move) > tuning.bend_move * length:
+        return forward > 0 and abs(aside) <= forward * np.tan(np.radians(tuning.tilt))
+    joints[1] = joints[1] + move
+    return True
 
 
 def _mirror_twins(fit, units, midline, tolerance, middle=None):
     """Make each unit of twin bones (``.L`` names; their ``.R`` twins) exact mirror images across the midline (the
-    metarig's X = ``middle``, by default the median X of the ``midline`` bones) when all of them mirror within
-    ``tolerance`` already; ``midline`` bones within it of the midline go onto it. Returns ``middle``."""
+    metarig's X = ``middle``, by default the median X of the bones of the ``midline`` chains) when all of them
+    mirror within ``tolerance`` already; a midline chain all within it of the midline goes onto it. Returns
+    ``middle``."""
     if middle is None:
-        xs = [point[0] for name in midline if name in fit.heads for point in (fit.heads[name], fit.tails[name])]
+        xs = [point[0] for chain in midline for name in chain if name in fit.heads
+              for point in (fit.heads[name], fit.tails[name])]
         middle = float(np.median(xs)) if xs else 0.0
-    for name in midline:
-        if name in fit.heads and max(abs(fit.heads[name][0] - middle), abs(fit.tails[name][0] - middle)) <= tolerance:
-            fit.heads[name], fit.tails[name] = (np.r_[middle, point[1:]] for point in (fit.heads[name],
-                                                                                        fit.tails[name]))
+    for chain in midline:
+        names = [name for name in chain if name in fit.heads]
+        if names and max(abs(end[name][0] - middle) for name in names for end in (fit.heads, fit.tails)) <= tolerance:
+            for name in names:
+                for end in (fit.heads, fit.tails):
+                    end[name] = np.r_[middle, end[name][1:]]
 
     def mirrored(point):
         return np.r_[2 * middle - point[0], point[1:]]
@@ -541,6 +678,28 @@ def _mirror_twins(fit, units, midline, tolerance, middle=None):
                 end[a] = 0.5 * (end[a] + mirrored(end[b]))
                 end[b] = mirrored(end[a])
     return middle
+
+
+def _join_chains(fit, spec, meta):
+    """Start each chain exactly where the metarig starts it on another chain's bone (the neck at the torso's end, a
+    tail at the hips' start): Rigify connects such chains only when their ends coincide."""
+    ends = np.array([end for bone in meta.values() for end in (bone.head, bone.tail)], dtype=np.float64)
+    tolerance = 1e-4 * float(np.ptp(ends, axis=0).max())
+    done = []
+    for chain in spec.chains:
+        for side in _sides(chain):
+            names = chain.names(side)
+            if names[0] in fit.heads:
+                start = np.asarray(meta[names[0]].head, dtype=np.float64)
+                for other in done:
+                    for end, fitted in (("tail", fit.tails), ("head", fit.heads)):
+                        if np.linalg.norm(np.asarray(getattr(meta[other], end)) - start) <= tolerance:
+                            fit.heads[names[0]] = fitted[other].copy()
+                            break
+                    else:
+                        continue
+                    break
+            done += [name for name in names if name in fit.heads]
 
 
 def _heel(body, fit, side, tuning):
@@ -621,6 +780,7 @@ def _notes(spec, meta, fit, body):
     if others:
         notes.append(f"removed {len(others)} metarig bones that no skeleton places ({', '.join(others[:4])}"
                      f"{', ...' if len(others) > 4 else ''})")
+    notes += body.notes
     if body.side_map["L"] == "R":
         notes.append("the skeleton's .L limbs are on the character's right: Rigify's .L bones went to its left")
     return notes
