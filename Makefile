@@ -9,7 +9,7 @@ BPY42_VENV := $(VENV)/bpy42
 BPY42_STAMP := $(BPY42_VENV)/.installed
 
 .PHONY: test build demo addon bpy42 bench bench-quality bench-silhouette bench-skinning bench-posing \
-	bench-bodyplan bench-rig-time regress regress-baseline defects clean
+	bench-bodyplan bench-rigify bench-rig-time regress regress-baseline defects clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -58,6 +58,11 @@ bench-posing: build
 # Body plan of every ../shared model against a hand label, named-joint error of the humanoids: bodyplan.{md,png,json}.
 bench-bodyplan: build
 	$(PY) bench/bodyplan.py
+
+# The rigify target on every ../shared model and sample character: generated, skinned, IK bends, regenerated:
+# bench/results/rigify.{md,png,json} and rigify_pose.png.
+bench-rigify: build
+	$(PY) bench/rigify_target.py
 
 bench-rig-time: build
 	$(PY) bench/rig_time.py

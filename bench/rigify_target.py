@@ -20,12 +20,11 @@ skinned with ``skin_meshes``, as the panel and the command line do. The sample c
 
     .venv/bin/python bench/rigify_target.py [--models NAME ...] [--out DIR]
 
-Writes rigify.md, rigify.json, rigify.png (every generated rig's DEF bones on its mesh, seen from its side) and
+Writes rigify.md, rigify.json, rigify.png (every generated rig's DEF bones on its mesh, from the front and the side) and
 rigify_pose.png (the sample humanoid posed by its IK controls, a knee raised and an elbow bent, Workbench render) to
 bench/results (or ``--out``; a run on ``--models`` writes to out/rigify unless told otherwise).
 """
 import argparse
-import datetime
 import json
 import os
 import pathlib
@@ -36,7 +35,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from benchkit import (REPO, RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit, markdown_table,  # noqa: E402
+from benchkit import (REPO, RESULTS_DIR, SHARED_MODELS, markdown_table, picked, run_record,  # noqa: E402
                       table_cell)
 from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
 
@@ -331,25 +330,29 @@ def plot(records, path):
     import matplotlib.pyplot as plt
 
     drawn = [record for record in records if "drawing" in record]
-    columns = 6
+    columns = 5
     rows_count = max(1, -(-len(drawn) // columns))
-    figure, axes = plt.subplots(rows_count, columns, figsize=(2.6 * columns, 3.0 * rows_count))
+    figure, axes = plt.subplots(rows_count, columns, figsize=(3.4 * columns, 2.8 * rows_count))
     for axis in np.atleast_1d(axes).ravel():
         axis.axis("off")
     for axis, record in zip(np.atleast_1d(axes).ravel(), drawn):
         frame = np.array(record["drawing"]["frame"])  # columns: the rig's left, back, up
-        side = frame[:, 1], frame[:, 2]  # seen from the character's left: back to the right, up
         points = np.array(record["drawing"]["points"])
-        axis.scatter(points @ side[0], points @ side[1], s=0.3, c="0.8")
-        for name, head, tail in record["drawing"]["bones"]:
-            ends = np.array([head, tail])
-            colour = "tab:red" if name.endswith(".L") or ".L." in name else \
-                "tab:blue" if name.endswith(".R") or ".R." in name else "k"
-            axis.plot(ends @ side[0], ends @ side[1], color=colour, linewidth=1.0)
+        views = [(frame[:, 0], frame[:, 2]), (frame[:, 1], frame[:, 2])]  # from the front (its left to the right),
+        shift = 0.0  # then from its left (its front to the left)
+        for across, up in views:
+            low = (points @ across).min()
+            axis.scatter(points @ across - low + shift, points @ up, s=0.2, c="0.8")
+            for name, head, tail in record["drawing"]["bones"]:
+                ends = np.array([head, tail])
+                colour = "tab:red" if name.endswith(".L") or ".L." in name else \
+                    "tab:blue" if name.endswith(".R") or ".R." in name else "k"
+                axis.plot(ends @ across - low + shift, ends @ up, color=colour, linewidth=0.8)
+            shift += np.ptp(points @ across) * 1.15
         axis.set_aspect("equal")
         axis.set_title(f"{record['model']}\n{record.get('metarig', '')}, IK {ik_cell(record)}", fontsize=7)
-    figure.suptitle("Rigify rigs: the DEF bones on the mesh, seen from the character's left (front to the left; "
-                    "red .L, blue .R)", fontsize=9)
+    figure.suptitle("Rigify rigs: the DEF bones on the mesh, from the front and from the character's left (front "
+                    "to the left); red .L, blue .R", fontsize=9)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
@@ -368,18 +371,10 @@ def main(argv=None):
     import rigger
 
     rigger.register()  # the pipeline keeps its armature pointer in the add-on's properties
-    names = model_names()
-    if args.models:
-        wanted = [text for item in args.models for text in item.split(",") if text]
-        names = [(source, name) for source, name in names if any(text in name for text in wanted)]
-        if not names:
-            raise SystemExit(f"No model name contains any of {wanted}.")
+    names = picked(model_names(), args.models, lambda item: item[1])
     out = args.out or (REPO / "out" / "rigify" if args.models else RESULTS_DIR)
     out.mkdir(parents=True, exist_ok=True)
-    arguments = " ".join(argv if argv is not None else sys.argv[1:])
-    run = {"command": f"python bench/rigify_target.py {arguments}".rstrip(),
-           "started": datetime.datetime.now(datetime.timezone.utc), "load": os.getloadavg(), "cpu": cpu_model(),
-           "commit": described_commit()}
+    run = run_record("rigify_target.py", argv)
     started = time.perf_counter()
     records = []
     for source, name in names:

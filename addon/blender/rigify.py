@@ -74,8 +74,7 @@ def build_rigify(skeleton, name, collection, frame, mesh=None):
     rig[METARIG_PROPERTY] = metarig
     metarig.hide_set(True)
     metarig.hide_render = True
-    notes = [note for note in fit.notes if "no skeleton places" not in note]
-    warnings = [f"Rigify's {metarig_name} metarig: {note}" for note in notes]
+    warnings = [f"Rigify's {metarig_name} metarig: {note}" for note in fit.notes]
     return Built(rig, deform_skeleton(rig), [metarig], warnings)
 
 

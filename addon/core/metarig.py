@@ -12,9 +12,9 @@ serpents get none (Rigify's shark fits a shark, and a body plan cannot tell it f
 
 How the bones are placed, in order:
 
-- The character's frame: up is the body plan's; the front is, for an animal, from the torso's middle to the head,
-  for a humanoid where the feet point (from the ankle to the toe tip), else the front of a figure whose left is its
-  ``.L`` side (Blender's convention); left = up x front. Rigify expects Z up and the front at -Y in the armature's own
+- The character's frame: up is the body plan's; the front is, for an animal, from the torso's middle to the head;
+  for a humanoid, across the line from its ``.R`` limbs to its ``.L`` ones, the way its feet point (from the ankle to
+  the toe tip; without feet, as Blender has it: ``.L`` is the character's left); left = up x front. Rigify expects Z up and the front at -Y in the armature's own
   space, so the metarig gets this frame as its rotation and its bones are placed in it. A skeleton whose ``.L`` limbs
   lie on the character's right has its sides swapped: Rigify's ``.L`` bones go on the character's left.
 - Chains: each :class:`Chain` of a metarig is a run of its bones with the roles each takes. The skeleton's bones of
@@ -191,7 +191,7 @@ METARIGS = {
         Chain(("thigh.{s}", "shin.{s}", "foot.{s}", "toe.{s}"), ("thigh", "shin", "foot", "toe"), True, BACKWARD),
     ), ("pelvis.{s}",)),
 }
-PLAN_METARIGS = {"humanoid": ("human", "basic_human"), "quadruped": ("basic_quadruped",), "bird": ("bird",)}
+PLAN_METARIGS = {"humanoid": "basic_human", "quadruped": "basic_quadruped", "bird": "bird"}  # "human": fingers
 
 
 def choose_metarig(skeleton):
@@ -201,17 +201,17 @@ def choose_metarig(skeleton):
     kind = "unknown" if plan is None else plan.kind
     if kind not in PLAN_METARIGS:
         raise ValueError(f"no Rigify metarig fits a {kind} body plan (metarigs for: {', '.join(PLAN_METARIGS)})")
-    if kind == "humanoid":
-        fingers = any(role.role == "finger" and role.digit == "index" for role in skeleton.roles or ())
-        return "human" if fingers else "basic_human"
-    return PLAN_METARIGS[kind][0]
+    if kind == "humanoid" and any(role.role == "finger" and role.digit == "index" for role in skeleton.roles or ()):
+        return "human"
+    return PLAN_METARIGS[kind]
 
 
 @dataclass
 class Fit:
     """Where a metarig's bones go: the ``metarig``'s name, the ``frame`` (3x3: the columns are the metarig's X, Y, Z
     axes in the world: the character's left, back and up), and in that frame each kept bone's ``heads``, ``tails``
-    and ``z_axes`` (the roll reference) by name; the metarig bones ``removed`` and ``notes`` saying why."""
+    and ``z_axes`` (the roll reference) by name; the metarig bones ``removed``, and ``notes``: the parts of the
+    metarig the skeleton lacks and what the fit could not do, in words (the face of ``human`` goes unsaid)."""
 
     metarig: str
     frame: np.ndarray
@@ -221,15 +221,12 @@ class Fit:
     removed: tuple = ()
     notes: list = field(default_factory=list)
 
-    def world(self, name):
-        """(head, tail) of bone ``name`` in the world."""
-        return self.frame @ self.heads[name], self.frame @ self.tails[name]
-
 
 def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
     """A :class:`Fit` of metarig ``metarig`` (a name in :data:`METARIGS`, whose bones are ``bones``, a sequence of
     :class:`MetaBone`) to ``skeleton`` (with its body plan and roles) rigging ``mesh`` ((vertices, triangles) or a
-    ``core.mesh.Mesh``, in the skeleton's frame). ValueError when the skeleton has no roles or no torso."""
+    ``core.mesh.Mesh``, in the skeleton's frame). ValueError when the skeleton has no roles, or ``bones`` lack a bone
+    the fit places."""
     if metarig not in METARIGS:
         raise ValueError(f"unknown metarig {metarig!r}; known: {', '.join(METARIGS)}")
     if skeleton.roles is None or skeleton.body_plan is None:
@@ -242,28 +239,24 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
         raise ValueError(f"the {metarig} metarig has no bones {', '.join(missing)}: not the metarig Rigger knows")
     body = _Body(skeleton, vertices, tuning)
     fit = Fit(metarig, body.frame)
-    anchors = []  # (metarig point, fitted point) of every placed joint
     for chain in spec.chains:
         for side in _sides(chain):
             names = chain.names(side)
             points = _fit_chain(body, chain, side, names, meta, tuning)
-            if points is None:
-                continue
-            for k, name in enumerate(names):
+            for k, name in enumerate(names if points is not None else ()):
                 fit.heads[name], fit.tails[name] = points[k], points[k + 1]
-            anchors += [(np.asarray(meta[name].head, float), points[k]) for k, name in enumerate(names)]
-            anchors.append((np.asarray(meta[names[-1]].tail, float), points[-1]))
     units = [chain.names("L") for chain in spec.chains if chain.sided]
     midline = [chain.names(None) for chain in spec.chains if not chain.sided]
     middle = _mirror_twins(fit, units, midline, tuning.mirror_tolerance * body.size)
     _join_chains(fit, spec, meta)
+    placed = list(fit.heads)
+    meta_points = np.array([meta[name].head for name in placed] + [meta[name].tail for name in placed], float)
+    fitted_points = np.array([fit.heads[name] for name in placed] + [fit.tails[name] for name in placed])
     for template in spec.heels:
         for side in "LR":
             name = template.replace("{s}", side)
             if f"foot.{side}" in fit.heads and name in meta:
                 fit.heads[name], fit.tails[name] = _heel(body, fit, side, tuning)
-    meta_points = np.array([point for point, _ in anchors])
-    fitted_points = np.array([point for _, point in anchors])
     for template in spec.derived:
         for side in "LR":
             name = template.replace("{s}", side)
@@ -279,7 +272,7 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
         if name not in chained:
             _keep_length(fit, name, body.size * tuning.shortest)
     fit.removed = _removed(meta, fit.heads)
-    fit.notes = _notes(spec, meta, fit, body)
+    fit.notes = _notes(spec, fit, body)
     return fit
 
 
@@ -330,22 +323,34 @@ class _Body:
 
     def _front(self):
         """The character's front, across up: for an animal from the torso's middle to its head (else its neck,
-        else from its tail to the torso's middle, else from its hips to its chest), else where its feet point, else (a humanoid without feet) the front of a figure whose ``.L`` side is its left,
-        else Blender's -Y."""
-        animal = self.skeleton.body_plan.kind != "humanoid"
-        spine = []
-        for ahead, behind in ((("head",), None), (("neck",), None), (None, ("tail",)), (("chest",), ("hips",))):
-            front_bones, back_bones = (self.bones_of(roles, None) if roles else None for roles in (ahead, behind))
-            if animal and front_bones != [] and back_bones != []:
-                spine.append((self.middle(front_bones) if front_bones else self.centre) -
-                             (self.middle(back_bones) if back_bones else self.centre))
-        lefts, rights = (self.bones_of(("upper_arm", "forearm", "thigh", "shin"), side) for side in ("L", "R"))
-        sides = [np.cross(self.middle(lefts) - self.middle(rights), self.up)] if lefts and rights else []
-        for direction in spine + self._feet() + sides + [np.array([0.0, -1.0, 0.0]), np.array([0.0, 0.0, 1.0])]:
-            across = direction - (direction @ self.up) * self.up
-            if np.linalg.norm(across) > 1e-6 * np.linalg.norm(direction):
-                return across / np.linalg.norm(across)
+        else from its tail to the torso's middle, else from its hips to its chest); for a humanoid across the line
+        from its ``.R`` limbs to its ``.L`` ones, the way its feet point (else the front of a figure whose ``.L``
+        side is its left, Blender's convention), else where its feet point; else Blender's -Y."""
+        candidates = []
+        if self.skeleton.body_plan.kind != "humanoid":
+            for ahead, behind in ((("head",), None), (("neck",), None), (None, ("tail",)), (("chest",), ("hips",))):
+                front_bones, back_bones = (self.bones_of(roles, None) if roles else None for roles in (ahead, behind))
+                if front_bones != [] and back_bones != []:
+                    candidates.append((self.middle(front_bones) if front_bones else self.centre) -
+                                      (self.middle(back_bones) if back_bones else self.centre))
+        feet = self._feet()
+        limbs = ("upper_arm", "forearm", "hand", "thigh", "shin", "foot")
+        lefts, rights = (self.bones_of(limbs, side) for side in ("L", "R"))
+        if lefts and rights:
+            across = self._across(np.cross(self.middle(lefts) - self.middle(rights), self.up))
+            if across is not None:
+                candidates.append(-across if feet and feet[0] @ across < 0 else across)
+        for direction in candidates + feet + [np.array([0.0, -1.0, 0.0]), np.array([0.0, 0.0, 1.0])]:
+            across = self._across(direction)
+            if across is not None:
+                return across
         raise ValueError("cannot tell the character's front")  # unreachable: -Y and +Z are never both along up
+
+    def _across(self, direction):
+        """``direction`` across up, as a unit vector (None when it runs along up)."""
+        across = direction - (direction @ self.up) * self.up
+        norm = np.linalg.norm(across)
+        return across / norm if norm > 1e-6 * np.linalg.norm(direction) else None
 
     def _feet(self):
         """From each ankle to its toe tip, of the legs that have feet."""
@@ -762,24 +767,20 @@ def _removed(meta, kept):
     return tuple(name for name in meta if name not in kept)
 
 
-def _notes(spec, meta, fit, body):
-    """What the fit left out, in words."""
-    notes = []
-    removed = set(fit.removed)
+def _notes(spec, fit, body):
+    """What the fit left out and could not do, in words: one note per part the skeleton lacks."""
+    removed, missing = set(fit.removed), {}
     for chain in spec.chains:
         for side in _sides(chain):
             names = chain.names(side)
             if all(name in removed for name in names):
                 part = f"{chain.digit} finger" if chain.digit else "/".join(
                     role if isinstance(role, str) else "+".join(role) for role in dict.fromkeys(chain.roles))
-                notes.append(f"the model shows no {part}{f' on the {side} side' if side else ''}: removed the "
-                             f"metarig's {', '.join(names)}")
-    covered = {name for chain in spec.chains for side in _sides(chain) for name in chain.names(side)}
-    covered |= {template.replace("{s}", side) for template in spec.derived + spec.heels for side in "LR"}
-    others = sorted(name for name in removed if name not in covered)
-    if others:
-        notes.append(f"removed {len(others)} metarig bones that no skeleton places ({', '.join(others[:4])}"
-                     f"{', ...' if len(others) > 4 else ''})")
+                sides, bones = missing.setdefault(part, ([], []))
+                sides.append(side)
+                bones.extend(names)
+    notes = [f"the model shows no {part}{' (' + ' and '.join(sides) + ')' if sides != [None] else ''}: removed the "
+             f"metarig's {', '.join(bones)}" for part, (sides, bones) in missing.items()]
     notes += body.notes
     if body.side_map["L"] == "R":
         notes.append("the skeleton's .L limbs are on the character's right: Rigify's .L bones went to its left")
