@@ -277,11 +277,12 @@ def summary(records):
     cracked = [r for r in built if r["seam_gap"] > 0]
     limbs = [item for r in built for item in r.get("ik", [])]
     regenerated = [r for r in built if r.get("regenerated_bound")]
-    fallbacks = [r for r in records if r.get("plan") not in RIGIFY_PLANS and "plan" in r]
+    others = [r for r in records if r.get("plan") not in RIGIFY_PLANS and "plan" in r]
     return {"expected": len(expected), "built": len(built), "fully_weighted": len(full), "cracked": len(cracked),
             "ik_right": sum(item["right"] for item in limbs), "ik_limbs": len(limbs),
-            "regenerated": len(regenerated), "fallbacks": len(fallbacks),
-            "fell_back_plain": sum(r.get("target") == "plain" for r in fallbacks),
+            "regenerated": len(regenerated), "others": len(others),
+            "others_built": [r["model"] for r in others if r.get("target") == "rigify" and "error" not in r],
+            "fell_back_plain": sum(r.get("target") == "plain" for r in others),
             "failures": [(r["model"], r.get("error", "")) for r in expected if r not in built]}
 
 
@@ -306,8 +307,9 @@ def report(records, totals, pose, run):
         ]), "",
         f"Also: IK bends the right way (knees forward, elbows back) on {totals['ik_right']} / {totals['ik_limbs']} "
         f"limbs; regenerating from the edited metarig kept the mesh bound on {totals['regenerated']} / "
-        f"{totals['built']}; the {totals['fallbacks']} models of other plans fell back "
-        f"({totals['fell_back_plain']} to plain) with a warning.",
+        f"{totals['built']}. Of the {totals['others']} models of other plans, "
+        f"{', '.join(totals['others_built']) or 'none'} (birds with legs) got the bird metarig and "
+        f"{totals['fell_back_plain']} fell back to plain with a warning saying why.",
     ]
     if totals["failures"]:
         lines += ["", "Failures: " + "; ".join(f"{model}: {table_cell(error, 200)}"

@@ -77,7 +77,8 @@ def test_every_bone_the_fit_names_is_in_rigifys_metarig_and_the_human_loses_only
         names = {bone.name for bone in metarigs[name]}
         named = {bone for chain in spec.chains for side in (("L", "R") if chain.sided else (None,))
                  for bone in chain.names(side)}
-        named |= {template.replace("{s}", side) for template in spec.derived + spec.heels for side in "LR"}
+        named |= {template.replace("{s}", side) for template in (*spec.heels, *(name for name, _ in spec.derived))
+                  for side in "LR"}
         assert named <= names, (name, sorted(named - names))
     human = {bone.name: bone for bone in metarigs["human"]}
 
@@ -92,7 +93,8 @@ def test_every_bone_the_fit_names_is_in_rigifys_metarig_and_the_human_loses_only
     assert len(face) > 50
     spec = METARIGS["human"]
     placed = {bone for chain in spec.chains for side in ("L", "R") for bone in chain.names(side)}
-    placed |= {template.replace("{s}", side) for template in spec.derived + spec.heels for side in "LR"}
+    placed |= {template.replace("{s}", side) for template in (*spec.heels, *(name for name, _ in spec.derived))
+               for side in "LR"}
     assert set(human) - placed == face  # everything but the face rig is placed
 
 
@@ -247,6 +249,10 @@ def test_the_rig_has_rigifys_bones_and_ik_controls_and_reports_its_def_bones(rig
     world = np.array(rig.matrix_world)
     heads = np.array([world[:3, :3] @ np.array(rig.data.bones[name].head_local) + world[:3, 3] for name in deform])
     np.testing.assert_allclose(result.bones.heads, heads, atol=1e-6)
+    roles = dict(zip(result.bones.names, result.bones.roles))  # each DEF bone with its metarig bone's role
+    assert (roles["DEF-thigh.L"], roles["DEF-thigh.L.001"]) == (BoneRole("thigh", "L", 0), BoneRole("thigh", "L", 1))
+    assert roles["DEF-spine"].role == "hips" and roles["DEF-spine.006"].role == "head"
+    assert roles["DEF-breast.R"] == BoneRole("chest", "R") and roles["DEF-hand.R"] == BoneRole("hand", "R")
     parents = dict(zip(result.bones.names, result.bones.parents))
     assert result.bones.names[parents["DEF-shin.L"]] == "DEF-thigh.L.001"
     assert result.bones.names[parents["DEF-thigh.L"]] == "DEF-spine"  # through ORG-spine
@@ -393,6 +399,8 @@ def test_the_command_line_reports_the_def_bones_in_the_files_frame(registered, t
     assert all(mesh["unweighted"] == 0 for mesh in report["skinning"]["meshes"].values())
     bones = report["bones"]
     assert bones and all(bone["name"].startswith("DEF-") for bone in bones)
+    assert {(bone["name"], bone["role"], bone["side"]) for bone in bones} >= {("DEF-shin.L", "shin", "L"),
+                                                                              ("DEF-spine.003", "chest", None)}
     heads = np.array([bone["head"] for bone in bones])
     assert strictly_inside_fraction(in_file, triangles, heads) >= 0.8  # in the OBJ's own frame, inside its mesh
     # ... and they are the saved rig's DEF bones, mapped back into the file's frame

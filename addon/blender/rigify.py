@@ -21,6 +21,7 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from ..core.metarig import METARIGS, MetaBone, choose_metarig, fit_metarig
+from ..core.roles import BoneRole
 from ..core.skeleton import Skeleton
 
 ADDON = "rigify"
@@ -75,7 +76,7 @@ def build_rigify(skeleton, name, collection, frame, mesh=None):
     metarig.hide_set(True)
     metarig.hide_render = True
     warnings = [f"Rigify's {metarig_name} metarig: {note}" for note in fit.notes]
-    return Built(rig, deform_skeleton(rig), [metarig], warnings)
+    return Built(rig, deform_skeleton(rig, fit.roles), [metarig], warnings)
 
 
 def _object_mode():
@@ -187,9 +188,11 @@ def generate(metarig, rig):
     _object_mode()
 
 
-def deform_skeleton(rig):
+def deform_skeleton(rig, roles=None):
     """The rig's deforming bones as a ``Skeleton`` in the world: each hangs from the nearest deforming bone above it,
-    where a metarig bone (``ORG-``) above stands for its own ``DEF-`` bone."""
+    where a metarig bone (``ORG-``) above stands for its own ``DEF-`` bone. With ``roles`` ({metarig bone:
+    ``BoneRole``}, ``Fit.roles``) each gets the role of the metarig bone it deforms for (Rigify splits a limb bone
+    into ``DEF-thigh.L`` and ``DEF-thigh.L.001``), counted along its chain."""
     deform = [bone for bone in rig.data.bones if bone.use_deform]
     index = {bone.name: k for k, bone in enumerate(deform)}
     parents = []
@@ -207,7 +210,28 @@ def deform_skeleton(rig):
     matrix = np.array(rig.matrix_world, dtype=np.float64)
     ends = np.array([(bone.head_local, bone.tail_local) for bone in deform], dtype=np.float64)
     world = ends @ matrix[:3, :3].T + matrix[:3, 3]
-    return Skeleton([bone.name for bone in deform], world[:, 0], world[:, 1], np.array(parents, dtype=np.int32))
+    skeleton = Skeleton([bone.name for bone in deform], world[:, 0], world[:, 1], np.array(parents, dtype=np.int32))
+    if roles is not None:
+        skeleton.roles = _counted([_metarig_role(bone.name, roles) for bone in deform])
+    return skeleton
+
+
+def _metarig_role(name, roles):
+    """The role of DEF bone ``name``: its metarig bone's (``DEF-thigh.L.001`` deforms for ``thigh.L``)."""
+    base = name[len(DEFORM_PREFIX):]
+    if base not in roles and len(base) > 4 and base[-4] == "." and base[-3:].isdigit():
+        base = base[:-4]
+    return roles.get(base, BoneRole("other"))
+
+
+def _counted(roles):
+    """``roles`` with each one's index counted along the bones of its role, side and digit, in order."""
+    counts, counted = {}, []
+    for role in roles:
+        key = (role.role, role.side, role.digit)
+        counted.append(BoneRole(role.role, role.side, counts.get(key, 0), role.digit))
+        counts[key] = counts.get(key, 0) + 1
+    return counted
 
 
 def remove_generated(metarig, rig):

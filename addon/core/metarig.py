@@ -49,10 +49,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .roles import BoneRole
 from .tuning import TuningTable, tuned
 
 FORWARD, BACKWARD = 1, -1  # the way a limb's first joint bends (a knee, an elbow)
 TORSO = ("hips", "spine", "chest")
+HELPERS = (("pelvis.{s}", "hips"), ("breast.{s}", "chest"))  # Rigify's deforming helpers and their roles
 DIGIT_BONES = {"thumb": "thumb", "index": "f_index", "middle": "f_middle", "ring": "f_ring", "pinky": "f_pinky"}
 
 
@@ -123,8 +125,8 @@ class Chain:
 @dataclass(frozen=True)
 class MetarigSpec:
     """How a metarig's bones are placed: its ``chains``, the ``derived`` bones that keep their place among the
-    placed joints, and the ``heels`` placed from the mesh (``{s}``: the side); ``added``: (``MetaBone``, Rigify rig
-    type or "") of bones Rigger adds to Rigify's metarig first."""
+    placed joints ((name, role) pairs), and the ``heels`` placed from the mesh (``{s}``: the side); ``added``:
+    (``MetaBone``, Rigify rig type or "") of bones Rigger adds to Rigify's metarig first."""
 
     chains: tuple
     derived: tuple = ()
@@ -164,8 +166,8 @@ def _human_chains(fingers):
 
 
 METARIGS = {
-    "human": MetarigSpec(_human_chains(True), ("pelvis.{s}", "breast.{s}"), ("heel.02.{s}",)),
-    "basic_human": MetarigSpec(_human_chains(False), ("pelvis.{s}", "breast.{s}"), ("heel.02.{s}",)),
+    "human": MetarigSpec(_human_chains(True), HELPERS, ("heel.02.{s}",)),
+    "basic_human": MetarigSpec(_human_chains(False), HELPERS, ("heel.02.{s}",)),
     "basic_quadruped": MetarigSpec((
         Chain(("spine.004", "spine.005", "spine.006", "spine.007", "spine.008"), (TORSO,) * 5),
         Chain(("spine.009", "spine.010", "spine.011"), ("neck", "neck", "head")),
@@ -177,7 +179,7 @@ METARIGS = {
               hock=("thigh", "thigh", "shin", ("foot", "toe"))),
         Chain(("ear.01.{s}", "ear.02.{s}"), ("ear", "ear"), sided=True),
         Chain(("jaw.01", "jaw.02"), ("jaw", "jaw")),
-    ), ("pelvis.{s}", "breast.{s}"), added=(  # ears and a jaw as Rigify's horse metarig has them
+    ), HELPERS, added=(  # ears and a jaw as Rigify's horse metarig has them
         *_tentacle("ear.{s}", ((0.05, -0.5, 0.93), (0.07, -0.51, 0.99), (0.09, -0.52, 1.05)), "spine.011",
                    (0.0, -1.0, 0.0)),
         *_tentacle("jaw", ((0.0, -0.5, 0.85), (0.0, -0.58, 0.82), (0.0, -0.66, 0.81)), "spine.011",
@@ -189,7 +191,7 @@ METARIGS = {
         Chain(("shoulder.{s}",), ("shoulder",), sided=True),
         Chain(("Wing.{s}", "Wing.001.{s}", "Wing.002.{s}"), ("wing",) * 3, sided=True),
         Chain(("thigh.{s}", "shin.{s}", "foot.{s}", "toe.{s}"), ("thigh", "shin", "foot", "toe"), True, BACKWARD),
-    ), ("pelvis.{s}",)),
+    ), HELPERS[:1]),
 }
 PLAN_METARIGS = {"humanoid": "basic_human", "quadruped": "basic_quadruped", "bird": "bird"}  # "human": fingers
 
@@ -210,8 +212,9 @@ def choose_metarig(skeleton):
 class Fit:
     """Where a metarig's bones go: the ``metarig``'s name, the ``frame`` (3x3: the columns are the metarig's X, Y, Z
     axes in the world: the character's left, back and up), and in that frame each kept bone's ``heads``, ``tails``
-    and ``z_axes`` (the roll reference) by name; the metarig bones ``removed``, and ``notes``: the parts of the
-    metarig the skeleton lacks and what the fit could not do, in words (the face of ``human`` goes unsaid)."""
+    and ``z_axes`` (the roll reference) by name; the metarig bones ``removed``; ``notes``: the parts of the metarig
+    the skeleton lacks and what the fit could not do, in words (the face of ``human`` goes unsaid); ``roles``: the
+    ``core.roles.BoneRole`` of each kept bone that deforms (sides the metarig's: ``L`` is the character's left)."""
 
     metarig: str
     frame: np.ndarray
@@ -220,6 +223,7 @@ class Fit:
     z_axes: dict = field(default_factory=dict)
     removed: tuple = ()
     notes: list = field(default_factory=list)
+    roles: dict = field(default_factory=dict)
 
 
 def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
@@ -245,6 +249,8 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
             points = _fit_chain(body, chain, side, names, meta, tuning)
             for k, name in enumerate(names if points is not None else ()):
                 fit.heads[name], fit.tails[name] = points[k], points[k + 1]
+            if points is not None:
+                fit.roles.update(_chain_roles(chain, side, names))
     units = [chain.names("L") for chain in spec.chains if chain.sided]
     midline = [chain.names(None) for chain in spec.chains if not chain.sided]
     middle = _mirror_twins(fit, units, midline, tuning.mirror_tolerance * body.size)
@@ -257,14 +263,15 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
             name = template.replace("{s}", side)
             if f"foot.{side}" in fit.heads and name in meta:
                 fit.heads[name], fit.tails[name] = _heel(body, fit, side, tuning)
-    for template in spec.derived:
+    for template, role in spec.derived:
         for side in "LR":
             name = template.replace("{s}", side)
             bone = meta.get(name)
             if bone is not None and (bone.parent is None or bone.parent in fit.heads):
                 fit.heads[name], fit.tails[name] = (_derived(np.asarray(point, float), meta_points, fitted_points,
                                                              tuning) for point in (bone.head, bone.tail))
-    extra = [[template.replace("{s}", "L")] for template in spec.heels + spec.derived]
+                fit.roles[name] = BoneRole(role, side)
+    extra = [[template.replace("{s}", "L")] for template in (*spec.heels, *(name for name, _ in spec.derived))]
     _mirror_twins(fit, extra, (), tuning.mirror_tolerance * body.size, middle)
     chained = {name for chain in spec.chains for side in _sides(chain) for name in chain.names(side)}
     for name in fit.heads:
@@ -274,6 +281,22 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
     fit.removed = _removed(meta, fit.heads)
     fit.notes = _notes(spec, fit, body)
     return fit
+
+
+def _chain_roles(chain, side, names):
+    """{bone name: BoneRole} of a placed chain: each bone its role (a torso's first bone the hips, its last the
+    chest, those between the spine; a palm the hand), counted along the chain."""
+    roles, counts = {}, {}
+    for k, (name, role) in enumerate(zip(names, chain.roles)):
+        if isinstance(role, tuple):  # the torso
+            run = [j for j, other in enumerate(chain.roles) if other == role]
+            role = role[0] if k == run[0] else role[-1] if k == run[-1] else role[len(role) // 2]
+        role = "hand" if role == "palm" else role
+        digit = chain.digit if role == "finger" else None
+        index = counts.get(role, 0)
+        counts[role] = index + 1
+        roles[name] = BoneRole(role, side, index, digit)
+    return roles
 
 
 def _sides(chain):
