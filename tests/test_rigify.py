@@ -322,6 +322,7 @@ def test_editing_the_metarig_and_regenerating_updates_the_same_rig_and_keeps_the
     modifier = next(m for m in obj.modifiers if m.type == 'ARMATURE')
     assert modifier.object == rig
     assert {group.name for group in obj.vertex_groups} <= {bone.name for bone in rig.data.bones if bone.use_deform}
+    assert rig[rigify.METARIG_PROPERTY] == metarig and rig[TARGET_PROPERTY] == "rigify"  # Rigger still knows it
 
 
 # Each of these in a scene of its own.
