@@ -24,9 +24,9 @@ How the bones are placed, in order:
   the shin begins), or where the one before ends when the next is missing; the other joints divide the stretch
   between such joints in the metarig's own proportions and move onto a skeleton joint near them (the skeleton's
   joints sit where the mesh bends): a skeleton without a toe gets its foot split at the metarig's ball. A chain
-  whose last roles the skeleton lacks goes on into the mesh, as long as the metarig's proportions make them, when
-  the mesh goes on there (an arm ending at the wrist gets its hand); else they share the stretch of the last role
-  (a leg whose shin reaches the ground gets its foot and toe from the shin's lower part).
+  whose last roles the skeleton lacks goes on to where the mesh ends ahead of it, when the mesh goes on there (an arm
+  ending at the wrist gets its hand; a skeleton whose spine ends at the chest gets a neck and a head), else they share
+  the stretch of the last role (a leg whose shin reaches the ground gets its foot and toe from the shin's lower part).
 - Limbs that Rigify bends with IK (legs, arms, paws): the joint between their first two bones is moved, when it does
   not already bend that way by ``bend`` of the limb's reach, so that knees bend forward and elbows backward (Rigify
   takes the bend direction from the chain); a limb bent sideways leans at most ``tilt`` from that. An animal's hind
@@ -74,9 +74,11 @@ class MetarigTuning(TuningTable):
                                   "way; a skeleton bending it further the wrong way keeps its joint (its roles are "
                                   "likely wrong there; the ../shared models need up to 0.18, then 0.3 and more)")
     extend: float = tuned(0.4, "a chain whose last roles the skeleton lacks (an arm ending at the wrist) goes on "
-                                "into the mesh when the mesh goes on for at least this share of what the metarig's "
-                                "proportions give them; else they share the last role's stretch (a leg reaching the "
-                                "ground)")
+                                "to the end of the mesh when the mesh goes on for at least this share of what the "
+                                "metarig's proportions give them; else they share the last role's stretch (a leg "
+                                "reaching the ground)")
+    extend_most: float = tuned(2.5, "... and no further than this many times what the proportions give them (a "
+                                    "cartoon's head is two to three times a man's; a sword in the hand is no hand)")
     snap: float = tuned(0.3, "a joint placed by the metarig's proportions moves onto a skeleton joint within this "
                              "share of the shorter of its two bones")
     mirror_tolerance: float = tuned(0.03, "twin chains whose joints mirror within this are made exact mirror images "
@@ -243,7 +245,8 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
         raise ValueError(f"the {metarig} metarig has no bones {', '.join(missing)}: not the metarig Rigger knows")
     body = _Body(skeleton, vertices, tuning)
     fit = Fit(metarig, body.frame)
-    for chain in spec.chains:
+    chains = _continued(spec.chains, meta, body)
+    for chain in chains:
         for side in _sides(chain):
             names = chain.names(side)
             points = _fit_chain(body, chain, side, names, meta, tuning)
@@ -281,6 +284,29 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
     fit.removed = _removed(meta, fit.heads)
     fit.notes = _notes(spec, fit, body)
     return fit
+
+
+def _continued(chains, meta, body):
+    """``chains``, each midline chain that goes on from another one's end in the metarig (the neck from the torso)
+    and whose roles the skeleton lacks made part of that one: it goes on from it in the metarig's proportions (a
+    skeleton whose chest runs up through the head still gets a neck and a head)."""
+    ends = {chain.bones[-1]: k for k, chain in enumerate(chains) if not chain.sided}
+    tolerance = 1e-6 * float(np.ptp([end for bone in meta.values() for end in (bone.head, bone.tail)], axis=0).max())
+    merged, absorbed = list(chains), set()
+    for k, chain in enumerate(chains):
+        roles = {role for group in _groups(chain.roles) for role in group}
+        if chain.sided or body.bones_of(roles, None):
+            continue
+        before = next((ends[bone] for bone in ends if ends[bone] != k and
+                       np.linalg.norm(np.subtract(meta[bone].tail, meta[chain.bones[0]].head)) <= tolerance), None)
+        if before is None:
+            continue
+        first = merged[before]
+        merged[before] = Chain(first.bones + chain.bones, first.roles + chain.roles)
+        absorbed.add(k)
+        body.notes.append(f"the model shows no {'/'.join(dict.fromkeys(chain.roles))}: the metarig's "
+                          f"{', '.join(chain.bones)} go on from {first.bones[-1]} in its proportions")
+    return [chain for k, chain in enumerate(merged) if k not in absorbed]
 
 
 def _chain_roles(chain, side, names):
@@ -545,10 +571,10 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning):
         wanted = scale * lengths[missing:].sum()
         direction = points[-1] - points[-2]
         direction = direction / max(np.linalg.norm(direction), 1e-300)
-        reach = _reach(body.vertices, points[-1], direction, wanted, body.size)
+        reach = _reach(body.vertices, points[-1], direction, tuning.extend_most * wanted, body.size)
         if reach >= tuning.extend * wanted:
-            points = np.vstack([points, points[-1] + min(reach, wanted) * direction])
-            arc = np.r_[arc, arc[-1] + min(reach, wanted)]
+            points = np.vstack([points, points[-1] + reach * direction])
+            arc = np.r_[arc, arc[-1] + reach]
             spans[missing] = (arc[-2], arc[-1])
     cuts = _cuts(groups, spans, arc, lengths, tuning.shortest * body.size, tuning)
     return body.local(np.array([_at(points, arc, cut) for cut in cuts]))
@@ -604,13 +630,13 @@ def _at(points, arc, position):
 
 
 def _reach(vertices, point, direction, limit, size):
-    """How far the mesh goes on beyond ``point`` along ``direction`` (unit), up to twice ``limit``: its vertices
-    within a tube as thick as the mesh is at ``point``."""
+    """How far the mesh goes on beyond ``point`` along ``direction`` (unit), up to ``limit``: its vertices within a
+    tube as thick as the mesh is at ``point``."""
     offsets = vertices - point
     along = offsets @ direction
     across = np.linalg.norm(offsets - np.outer(along, direction), axis=1)
     tube = max(2 * float(np.linalg.norm(offsets, axis=1).min()), 0.02 * size)
-    beyond = along[(along > 0) & (across <= tube) & (along <= 2 * limit)]
+    beyond = along[(along > 0) & (across <= tube) & (along <= limit)]
     return float(beyond.max()) if len(beyond) else 0.0
 
 
