@@ -355,7 +355,7 @@ def plot(records, path):
         axis.set_title(f"{record['model']}\n{record.get('metarig', '')}, IK {ik_cell(record)}", fontsize=7)
     figure.suptitle("Rigify rigs: the DEF bones on the mesh, from the front and from the character's left (front "
                     "to the left); red .L, blue .R", fontsize=9)
-    figure.tight_layout()
+    figure.tight_layout(rect=(0, 0, 1, 1 - 0.35 / (2.8 * rows_count)))
     figure.savefig(path, dpi=110)
     plt.close(figure)
 
