@@ -11,7 +11,7 @@ BPY42_STAMP := $(BPY42_VENV)/.installed
 RAY_STAMP := $(VENV)/.ray-installed
 
 .PHONY: test build demo addon bpy42 ray bench bench-quality bench-silhouette bench-skinning bench-posing \
-	bench-bodyplan bench-retarget bench-rig-time bench-batch regress regress-baseline defects clean
+	bench-bodyplan bench-retarget bench-rigify bench-rig-time bench-batch regress regress-baseline defects clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -70,6 +70,11 @@ bench-bodyplan: build
 # The CMU walk and jump (../shared/anim) on game rigs of the humanoids: feet, knees, elbows, weights, seams.
 bench-retarget: build
 	$(PY) bench/retarget.py
+
+# The rigify target on every ../shared model and sample character: generated, skinned, IK bends, regenerated:
+# bench/results/rigify.{md,png,json} and rigify_pose.png.
+bench-rigify: build
+	$(PY) bench/rigify_target.py
 
 bench-rig-time: build
 	$(PY) bench/rig_time.py

@@ -136,6 +136,10 @@ def _run_methods(args):
 
         print("body plan and bone roles (after every method):")
         _print_tuning(BodyPlanTuning)
+        from .core.metarig import MetarigTuning
+
+        print("the rigify target's metarig fitting:")
+        _print_tuning(MetarigTuning)
     for where, error in registry.failures.items():
         print(f"failed to load {where}: {error}", file=sys.stderr)
     return 0

@@ -1,8 +1,10 @@
 """Helpers the benchmarks share: where the checkout, the shared models and the results are, the machine and commit,
 markdown tables, time formatting, mesh refinement."""
+import datetime
 import os
 import pathlib
 import subprocess
+import sys
 
 import numpy as np
 
@@ -29,6 +31,27 @@ def described_commit():
     except (OSError, subprocess.SubprocessError):
         described = ""
     return described or "unknown"
+
+
+def run_record(script, argv):
+    """What a benchmark's report says about its run: the command (``script`` with the arguments ``argv``, None: this
+    process's), the start (UTC), the load average then, the CPU and the commit."""
+    arguments = " ".join(argv if argv is not None else sys.argv[1:])
+    return {"command": f"python bench/{script} {arguments}".rstrip(),
+            "started": datetime.datetime.now(datetime.timezone.utc), "load": os.getloadavg(), "cpu": cpu_model(),
+            "commit": described_commit()}
+
+
+def picked(items, wanted, name=lambda item: item):
+    """The ``items`` whose ``name`` contains any of the texts of ``wanted`` (a ``--models`` list, commas also
+    separating), all of them when ``wanted`` is empty; SystemExit when none does."""
+    if not wanted:
+        return list(items)
+    texts = [text for item in wanted for text in item.split(",") if text]
+    chosen = [item for item in items if any(text in name(item) for text in texts)]
+    if not chosen:
+        raise SystemExit(f"No model name contains any of {texts}.")
+    return chosen
 
 
 def markdown_table(header, rows, numeric=False):

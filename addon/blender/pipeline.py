@@ -13,6 +13,7 @@ from . import overlays, skinning, targets
 from .armature import delete_armature
 from .meshdata import combined_arrays
 from .properties import ARMATURE_POINTER
+from .rigify import remove_extras
 
 METHOD_PROPERTY = "rigger_method"  # custom property on the armature: the method that made it
 TARGET_PROPERTY = "rigger_target"  # ... and the output target it was built as
@@ -153,13 +154,15 @@ def skin_summary(outcomes):
 
 
 def remove_rig(obj):
-    """Delete the armature Rigger made for ``obj`` earlier, and unbind every mesh made with it (their Armature
-    modifiers, Rigger's vertex groups, the parenting; meshes keep their place). True when there was one."""
+    """Delete the armature Rigger made for ``obj`` earlier (with what its target made beside it: Rigify's metarig
+    and widgets), and unbind every mesh made with it (their Armature modifiers, Rigger's vertex groups, the
+    parenting; meshes keep their place). True when there was one."""
     armature = getattr(obj, ARMATURE_POINTER, None)
     if armature is None:
         return False
     for mesh in [o for o in bpy.data.objects if getattr(o, ARMATURE_POINTER, None) == armature]:
         skinning.unbind(mesh, armature)
         setattr(mesh, ARMATURE_POINTER, None)
+    remove_extras(armature)
     delete_armature(armature)
     return True

@@ -7,6 +7,7 @@ import bpy
 from ..core.skeleton import Skeleton
 from . import game
 from .armature import build_armature
+from .rigify import build_rigify
 
 
 @dataclass
@@ -40,5 +41,5 @@ def _plain(skeleton, name, collection, frame, mesh=None):
     return Built(build_armature(skeleton, name, collection, frame=frame), skeleton)
 
 
-BUILDERS = {"plain": _plain, "game": game.build}
+BUILDERS = {"plain": _plain, "game": game.build, "rigify": build_rigify}
 FINISHERS = {"game": game.finish_skin}

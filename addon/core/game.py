@@ -23,8 +23,8 @@ The naming scheme (one for every body plan; the README says the same for users):
   chains are numbered from the highest start down.
 
 Each bone with a Mixamo name begins at its role's named joint (``core.roles.named_joints``: a knee where the artists'
-rigs have it, which may lie inside a bone of Rigger's), the bones ending there moved with it, unless that would all
-but remove a bone (``_Bones.at_named_joints``).
+rigs have it, which may lie inside a bone of Rigger's) when it lies near (``core.roles.within_reach``), the bones
+ending there moved with it.
 
 The hierarchy is Rigger's read from the hips outwards (Rigger may root a quadruped at its neck): a chain hangs from the
 game bone that holds the joint it starts from. Twins (``Left…`` and ``Right…`` bones that mirror each other within
@@ -34,7 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .roles import BoneRole, named_joints
+from .polyline import arc_nearest
+from .roles import BoneRole, named_joints, within_reach
 from .skeleton import Skeleton
 
 ROOT = "root"
@@ -42,7 +43,6 @@ SPINE_AT = 0.2  # share of the trunk from the hips joint to the neck where Mixam
 CHEST_AT = 0.7  # ... and Spine2 (0.7)
 TWIN_TOLERANCE = 0.02  # twins whose points mirror within this share of the size are mirrored exactly
 ROOT_LENGTH = 0.1  # the root bone's length, a share of the size
-KEEP_LENGTH = 0.5  # a bone keeps at least this share of its length when its end moves to a named joint
 MERGE_TOLERANCE = 1e-9  # points this close (a share of the size) are one joint
 
 WORDS = {"hips": "Hips", "neck": "Neck", "head": "Head", "jaw": "Jaw", "shoulder": "Shoulder", "upper_arm": "Arm",
@@ -285,7 +285,7 @@ class _Bones:
             named = next((self.joints[(name, None, None)] for name in names if (name, None, None) in self.joints),
                          None)
             at = next((k for k, role in enumerate(role_at) if role in names), None)
-            along = _arc_nearest(points, arc, named) if named is not None else arc[at] if at is not None else None
+            along = arc_nearest(points, arc, named) if named is not None else arc[at] if at is not None else None
             return along if along is not None and 0 < along < total else share * total
 
         spine = begins(("spine", "chest"), SPINE_AT)
@@ -355,8 +355,7 @@ class _Bones:
 
     def at_named_joints(self, tolerance):
         """Move the head of each first bone of a Mixamo name to its role's named joint, with the bones ending there
-        (siblings starting there have joints of their own). A named joint farther than the bone's length, or one that
-        would shrink a bone below ``KEEP_LENGTH`` of its length, is not this chain's: those ends stay."""
+        (siblings starting there have joints of their own), when it is within reach (``core.roles.within_reach``)."""
         for bone in self.bones:
             role = bone["role"]
             key = (role.role, role.side, None)
@@ -364,11 +363,8 @@ class _Bones:
                 continue
             old, new = bone["head"].copy(), np.asarray(self.joints[key], float)
             ending = [other for other in self.bones if np.linalg.norm(other["tail"] - old) <= tolerance]
-            if not tolerance < np.linalg.norm(new - old) <= np.linalg.norm(bone["tail"] - old):
+            if not within_reach(old, new, [bone["tail"]] + [other["head"] for other in ending]):
                 continue
-            if any(np.linalg.norm(end - start) < KEEP_LENGTH * np.linalg.norm(end - old)
-                   for end, start in [(bone["tail"], new)] + [(other["head"], new) for other in ending]):
-                continue  # a bone would all but vanish: the joint is not this chain's
             bone["head"] = new.copy()
             for other in ending:
                 other["tail"] = new.copy()
@@ -414,16 +410,6 @@ def _point_at(points, arc, at):
     span = arc[k + 1] - arc[k]
     share = 0.0 if span <= 0 else (at - arc[k]) / span
     return points[k] + np.clip(share, 0.0, 1.0) * (points[k + 1] - points[k])
-
-
-def _arc_nearest(points, arc, point):
-    """The arc length along the polyline ``points`` (cumulative lengths ``arc``) of its point nearest ``point``."""
-    starts, steps = points[:-1], np.diff(points, axis=0)
-    lengths = np.einsum("ij,ij->i", steps, steps)
-    shares = np.clip(np.einsum("ij,ij->i", point - starts, steps) / np.where(lengths > 0, lengths, 1), 0, 1)
-    distances = np.linalg.norm(starts + shares[:, None] * steps - point, axis=1)
-    k = int(np.argmin(distances))
-    return float(arc[k] + shares[k] * (arc[k + 1] - arc[k]))
 
 
 def _finger_spans(points, real):

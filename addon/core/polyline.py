@@ -35,3 +35,12 @@ def nearest_on_segments(points, starts, ends):
 def segment_distances(points, starts, ends):
     """(P, S) distances from each of the (P, 3) ``points`` to each segment ``starts[k]``–``ends[k]``."""
     return np.linalg.norm(points[:, None, :] - nearest_on_segments(points, starts, ends), axis=2)
+
+
+def arc_nearest(line, arc, point):
+    """The arc length along a polyline (cumulative arc lengths ``arc``) of its point nearest ``point``."""
+    starts, ends = line[:-1], line[1:]
+    nearest = nearest_on_segments(np.asarray(point, dtype=np.float64)[None], starts, ends)[0]
+    k = int(np.argmin(np.linalg.norm(nearest - point, axis=1)))
+    span = np.linalg.norm(ends[k] - starts[k])
+    return float(arc[k] + (np.linalg.norm(nearest[k] - starts[k]) if span > 0 else 0.0))

@@ -9,13 +9,15 @@ from dataclasses import dataclass
 @dataclass(frozen=True)
 class Target:
     """An output target: ``name`` (the CLI's ``--target`` value), a ``label`` and ``description`` for the panel, the
-    body plan kinds it can fill (None: every plan) and the target it falls back to otherwise."""
+    body plan kinds it can fill (None: every plan), the target it falls back to otherwise, and ``needs``: {plan kind:
+    a part (a key of ``BodyPlan.parts``) that a plan of that kind must have to fill it}."""
 
     name: str
     label: str
     description: str
     plans: tuple = None
     fallback: str = None
+    needs: dict = None
 
     def unfit(self, plan):
         """Why ``plan`` (a ``core.bodyplan.BodyPlan``, or None when not recognised) cannot fill this target, or None
@@ -23,9 +25,12 @@ class Target:
         if self.plans is None:
             return None
         kind = "unknown" if plan is None else plan.kind
-        if kind in self.plans:
-            return None
-        return f"the {self.name} target needs a {' or '.join(self.plans)} body plan, and this one is {kind}"
+        if kind not in self.plans:
+            return f"the {self.name} target needs a {' or '.join(self.plans)} body plan, and this one is {kind}"
+        part = (self.needs or {}).get(kind)
+        if part is not None and not plan.parts.get(part):
+            return f"the {self.name} target needs a {kind} with {part}, and this one has none ({plan.reason})"
+        return None
 
 
 TARGETS = {target.name: target for target in (
@@ -33,6 +38,8 @@ TARGETS = {target.name: target for target in (
     Target("game", "Game", "A deform-only skeleton for game engines and mocap: a root bone on the ground, Mixamo "
                            "names on humanoids, at most 4 weights per vertex",
            plans=("humanoid", "quadruped", "bird", "fish"), fallback="plain"),
+    Target("rigify", "Rigify", "Rigify's control rig (IK/FK, editable metarig) from its metarig fitted to the mesh",
+           plans=("humanoid", "quadruped", "bird"), fallback="game", needs={"bird": "legs"}),
 )}
 
 
