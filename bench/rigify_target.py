@@ -282,7 +282,7 @@ def summary(records):
             "ik_right": sum(item["right"] for item in limbs), "ik_limbs": len(limbs),
             "regenerated": len(regenerated), "others": len(others),
             "others_built": [r["model"] for r in others if r.get("target") == "rigify" and "error" not in r],
-            "fell_back_plain": sum(r.get("target") == "plain" for r in others),
+            "fell_back": {target: sum(r.get("target") == target for r in others) for target in ("game", "plain")},
             "failures": [(r["model"], r.get("error", "")) for r in expected if r not in built]}
 
 
@@ -309,7 +309,8 @@ def report(records, totals, pose, run):
         f"limbs; regenerating from the edited metarig kept the mesh bound on {totals['regenerated']} / "
         f"{totals['built']}. Of the {totals['others']} models of other plans, "
         f"{', '.join(totals['others_built']) or 'none'} (birds with legs) got the bird metarig and "
-        f"{totals['fell_back_plain']} fell back to plain with a warning saying why.",
+        f"{totals['fell_back']['game']} fell back to game and {totals['fell_back']['plain']} to plain (game's own "
+        f"fallback), each with a warning saying why.",
     ]
     if totals["failures"]:
         lines += ["", "Failures: " + "; ".join(f"{model}: {table_cell(error, 200)}"

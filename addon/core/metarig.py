@@ -578,6 +578,15 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
     for group in groups:
         at = [k for k, role in enumerate(step_roles) if role in group]
         spans.append((arc[min(at)], arc[max(at) + 1]) if at else None)
+    starts = {} if named is None else {k: body.joints.get((group[0], *named)) for k, group in enumerate(groups)
+                                       if spans[k] is not None and (k == 0 or group != groups[k - 1])}
+    starts = {k: joint for k, joint in starts.items() if joint is not None}  # of roles the skeleton has
+    pins = {}  # where a role begins, moved to its named joint when within reach of the roles around it
+    for k, joint in starts.items():
+        before = next((span for span in reversed(spans[:k]) if span is not None), None)
+        if k and before is not None and within_reach(_at(points, arc, spans[k][0]), joint,
+                                                     [_at(points, arc, before[0]), _at(points, arc, spans[k][1])]):
+            pins[k] = arc_nearest(points, arc, joint)
     missing = next((k for k in range(len(groups)) if all(span is None for span in spans[k:])), len(groups))
     if 0 < missing < len(groups):  # the chain's last roles are missing: the mesh may go on where they belong
         present = [k for k in range(missing) if spans[k] is not None]
@@ -590,16 +599,12 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
             points = np.vstack([points, points[-1] + reach * direction])
             arc = np.r_[arc, arc[-1] + reach]
             spans[missing] = (arc[-2], arc[-1])
-    starts = {} if named is None else {k: body.joints.get((group[0], *named)) for k, group in enumerate(groups)
-                                       if k == 0 or group != groups[k - 1]}
-    starts = {k: joint for k, joint in starts.items() if joint is not None}
-    pins = {k: arc_nearest(points, arc, joint) for k, joint in starts.items() if k}
     cuts = _cuts(groups, spans, arc, lengths, tuning.shortest * body.size, tuning, pins)
     placed = np.array([_at(points, arc, cut) for cut in cuts])
-    if after is not None:
-        starts[len(groups)] = after
-    for k, joint in starts.items():  # exactly there (a hip joint beside the path) when near
-        if within_reach(placed[k], joint, placed[[i for i in (k - 1, k + 1) if 0 <= i < len(placed)]]):
+    ends = {0: starts.get(0), len(groups): after}  # the chain's ends exactly there (a hip joint beside the path)
+    for k, joint in ends.items():
+        beside = placed[[i for i in (k - 1, k + 1) if 0 <= i < len(placed)]]
+        if joint is not None and within_reach(placed[k], joint, beside):
             placed[k] = joint
     return body.local(placed)
 
@@ -619,7 +624,7 @@ def _cuts(groups, spans, arc, lengths, shortest, tuning, named=None):
         if groups[k] == groups[k - 1]:
             continue
         pins[k] = spans[k][0] if spans[k] is not None else spans[k - 1][1] if spans[k - 1] is not None else None
-        if pins[k] is not None and named and k in named:
+        if named and k in named:
             pins[k] = named[k]
     changed = True
     while changed:  # pins that leave the bones between them no room give way
