@@ -94,6 +94,41 @@ class JointGraph:
                     stack.append(other)
         return distance, before
 
+    def distances(self):
+        """(K, K) distances along the bones between every two joints: each joint's row is its parent's (in a
+        depth-first order from joint 0) plus the bone between them, less twice that bone within its own subtree."""
+        count = len(self.points)
+        order, parent, seen = [], np.full(count, -1), np.zeros(count, bool)
+        for root in range(count):  # one tree, but stay total on a forest
+            if seen[root]:
+                continue
+            seen[root] = True
+            stack = [root]
+            while stack:
+                node = stack.pop()
+                order.append(node)
+                for other, _ in self.neighbours[node]:
+                    if not seen[other]:
+                        seen[other], parent[other] = True, node
+                        stack.append(other)
+        place = np.empty(count, int)
+        place[order] = np.arange(count)
+        ends = np.arange(count) + 1  # where each joint's subtree ends in ``order``
+        for node in reversed(order):
+            if parent[node] >= 0:
+                ends[place[parent[node]]] = max(ends[place[parent[node]]], ends[place[node]])
+        table = np.full((count, count), np.inf)
+        for node in order:
+            row = place[node]
+            if parent[node] < 0:
+                reached = self.search(node)[0]
+                table[row] = [reached.get(other, np.inf) for other in order]
+                continue
+            step = float(np.linalg.norm(self.points[node] - self.points[parent[node]]))
+            table[row] = table[place[parent[node]]] + step
+            table[row, row:ends[row]] -= 2 * step
+        return table[np.ix_(place, place)]
+
     def longest_path(self, allowed=None, start=None):
         """The longest path (by length) within ``allowed`` joints: from the joint farthest from ``start`` to the one
         farthest from it."""
@@ -345,8 +380,7 @@ def _fitted_plane(graph, mesh, size, tuning):
     body, more than ``contact_apart`` apart."""
     points = graph.points
     tips = points[graph.leaves()]
-    distance = np.array([[graph.search(node)[0][other] for other in range(len(points))]
-                         for node in range(len(points))])
+    distance = graph.distances()
     apart = distance > tuning.contact_apart * size
     best, best_pairs = None, tuning.plane_pairs - 1
     low, high = mesh.bbox
