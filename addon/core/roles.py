@@ -122,6 +122,8 @@ class RoleTuning(TuningTable):
     neck_at: float = tuned(0.85, "its neck joint: this share")
     spine_fall: float = tuned(0.02, "... on its spine up to where it falls this share of the height (a hunched "
                                     "figure's head hanging forward)")
+    named_reach: float = tuned(0.75, "a target's joint moves to its named joint only within this share of its "
+                                     "shortest bone (none shrinks below a quarter); farther off is another chain's")
 
 
 def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
@@ -452,17 +454,16 @@ def _limb_side(skeleton, graph, limb, left):
     return "L" if limb.side * left > 0 else "R"
 
 
-NAMED_REACH = 0.75  # a target's joint moves to its named joint within this share of its shortest bone
 CHAINS = (("hips", "spine", "chest", "neck", "head"), ("shoulder", "upper_arm", "forearm", "hand"),
           ("hips", "thigh", "shin", "foot", "toe"))  # roles that follow each other along a chain
 
 
-def within_reach(joint, named, ends):
-    """Whether a target's joint at ``joint`` may move to its role's named joint ``named``: only within
-    ``NAMED_REACH`` of the shortest bone from it to the other ``ends`` of the bones meeting there, so every bone keeps
-    most of its length; a named joint farther off is another chain's (a second pair of arms) or a guess."""
+def within_reach(joint, named, ends, tuning=RoleTuning()):
+    """Whether a target's joint at ``joint`` may move to its role's named joint ``named``: only within ``named_reach``
+    of the shortest bone from it to the other ``ends`` of the bones meeting there; a named joint farther off is
+    another chain's (a second pair of arms) or a guess."""
     shortest = min((np.linalg.norm(np.subtract(end, joint)) for end in ends), default=0.0)
-    return float(np.linalg.norm(np.subtract(named, joint))) <= NAMED_REACH * shortest
+    return float(np.linalg.norm(np.subtract(named, joint))) <= tuning.named_reach * shortest
 
 
 def named_joints(skeleton, roles=None):
