@@ -32,6 +32,7 @@ QUIET = {key: LOOPBACK[key] for key in ("RAY_AUTH_MODE", "RAY_USAGE_STATS_ENABLE
 TIMEOUT = 15  # seconds per file: a generated character takes well under one in a started worker
 GOOD = ("humanoid.obj", "quadruped.obj", "snake.obj", "sub/tree.obj")
 START_SECONDS = 120
+STOP_SECONDS = 300  # for the workers to be killed and Ray left after Ctrl-C (about a second when the machine is idle)
 
 
 def free_port():
@@ -166,7 +167,11 @@ def test_an_interrupted_batch_resumes_where_it_stopped(cluster, library, tmp_pat
             raise AssertionError(driver.communicate())
         time.sleep(0.2)
     driver.send_signal(signal.SIGINT)
-    _, stderr = driver.communicate(timeout=120)
+    try:
+        _, stderr = driver.communicate(timeout=STOP_SECONDS)
+    except subprocess.TimeoutExpired:
+        driver.kill()
+        raise AssertionError(f"still running {STOP_SECONDS} s after Ctrl-C: {driver.communicate()}") from None
     assert driver.returncode == 130 and "interrupted" in stderr and "--resume" in stderr, stderr
     assert files_below(out) == ["a.blend", "a.json", "b.blend", "b.json", "summary.json"]
     assert sorted(rows_of(out)) == ["a.obj", "b.obj"]
