@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .polyline import arc_nearest
+from .polyline import arc_lengths, arc_nearest, point_at
 from .roles import BoneRole, named_joints, within_reach
 from .skeleton import Skeleton
 
@@ -277,7 +277,7 @@ class _Bones:
         """Hips, Spine, Spine1, Spine2 along the trunk chain (see the module docstring)."""
         graph, roles = self.graph, self.graph.skeleton.roles
         points = graph.points[chain.nodes]
-        arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+        arc = arc_lengths(points)
         total = arc[-1]
         role_at = [roles[graph.edges[edge][2]].role if graph.edges[edge][2] >= 0 else None for edge in chain.edges]
 
@@ -293,7 +293,7 @@ class _Bones:
         if not spine < chest < total:
             spine, chest = SPINE_AT * total, CHEST_AT * total
         cuts = [0.0, spine, 0.5 * (spine + chest), chest, total]
-        at = [_point_at(points, arc, cut) for cut in cuts]
+        at = point_at(points, arc, np.array(cuts))
         names = [("Hips", BoneRole("hips")), ("Spine", BoneRole("spine")), ("Spine1", BoneRole("spine", index=1)),
                  ("Spine2", BoneRole("chest"))]
         made = [self._add(base, None, "", at[k], at[k + 1], role, chain.nodes[0] if k == 0 else None, id(chain),
@@ -404,21 +404,13 @@ class _Bones:
         return owners
 
 
-def _point_at(points, arc, at):
-    """The point at arc length ``at`` along the polyline ``points`` (cumulative lengths ``arc``)."""
-    k = int(np.clip(np.searchsorted(arc, at, side="right") - 1, 0, len(points) - 2))
-    span = arc[k + 1] - arc[k]
-    share = 0.0 if span <= 0 else (at - arc[k]) / span
-    return points[k] + np.clip(share, 0.0, 1.0) * (points[k + 1] - points[k])
-
-
 def _finger_spans(points, real):
     """(low, high) node spans of a finger's game bones: one per bone up to ``FINGER_BONES``, else cut at the joints
     nearest the thirds of its length."""
     count = len(points) - 1
     if sum(real) <= FINGER_BONES:
         return [(k, k + 1) for k in range(count) if real[k]] or [(0, count)]
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    arc = arc_lengths(points)
     cuts = [0]
     for share in np.arange(1, FINGER_BONES) / FINGER_BONES:
         best = int(np.argmin(np.abs(arc - share * arc[-1])))

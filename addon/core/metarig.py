@@ -53,7 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .polyline import arc_nearest
+from .polyline import arc_lengths, arc_nearest, point_at
 from .roles import CHAINS, BoneRole, named_joints, within_reach
 from .tuning import TuningTable, tuned
 
@@ -544,7 +544,7 @@ def _fit_chain(body, chain, side, names, meta, tuning):
             return None
         points = np.vstack([wrist, points])
         step_roles = ["palm"] + step_roles
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    arc = arc_lengths(points)
     if arc[-1] <= 0:
         return None
     lengths = np.array([np.linalg.norm(np.subtract(meta[name].tail, meta[name].head)) for name in names])
@@ -572,7 +572,7 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
     after = body.joints.get((_next_role(groups[-1][-1]), *named)) if named is not None else None
     if after is not None and 0 < (end := arc_nearest(points, arc, after)) < arc[-1]:
         kept = int(np.searchsorted(arc, end, side="left"))
-        points, step_roles = np.vstack([points[:kept], _at(points, arc, end)]), step_roles[:kept]
+        points, step_roles = np.vstack([points[:kept], point_at(points, arc, end)]), step_roles[:kept]
         arc = np.r_[arc[:kept], end]
     spans = []
     for group in groups:
@@ -584,8 +584,8 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
     pins = {}  # where a role begins, moved to its named joint when within reach of the roles around it
     for k, joint in starts.items():
         before = next((span for span in reversed(spans[:k]) if span is not None), None)
-        if k and before is not None and within_reach(_at(points, arc, spans[k][0]), joint,
-                                                     [_at(points, arc, before[0]), _at(points, arc, spans[k][1])]):
+        if k and before is not None and within_reach(point_at(points, arc, spans[k][0]), joint,
+                                                     point_at(points, arc, np.array([before[0], spans[k][1]]))):
             pins[k] = arc_nearest(points, arc, joint)
     missing = next((k for k in range(len(groups)) if all(span is None for span in spans[k:])), len(groups))
     if 0 < missing < len(groups):  # the chain's last roles are missing: the mesh may go on where they belong
@@ -600,7 +600,7 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
             arc = np.r_[arc, arc[-1] + reach]
             spans[missing] = (arc[-2], arc[-1])
     cuts = _cuts(groups, spans, arc, lengths, tuning.shortest * body.size, tuning, pins)
-    placed = np.array([_at(points, arc, cut) for cut in cuts])
+    placed = point_at(points, arc, cuts)
     ends = {0: starts.get(0), len(groups): after}  # the chain's ends exactly there (a hip joint beside the path)
     for k, joint in ends.items():
         beside = placed[[i for i in (k - 1, k + 1) if 0 <= i < len(placed)]]
@@ -656,13 +656,6 @@ def _cuts(groups, spans, arc, lengths, shortest, tuning, named=None):
     for k in range(count - 1, 0, -1):
         cuts[k] = min(cuts[k], cuts[k + 1] - gap)
     return cuts
-
-
-def _at(points, arc, position):
-    """The point ``position`` along the polyline ``points`` with cumulative lengths ``arc``."""
-    k = int(np.clip(np.searchsorted(arc, position, side="right") - 1, 0, len(points) - 2))
-    share = (position - arc[k]) / max(arc[k + 1] - arc[k], 1e-300)
-    return points[k] + np.clip(share, 0.0, 1.0) * (points[k + 1] - points[k])
 
 
 def _reach(vertices, point, direction, limit, size):
