@@ -61,11 +61,11 @@ def main(names):
         obj = build_character(name)
         vertices, triangles = mesh_arrays(obj.data)
         skeleton = rigger.rig_mesh(vertices, triangles)
-        lines = measured(name, vertices, triangles, skeleton)
+        truth = samples.ground_truth_bones(name)
+        lines = measured(name, vertices, triangles, skeleton, truth)
         print("\n".join(lines), flush=True)
         report += lines + [f"![{name}]({name}.png)", ""] + ([f"![{name}, zoomed]({name}_zoom.png)", ""]
                                                              if name in ZOOMS else [])
-        truth = samples.ground_truth_bones(name)
         render(bpy, demo, vertices, triangles, truth, skeleton, OUT / f"{name}.png")
         if name in ZOOMS:
             render(bpy, demo, vertices, triangles, truth, skeleton, OUT / f"{name}_zoom.png", ZOOMS[name])
@@ -73,9 +73,9 @@ def main(names):
     print(f"wrote {OUT / 'report.md'} and the pictures beside it")
 
 
-def measured(name, vertices, triangles, skeleton):
-    """Markdown lines: every measure of Rigger's ``skeleton`` of character ``name`` (see the module's docstring)."""
-    truth = samples.ground_truth_bones(name)
+def measured(name, vertices, triangles, skeleton, truth):
+    """Markdown lines: every measure of Rigger's ``skeleton`` of character ``name``, against its ``truth`` skeleton
+    (see the module's docstring)."""
     size = rc.mesh_size(vertices)
     left, right = rc.side_counts(skeleton)
     twins = rc.twin_mismatches(skeleton, size)
@@ -164,13 +164,13 @@ def render(bpy, demo, vertices, triangles, truth, skeleton, path, box=None):
             return (np.asarray(points) - centre) @ turn.T + shift
 
         _add(bpy, f"{view}_skin", placed(vertices), triangles, SKIN_COLOUR)
-        bones = demo.bone_mesh(bpy, _Bones(placed(truth.heads), placed(truth.tails)), TRUTH_WIDTH)
+        bones = demo.bone_mesh(bpy, placed(truth.heads), placed(truth.tails), TRUTH_WIDTH)
         _link(bpy, f"{view}_truth", bones, TRUTH_COLOUR)
         sides = np.array([rc.side_of(bone) for bone in skeleton.names], dtype=object)
         for side, colour in COLOURS.items():
             picked = np.flatnonzero(sides == side)
             if len(picked):
-                bones = demo.bone_mesh(bpy, _Bones(placed(skeleton.heads[picked]), placed(skeleton.tails[picked])))
+                bones = demo.bone_mesh(bpy, placed(skeleton.heads[picked]), placed(skeleton.tails[picked]))
                 _link(bpy, f"{view}_rig_{side}", bones, colour)
         width = offset + across
         offset += across + GAP * extent.max()
@@ -187,13 +187,6 @@ def render(bpy, demo, vertices, triangles, truth, skeleton, path, box=None):
     scene.display.shading.color_type = 'MATERIAL'
     scene.render.filepath = str(path)
     bpy.ops.render.render(write_still=True)
-
-
-class _Bones:
-    """Heads and tails, as ``demo.bone_mesh`` reads them."""
-
-    def __init__(self, heads, tails):
-        self.heads, self.tails = heads, tails
 
 
 def _add(bpy, name, vertices, triangles, colour):

@@ -142,7 +142,7 @@ def render(bpy, overlays, obj, skeleton, path):
     scene = bpy.context.scene
     for overlay in bpy.data.collections[overlays.COLLECTION_NAME].objects:
         overlay.hide_render = overlay[overlays.KIND_KEY] in HIDDEN_IN_PICTURE
-    bones = bpy.data.objects.new("bones", bone_mesh(bpy, skeleton))
+    bones = bpy.data.objects.new("bones", bone_mesh(bpy, skeleton.heads, skeleton.tails))
     material = bpy.data.materials.new("bones")
     material.diffuse_color = BONE_COLOUR
     bones.data.materials.append(material)
@@ -171,11 +171,11 @@ def render(bpy, overlays, obj, skeleton, path):
     bpy.ops.render.render(write_still=True)
 
 
-def bone_mesh(bpy, skeleton, width=BONE_WIDTH):
-    """Blender's octahedral bone shape for every bone of ``skeleton`` (its ``heads`` and ``tails``): a point at head
-    and tail, a square a tenth of the way up, ``width`` bone lengths from the axis."""
+def bone_mesh(bpy, heads, tails, width=BONE_WIDTH):
+    """Blender's octahedral bone shape for every bone from ``heads`` to ``tails``: a point at head and tail, a square
+    a tenth of the way up, ``width`` bone lengths from the axis."""
     vertices, faces = [], []
-    for head, tail in zip(skeleton.heads, skeleton.tails):
+    for head, tail in zip(heads, tails):
         along = tail - head
         length = np.linalg.norm(along)
         side = np.cross(along, [0.0, 0.0, 1.0] if abs(along[2]) < 0.9 * length else [1.0, 0.0, 0.0])

@@ -23,6 +23,7 @@ from mathutils import Matrix, Vector
 from ..core.metarig import METARIGS, MetaBone, choose_metarig, fit_metarig
 from ..core.roles import BoneRole
 from ..core.skeleton import Skeleton
+from .meshdata import world_points
 
 ADDON = "rigify"
 METARIG_PROPERTY = "rigger_metarig"  # custom property on the generated rig: its metarig object
@@ -207,9 +208,8 @@ def deform_skeleton(rig, roles=None):
                 found = index[twin]
             parent = parent.parent
         parents.append(found)
-    matrix = np.array(rig.matrix_world, dtype=np.float64)
     ends = np.array([(bone.head_local, bone.tail_local) for bone in deform], dtype=np.float64)
-    world = ends @ matrix[:3, :3].T + matrix[:3, 3]
+    world = world_points(ends, rig.matrix_world)
     skeleton = Skeleton([bone.name for bone in deform], world[:, 0], world[:, 1], np.array(parents, dtype=np.int32))
     if roles is not None:
         skeleton.roles = _counted([_metarig_role(bone.name, roles) for bone in deform])

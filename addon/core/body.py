@@ -18,6 +18,7 @@ The pieces, in the order :func:`read_body` finds them:
   Without a mirror plane the spine is the skeleton's longest path and every branch off it is a limb.
 """
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -94,6 +95,7 @@ class JointGraph:
                     stack.append(other)
         return distance, before
 
+    @cached_property
     def distances(self):
         """(K, K) distances along the bones between every two joints: each joint's row is its parent's (in a
         depth-first order from joint 0) plus the bone between them, less twice that bone within its own subtree."""
@@ -339,7 +341,7 @@ def read_body(skeleton, mesh, tuning=BodyTuning(), plane=None, prefer_up=AXES[2]
     spine, limbs, bases, connectors = _midline_and_limbs(graph, found, size, tuning)
     limbs = _paired(limbs, graph, skeleton, found, size, tuning)
     tips = sorted({node for limb in limbs for node in limb.before if graph.degree(node) == 1})
-    up, up_evidence, up_note = _up_axis(graph, tips, radius, mesh, found, size, tuning,
+    up, up_evidence, up_note = _up_axis(graph, tips, radius, mesh, vertices, found, size, tuning,
                                         np.asarray(prefer_up, dtype=np.float64))
     heights = mesh.used_vertices @ up
     if mesh.flat_normal is not None:
@@ -380,7 +382,7 @@ def _fitted_plane(graph, mesh, size, tuning):
     body, more than ``contact_apart`` apart."""
     points = graph.points
     tips = points[graph.leaves()]
-    distance = graph.distances()
+    distance = graph.distances
     apart = distance > tuning.contact_apart * size
     best, best_pairs = None, tuning.plane_pairs - 1
     low, high = mesh.bbox
@@ -411,11 +413,11 @@ def _span(points):
 
 # Up.
 
-def _up_axis(graph, tips, radius, mesh, plane, size, tuning, prefer_up):
+def _up_axis(graph, tips, radius, mesh, sample, plane, size, tuning, prefer_up):
     """(up, evidence, note) as :func:`read_body` says: each candidate axis scores ``leg_weight`` when separate limbs
     touch the ground at its bottom (their leaf ``tips``: the body's own ends are no feet), plus its flat bottom area
-    as a share of the best candidate's (or of ``flat_area`` when none has that much); ``prefer_up`` breaks ties. The
-    evidence is "legs", "flat" or "preferred"; the note says it in words."""
+    as a share of the best candidate's (or of ``flat_area`` when none has that much), spread over the vertex
+    ``sample``; ``prefer_up`` breaks ties. The evidence is "legs", "flat" or "preferred"; the note says it in words."""
     candidates = []
     low, high = mesh.bbox
     for axis in range(3):
@@ -441,7 +443,6 @@ def _up_axis(graph, tips, radius, mesh, plane, size, tuning, prefer_up):
     facing = -(normals @ ups.T) >= 0.7 * areas[:, None]
     bottom = tops <= lows + tuning.flat_bottom * size
     flats = (areas[:, None] * (bottom & facing)).sum(axis=0) / total_area
-    sample = _sampled(mesh.used_vertices, tuning.sample_vertices)
     spreads = np.array([_spread(corners[bottom[:, k] & facing[:, k]].reshape(-1, 3), sample, up)
                         if flats[k] >= tuning.flat_area else 0.0 for k, up in enumerate(candidates)])
     flats[spreads < tuning.flat_spread] = 0.0  # a base spreads under the body: a patch atop a floating head is none
@@ -479,7 +480,7 @@ def _contacts(graph, radius, tips, up, low, high, size, tuning):
                 if graph.points[leaf] @ up - radius[leaf] <= low + tuning.contact_height * (high - low)]  # touches()
     groups = []
     for leaf in touching:
-        if not any(graph.search(first)[0][leaf] <= tuning.contact_apart * size for first in groups):
+        if not any(graph.distances[first, leaf] <= tuning.contact_apart * size for first in groups):
             groups.append(leaf)
     return len(groups)
 

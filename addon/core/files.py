@@ -3,13 +3,11 @@ import contextlib
 import glob
 import os
 import pathlib
-import re
 import shutil
 import tempfile
 
 
-_LEFTOVER = ".rigger-partial.{}."  # the prefix of the temporary folder beside the final file
-_LEFTOVER_NAME = re.compile(r"\.rigger-partial\..+\.[a-z0-9_]{8}")  # ... and tempfile's eight random characters
+_LEFTOVER = ".rigger-partial."  # how the temporary folders beside the final files begin
 
 
 @contextlib.contextmanager
@@ -19,7 +17,7 @@ def replaced_on_success(final):
     for the rename, no existing file for Blender to back up as .blend1, and the usual permissions."""
     final = pathlib.Path(final)
     final.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix=_LEFTOVER.format(final.name), dir=final.parent) as folder:
+    with tempfile.TemporaryDirectory(prefix=f"{_LEFTOVER}{final.name}.", dir=final.parent) as folder:
         path = pathlib.Path(folder) / final.name
         yield path
         os.replace(path, final)
@@ -29,7 +27,7 @@ def remove_leftovers(final):
     """Remove the folders ``replaced_on_success`` leaves beside ``final`` when its process is killed before the
     rename."""
     final = pathlib.Path(final)
-    for leftover in final.parent.glob(glob.escape(_LEFTOVER.format(final.name)) + "*"):
+    for leftover in final.parent.glob(glob.escape(f"{_LEFTOVER}{final.name}.") + "*"):
         if leftover.is_dir():
             shutil.rmtree(leftover)
 
@@ -38,6 +36,6 @@ def remove_leftover_folders(folder):
     """Remove every folder ``replaced_on_success`` left anywhere below ``folder`` (processes killed before the
     rename, say a whole batch killed at once)."""
     for parent, folders, _ in os.walk(folder):
-        for name in [name for name in folders if _LEFTOVER_NAME.fullmatch(name)]:
+        for name in [name for name in folders if name.startswith(_LEFTOVER)]:
             shutil.rmtree(os.path.join(parent, name), ignore_errors=True)
             folders.remove(name)

@@ -87,7 +87,7 @@ def game_skeleton(skeleton, vertices):
             bones.chain(chain)
     bones.name_instances(up)
     bones.at_named_joints(MERGE_TOLERANCE * size)
-    names, heads, tails, parents, roles = bones.finished(start, arriving)
+    names, heads, tails, parents, roles = bones.finished(arriving)
     heads, tails = _mirrored_twins(names, heads, tails, skeleton.stages.get("mirror_plane"), size)
     hips = heads[bones.hips] if bones.hips is not None else graph.points[start]
     ground = float((vertices @ up).min()) if len(vertices) else float(hips @ up)
@@ -308,7 +308,7 @@ class _Bones:
     def chain(self, chain):
         graph = self.graph
         role_name, side, digit = chain.key
-        if role_name == "pelvis":  # a leg's hips bones are the pelvis: Hips holds them
+        if role_name in ("pelvis", "trunk"):  # a leg's hips bones (the pelvis), a trunk branch: Hips holds them
             owner = self.hips
             if owner is not None:
                 for edge in chain.edges:
@@ -369,7 +369,7 @@ class _Bones:
             for other in ending:
                 other["tail"] = new.copy()
 
-    def finished(self, start, arriving):
+    def finished(self, arriving):
         """(names, heads, tails, parents, roles): each bone hangs from the game bone holding the joint its chain
         starts at (the Hips at the hips node), or from the bone before it in its chain."""
         names = [f"{SIDE_WORDS[bone['side']]}{bone['base']}{bone['number']}{bone['suffix']}" for bone in self.bones]

@@ -54,7 +54,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .polyline import arc_lengths, arc_nearest, point_at
-from .roles import CHAINS, BoneRole, named_joints, within_reach
+from .roles import CHAINS, BoneRole, mesh_reach, named_joints, within_reach
 from .tuning import TuningTable, tuned
 
 FORWARD, BACKWARD = 1, -1  # the way a limb's first joint bends (a knee, an elbow)
@@ -282,10 +282,9 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
                 fit.roles[name] = BoneRole(role, side)
     extra = [[template.replace("{s}", "L")] for template in (*spec.heels, *(name for name, _ in spec.derived))]
     _mirror_twins(fit, extra, (), tuning.mirror_tolerance * body.size, middle)
-    chained = {name for chain in spec.chains for side in _sides(chain) for name in chain.names(side)}
     for name in fit.heads:
         fit.z_axes[name] = np.asarray(meta[name].z_axis, dtype=np.float64)
-        if name not in chained:
+        if name not in wanted:
             _keep_length(fit, name, body.size * tuning.shortest)
     fit.removed = _removed(meta, fit.heads)
     fit.notes = _notes(spec, fit, body)
@@ -343,7 +342,6 @@ class _Body:
         self.skeleton, self.roles, self.vertices = skeleton, skeleton.roles, vertices
         ends = np.concatenate([skeleton.heads, skeleton.tails])
         self.size = float(np.ptp(np.concatenate([ends, vertices]), axis=0).max())
-        self.tuning = tuning
         self.notes = []  # what the fit could not do as it should, in words
         self.joints = named_joints(skeleton)
         self.node = _merged_ends(ends, tuning.merge * self.size)
@@ -594,7 +592,7 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
         wanted = scale * lengths[missing:].sum()
         direction = points[-1] - points[-2]
         direction = direction / max(np.linalg.norm(direction), 1e-300)
-        reach = _reach(body.vertices, points[-1], direction, tuning.extend_most * wanted, body.size)
+        reach = mesh_reach(body.vertices, points[-1], direction, tuning.extend_most * wanted, body.size)
         if reach >= tuning.extend * wanted:
             points = np.vstack([points, points[-1] + reach * direction])
             arc = np.r_[arc, arc[-1] + reach]
@@ -656,17 +654,6 @@ def _cuts(groups, spans, arc, lengths, shortest, tuning, named=None):
     for k in range(count - 1, 0, -1):
         cuts[k] = min(cuts[k], cuts[k + 1] - gap)
     return cuts
-
-
-def _reach(vertices, point, direction, limit, size):
-    """How far the mesh goes on beyond ``point`` along ``direction`` (unit), up to ``limit``: its vertices within a
-    tube as thick as the mesh is at ``point``."""
-    offsets = vertices - point
-    along = offsets @ direction
-    across = np.linalg.norm(offsets - np.outer(along, direction), axis=1)
-    tube = max(2 * float(np.linalg.norm(offsets, axis=1).min()), 0.02 * size)
-    beyond = along[(along > 0) & (across <= tube) & (along <= limit)]
-    return float(beyond.max()) if len(beyond) else 0.0
 
 
 def _wrist(body, side, base):

@@ -359,18 +359,23 @@ def _shoulder(body, nodes, arc, total, tuning):
 
 
 def _reach(body, points):
-    """How far the mesh goes on beyond the last of ``points``, along the last bone's direction (within a tube of
-    the radius there)."""
+    """How far the mesh goes on beyond the last of ``points``, along the last bone's direction (``mesh_reach``, up to
+    a quarter of the size)."""
     direction = points[-1] - points[-2]
     norm = np.linalg.norm(direction)
     if not norm > 0:
         return 0.0
-    direction /= norm
-    offsets = body.vertices - points[-1]
+    return mesh_reach(body.vertices, points[-1], direction / norm, 0.25 * body.size, body.size)
+
+
+def mesh_reach(vertices, point, direction, limit, size):
+    """How far the mesh (its ``vertices``) goes on beyond ``point`` along ``direction`` (unit), up to ``limit``: its
+    vertices within a tube as thick as the mesh is at ``point`` (at least 0.02 of the ``size``)."""
+    offsets = vertices - point
     along = offsets @ direction
     across = np.linalg.norm(offsets - np.outer(along, direction), axis=1)
-    tube = max(2 * float(np.min(np.linalg.norm(body.vertices - points[-1], axis=1))), 0.02 * body.size)
-    beyond = along[(along > 0) & (across <= tube) & (along <= 0.25 * body.size)]
+    tube = max(2 * float(np.linalg.norm(offsets, axis=1).min()), 0.02 * size)
+    beyond = along[(along > 0) & (across <= tube) & (along <= limit)]
     return float(beyond.max()) if len(beyond) else 0.0
 
 
