@@ -100,11 +100,13 @@ class Silhouette:
 
         Returns a list with one (L, 2) float64 array of (entry, exit) depths per point, sorted front to back (empty
         on a miss). Hits pair up by crossing parity within each connected part of the mesh (vertices at identical
-        positions are welded first, as glTF seams split them), and overlapping intervals of different parts are
-        merged: two legs one behind the other give two intervals, an eye inside a head gives one. Where an open part
+        positions are welded first, as glTF seams split them; pieces that only abut are joined by tracing
+        :func:`sealed` vertices), and overlapping intervals of different parts are merged: two legs one behind the
+        other give two intervals, an eye inside a head gives one. Where an open part
         is hit an odd number of times, the hit whose removal leaves the thinnest pairing becomes a zero-thickness
-        interval. Parity also governs closed shells that overlap in 3D while sharing vertices (one part): the region
-        inside both counts as outside.
+        interval. Within a part whose hits along a ray nest by winding (each entry faces the way the nearest hit
+        does, each exit the other way, as on closed, consistently wound surfaces) the stretches of positive winding
+        are inside, so shells of one part that overlap stay solid where they overlap.
         """
         return self._trace.layers(_as_points(points))
 
@@ -185,6 +187,27 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
     origin, u, v, unit = handle.frame()
     _, cell, _, _ = handle.grid()
     return Silhouette(loops, origin, u, v, unit, cell, handle)
+
+
+SEAM_GAP = _rigger_silhouette.SEAM_GAP
+
+
+def sealed(vertices, triangles):
+    """The ``vertices`` of a mesh built of pieces that abut without sharing vertices, with those seams closed.
+
+    Game exports often are such pieces (a body shell, and its legs' inner shell, open where they meet): each piece
+    alone bounds nothing, so ``layers`` cannot pair its hits. Every vertex on an open boundary that lies within
+    ``SEAM_GAP`` of the mesh's largest extent from a boundary vertex of another part moves, with the vertices at its
+    position, onto one shared position, so the pieces weld into the solid they bound; parts farther apart stay
+    apart. Returns (N, 3) float64 vertices: a new array when any moved, else ``vertices`` as given (as float64).
+    """
+    verts = point_array(vertices, 3, "vertices")
+    tris = index_array(triangles, 3, len(verts), name="triangles", item="triangle", target=("vertex", "vertices"),
+                       dtype=np.int32)
+    if len(verts) > INT32_MAX:
+        raise ValueError(f"the mesh has {len(verts)} vertices; the tracer indexes at most {INT32_MAX}")
+    out, moved = _rigger_silhouette.seal(verts, tris)
+    return out if moved else verts
 
 
 def _as_direction(direction):

@@ -44,6 +44,8 @@ struct SilTrace {
     int32_t *all_tris;      /* every input triangle, for the mesh topology */
     int64_t n_tris;
     int32_t *tris;          /* triangles of non-zero snapped area, counter-clockwise in the frame */
+    int8_t *facing;         /* per such triangle: +1 where its own winding was counter-clockwise (it faces the
+                               viewer), -1 where it was turned */
     int32_t *corners;       /* per such triangle its snapped corners x0 y0 x1 y1 x2 y2, 2^16 per cell */
     int64_t n_loops;
     int64_t *loop_start;
@@ -75,6 +77,7 @@ typedef struct { /* a crossing met while walking around a cell counter-clockwise
 typedef struct { /* one ray hit, for layers */
     double depth;
     int32_t comp;
+    int8_t facing; /* the triangle's, see SilTrace */
 } Hit;
 
 /* ------------------------------------------------------------------------------------------------ memory */
@@ -127,6 +130,7 @@ void sil_free(SilTrace *t)
     free(t->corners);
     free(t->all_tris);
     free(t->tris);
+    free(t->facing);
     free(t->loop_start);
     free(t->loop_xy);
     free_bins(t->bins);
@@ -294,7 +298,8 @@ static int snap(SilTrace *t, int32_t resolution)
     fix = alloc_array(2 * t->n_vertices, sizeof(int32_t));
     t->tris = alloc_array(3 * t->n_all, sizeof(int32_t));
     t->corners = alloc_array(6 * t->n_all, sizeof(int32_t));
-    if (!fix || !t->tris || !t->corners) {
+    t->facing = alloc_array(t->n_all, sizeof(int8_t));
+    if (!fix || !t->tris || !t->corners || !t->facing) {
         rc = SIL_ERR_NOMEM;
         goto done;
     }
@@ -316,6 +321,7 @@ static int snap(SilTrace *t, int32_t resolution)
         out[0] = tri[0];
         out[1] = o > 0 ? tri[1] : tri[2];
         out[2] = o > 0 ? tri[2] : tri[1];
+        t->facing[kept] = o > 0 ? 1 : -1;
         for (int c = 0; c < 3; c++) {
             xy[2 * c] = fix[2 * out[c]];
             xy[2 * c + 1] = fix[2 * out[c] + 1];
@@ -1944,12 +1950,37 @@ int sil_depth(SilTrace *t, const double *points, int64_t n, double *front, doubl
     return SIL_OK;
 }
 
-/* Connected components of the welded mesh (vertices at identical positions merged, as glTF and game exports split
- * them along seams): hits pair up within one component, so nested or overlapping parts do not mix their layers. */
-static int build_components(SilTrace *t)
+static int32_t find_root(int32_t *parent, int32_t r)
 {
-    if (t->vertex_comp) return SIL_OK;
-    const int64_t n = t->n_vertices;
+    while (parent[r] != r) {
+        parent[r] = parent[parent[r]];
+        r = parent[r];
+    }
+    return r;
+}
+
+static void join_roots(int32_t *parent, int32_t a, int32_t b) /* roots point to the lower index */
+{
+    a = find_root(parent, a);
+    b = find_root(parent, b);
+    if (a < b) parent[b] = a;
+    else if (b < a) parent[a] = b;
+}
+
+static uint64_t mix64(uint64_t h)
+{
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdull;
+    h ^= h >> 33;
+    return h;
+}
+
+/* Weld vertices at identical positions and join them along triangles: *weld_out maps each vertex to its welded
+ * vertex (the lowest index at its position), *parent_out each welded vertex to its part's lowest welded vertex. */
+static int weld_parts(const double *pos, int64_t n, const int32_t *tris, int64_t m, int32_t **weld_out,
+                      int32_t **parent_out)
+{
+    *weld_out = *parent_out = NULL;
     int64_t table_size = 1;
     while (table_size < 2 * n) table_size *= 2;
     int32_t *table = alloc_array(table_size, sizeof(int32_t));
@@ -1963,7 +1994,7 @@ static int build_components(SilTrace *t)
     }
     for (int64_t i = 0; i < table_size; i++) table[i] = -1;
     for (int64_t i = 0; i < n; i++) {
-        const double *p = t->proj + 3 * i;
+        const double *p = pos + 3 * i;
         uint64_t h = 1469598103934665603ull;
         for (int c = 0; c < 3; c++) {
             double value = p[c] + 0.0; /* -0.0 and 0.0 weld */
@@ -1980,7 +2011,7 @@ static int build_components(SilTrace *t)
                 weld[i] = (int32_t)i;
                 break;
             }
-            const double *q = t->proj + 3 * other;
+            const double *q = pos + 3 * other;
             if (q[0] == p[0] && q[1] == p[1] && q[2] == p[2]) {
                 weld[i] = other;
                 break;
@@ -1989,26 +2020,177 @@ static int build_components(SilTrace *t)
         }
         parent[i] = (int32_t)i;
     }
-    for (int64_t k = 0; k < t->n_all; k++) {
-        int32_t root[3];
-        for (int c = 0; c < 3; c++) {
-            int32_t r = weld[t->all_tris[3 * k + c]];
-            while (parent[r] != r) {
-                parent[r] = parent[parent[r]];
-                r = parent[r];
-            }
-            root[c] = r;
-        }
-        int32_t low = root[0] < root[1] ? root[0] : root[1];
-        if (root[2] < low) low = root[2];
-        for (int c = 0; c < 3; c++) parent[root[c]] = low;
+    free(table);
+    for (int64_t k = 0; k < m; k++) {
+        join_roots(parent, weld[tris[3 * k]], weld[tris[3 * k + 1]]);
+        join_roots(parent, weld[tris[3 * k]], weld[tris[3 * k + 2]]);
     }
     for (int64_t i = 0; i < n; i++) { /* parents point to lower indices, so one forward pass resolves every root */
         parent[i] = parent[parent[i]];
     }
-    for (int64_t i = 0; i < n; i++) weld[i] = parent[weld[i]];
-    t->vertex_comp = weld;
+    *weld_out = weld;
+    *parent_out = parent;
+    return SIL_OK;
+}
+
+/* Mark the welded vertices on an open boundary: those of an edge that one triangle alone uses. Edges are keyed
+ * (low, high) welded vertex; bit 62 of a table entry records a second use. */
+static int mark_boundary(int64_t n, const int32_t *tris, int64_t m, const int32_t *weld, uint8_t *boundary)
+{
+    int64_t table_size = 1;
+    while (table_size < 4 * m) table_size *= 2;
+    int64_t *table = alloc_array(table_size, sizeof(int64_t));
+    if (!table) return SIL_ERR_NOMEM;
+    const int64_t empty = -1, twice = (int64_t)1 << 62;
+    for (int64_t i = 0; i < table_size; i++) table[i] = empty;
+    for (int64_t k = 0; k < m; k++) {
+        for (int c = 0; c < 3; c++) {
+            int64_t a = weld[tris[3 * k + c]], b = weld[tris[3 * k + (c + 1) % 3]];
+            if (a == b) continue;
+            int64_t key = a < b ? a * n + b : b * n + a;
+            int64_t slot = (int64_t)(mix64((uint64_t)key) & (uint64_t)(table_size - 1));
+            while (table[slot] != empty && (table[slot] & ~twice) != key) slot = (slot + 1) & (table_size - 1);
+            table[slot] = table[slot] == empty ? key : key | twice;
+        }
+    }
+    for (int64_t slot = 0; slot < table_size; slot++) {
+        if (table[slot] == empty || (table[slot] & twice)) continue;
+        boundary[table[slot] / n] = 1;
+        boundary[table[slot] % n] = 1;
+    }
     free(table);
+    return SIL_OK;
+}
+
+/* Join into clusters (in ``cluster``, lowest index the root) the boundary vertices of different parts that lie within
+ * ``gap`` of each other, bucketing them on a grid of that spacing. */
+static int cluster_seams(const double *pos, int64_t n, const uint8_t *boundary, const int32_t *part, double gap,
+                         int32_t *cluster)
+{
+    int64_t count = 0, buckets = 1;
+    double lo[3] = {INFINITY, INFINITY, INFINITY};
+    for (int64_t i = 0; i < n; i++) {
+        if (!boundary[i]) continue;
+        count++;
+        for (int c = 0; c < 3; c++) lo[c] = fmin(lo[c], pos[3 * i + c]);
+    }
+    while (buckets < 2 * count) buckets *= 2;
+    int32_t *head = alloc_array(buckets, sizeof(int32_t)), *next = alloc_array(n, sizeof(int32_t));
+    int64_t *cell = alloc_array(3 * n, sizeof(int64_t));
+    if (!head || !next || !cell) {
+        free(head);
+        free(next);
+        free(cell);
+        return SIL_ERR_NOMEM;
+    }
+    for (int64_t b = 0; b < buckets; b++) head[b] = -1;
+    for (int64_t i = 0; i < n; i++) {
+        if (!boundary[i]) continue;
+        uint64_t h = 0;
+        for (int c = 0; c < 3; c++) {
+            cell[3 * i + c] = (int64_t)floor((pos[3 * i + c] - lo[c]) / gap);
+            h = mix64(h ^ (uint64_t)cell[3 * i + c]);
+        }
+        next[i] = head[h & (uint64_t)(buckets - 1)];
+        head[h & (uint64_t)(buckets - 1)] = (int32_t)i;
+    }
+    for (int64_t i = 0; i < n; i++) {
+        if (!boundary[i]) continue;
+        const double *p = pos + 3 * i;
+        for (int d = 0; d < 27; d++) { /* the 3 x 3 x 3 cells around i's */
+            const int offset[3] = {d % 3 - 1, d / 3 % 3 - 1, d / 9 - 1};
+            uint64_t h = 0;
+            for (int c = 0; c < 3; c++) h = mix64(h ^ (uint64_t)(cell[3 * i + c] + offset[c]));
+            for (int32_t j = head[h & (uint64_t)(buckets - 1)]; j >= 0; j = next[j]) {
+                const double *q = pos + 3 * j;
+                double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+                if (part[i] != part[j] && dx * dx + dy * dy + dz * dz <= gap * gap)
+                    join_roots(cluster, (int32_t)i, j);
+            }
+        }
+    }
+    free(head);
+    free(next);
+    free(cell);
+    return SIL_OK;
+}
+
+/* Whether the triangles join all the vertices they use into one part without welding (most meshes: then nothing is
+ * split along seams, and the hash of welding is not needed). */
+static int one_piece(int64_t n, const int32_t *tris, int64_t m, int *rc)
+{
+    int32_t *parent = alloc_array(n, sizeof(int32_t));
+    if (!parent) {
+        *rc = SIL_ERR_NOMEM;
+        return 0;
+    }
+    for (int64_t i = 0; i < n; i++) parent[i] = (int32_t)i;
+    for (int64_t k = 0; k < m; k++) {
+        join_roots(parent, tris[3 * k], tris[3 * k + 1]);
+        join_roots(parent, tris[3 * k], tris[3 * k + 2]);
+    }
+    int32_t root = find_root(parent, tris[0]);
+    int one = 1;
+    for (int64_t k = 0; k < 3 * m && one; k++) one = find_root(parent, tris[k]) == root;
+    free(parent);
+    return one;
+}
+
+int sil_seal(const double *vertices, int64_t n, const int32_t *tris, int64_t m, double *out, int64_t *moved)
+{
+    *moved = 0;
+    memcpy(out, vertices, (size_t)(3 * n) * sizeof(double));
+    int32_t *weld = NULL, *part = NULL, *cluster = NULL;
+    uint8_t *boundary = NULL;
+    int rc = SIL_OK;
+    if (m == 0 || one_piece(n, tris, m, &rc)) return rc;
+    if ((rc = weld_parts(vertices, n, tris, m, &weld, &part)) != SIL_OK) goto done;
+    int several = 0; /* parts after welding */
+    for (int64_t k = 1; k < 3 * m && !several; k++) several = part[weld[tris[k]]] != part[weld[tris[0]]];
+    if (!several) goto done;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, extent = 0.0;
+    for (int64_t k = 0; k < 3 * m; k++) {
+        const double *p = vertices + 3 * (int64_t)tris[k];
+        for (int c = 0; c < 3; c++) {
+            lo[c] = fmin(lo[c], p[c]);
+            hi[c] = fmax(hi[c], p[c]);
+        }
+    }
+    for (int c = 0; c < 3; c++) extent = fmax(extent, hi[c] - lo[c]);
+    boundary = calloc((size_t)n, 1);
+    cluster = alloc_array(n, sizeof(int32_t));
+    if (!boundary || !cluster) {
+        rc = SIL_ERR_NOMEM;
+        goto done;
+    }
+    if ((rc = mark_boundary(n, tris, m, weld, boundary)) != SIL_OK) goto done;
+    for (int64_t i = 0; i < n; i++) cluster[i] = (int32_t)i;
+    if (!(extent > 0.0)) goto done;
+    if ((rc = cluster_seams(vertices, n, boundary, part, SIL_SEAM_GAP * extent, cluster)) != SIL_OK) goto done;
+    for (int64_t i = 0; i < n; i++) {
+        int32_t root = find_root(cluster, weld[i]);
+        if (root == weld[i]) continue;
+        memcpy(out + 3 * i, vertices + 3 * (int64_t)root, 3 * sizeof(double));
+        (*moved)++;
+    }
+done:
+    free(weld);
+    free(part);
+    free(boundary);
+    free(cluster);
+    return rc;
+}
+
+/* Connected components of the welded mesh (vertices at identical positions merged, as glTF and game exports split
+ * them along seams): hits pair up within one component, so nested or overlapping parts do not mix their layers. */
+static int build_components(SilTrace *t)
+{
+    if (t->vertex_comp) return SIL_OK;
+    int32_t *weld = NULL, *parent = NULL;
+    int rc = weld_parts(t->proj, t->n_vertices, t->all_tris, t->n_all, &weld, &parent);
+    if (rc != SIL_OK) return rc;
+    for (int64_t i = 0; i < t->n_vertices; i++) weld[i] = parent[weld[i]];
+    t->vertex_comp = weld;
     free(parent);
     return SIL_OK;
 }
@@ -2056,8 +2238,23 @@ static void sort_intervals(double *iv, int64_t n)
     }
 }
 
-/* Pair one component's sorted hits into inside intervals. An even count pairs by parity; an odd count (only on open
- * components) leaves alone the one hit whose removal gives the thinnest pairing, as a zero-thickness layer. */
+/* Whether one component's n sorted hits nest by winding: facing as its nearest hit does enters the component,
+ * facing the other way leaves it, and the count of entries less exits never drops below zero and ends at zero (a
+ * closed, consistently wound surface, or several such overlapping; either winding, as its nearest hit sets it). */
+static int winding_nests(const Hit *h, int64_t n)
+{
+    int64_t depth = 0;
+    for (int64_t i = 0; i < n; i++) {
+        depth += h[i].facing == h[0].facing ? 1 : -1;
+        if (depth < 0) return 0;
+    }
+    return depth == 0;
+}
+
+/* Pair one component's sorted hits into inside intervals. Hits that nest by winding (winding_nests) give the
+ * stretches where the winding is positive, so pieces of one part that overlap stay solid where they overlap; other
+ * even counts pair by parity; an odd count (only on open components) leaves alone the one hit whose removal gives the
+ * thinnest pairing, as a zero-thickness layer. */
 static int pair_hits(const Hit *h, int64_t n, double **iv, int64_t *cap, int64_t *count)
 {
     int64_t single = -1;
@@ -2074,6 +2271,21 @@ static int pair_hits(const Hit *h, int64_t n, double **iv, int64_t *cap, int64_t
                 rest -= h[k + 2].depth - h[k + 1].depth;
             }
         }
+    }
+    if (n % 2 == 0 && n > 2 && winding_nests(h, n)) {
+        int64_t depth = 0;
+        for (int64_t i = 0; i < n; i++) {
+            int64_t before = depth;
+            depth += h[i].facing == h[0].facing ? 1 : -1;
+            if (before == 0) {
+                int rc = reserve((void **)iv, cap, 2 * (*count + 1), sizeof(double));
+                if (rc != SIL_OK) return rc;
+                (*iv)[2 * *count] = h[i].depth;
+            } else if (depth == 0) {
+                (*iv)[2 * (*count)++ + 1] = h[i].depth;
+            }
+        }
+        return SIL_OK;
     }
     for (int64_t i = 0; i < n;) {
         int rc = reserve((void **)iv, cap, 2 * (*count + 1), sizeof(double));
@@ -2114,6 +2326,7 @@ int sil_layers(SilTrace *t, const double *points, int64_t n, int64_t **offsets_o
             if ((rc = reserve((void **)&hits, &hit_cap, n_hits + 1, sizeof(Hit))) != SIL_OK) goto fail;
             hits[n_hits].depth = hit_depth(t, k, points[2 * p], points[2 * p + 1], w, area2);
             hits[n_hits].comp = t->vertex_comp[t->tris[3 * k]];
+            hits[n_hits].facing = t->facing[k];
             n_hits++;
         }
         sort_hits(hits, n_hits);

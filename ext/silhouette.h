@@ -72,6 +72,15 @@ void sil_release(void *memory);
  * triangles differ). A trace that has its components keeps them. */
 int sil_share_components(SilTrace *trace, SilTrace *source);
 
+/* The seam gap, as a fraction of the mesh's largest extent: open parts whose boundaries come this close abut. */
+#define SIL_SEAM_GAP 1e-3
+
+/* Close the seams of a mesh built of pieces that abut without sharing vertices: copy the n vertices to `out` (3n
+ * doubles), then move every boundary vertex (of an edge one triangle alone uses) that lies within SIL_SEAM_GAP of a
+ * boundary vertex of another part (parts: connected through triangles, vertices at identical positions welded), and
+ * the vertices welded to it, onto the lowest-indexed vertex of its cluster. *moved counts the vertices moved. */
+int sil_seal(const double *vertices, int64_t n, const int32_t *triangles, int64_t m, double *out, int64_t *moved);
+
 #ifdef __cplusplus
 }
 #endif

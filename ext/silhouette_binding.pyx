@@ -18,6 +18,7 @@ cdef extern from "silhouette.h":
     int SIL_ERR_ZERO_AREA
     int SIL_MIN_RESOLUTION
     int SIL_MAX_RESOLUTION
+    double SIL_SEAM_GAP
     const char *sil_error_message(int code)
     int sil_trace(const double *vertices, int64_t n_vertices, const int32_t *triangles, int64_t n_triangles,
                   const double *direction, int32_t resolution, double tolerance, SilTrace **out) nogil
@@ -31,10 +32,13 @@ cdef extern from "silhouette.h":
     int sil_layers(SilTrace *trace, const double *points, int64_t n, int64_t **offsets, double **intervals)
     void sil_release(void *memory)
     int sil_share_components(SilTrace *trace, SilTrace *source)
+    int sil_seal(const double *vertices, int64_t n, const int32_t *triangles, int64_t m, double *out,
+                 int64_t *moved) nogil
 
 
 MIN_RESOLUTION = SIL_MIN_RESOLUTION
 MAX_RESOLUTION = SIL_MAX_RESOLUTION
+SEAM_GAP = SIL_SEAM_GAP
 
 
 class NoSilhouette(ValueError):
@@ -134,6 +138,21 @@ def trace(const double[:, ::1] vertices, const int32_t[:, ::1] triangles, const 
     result = Trace.__new__(Trace)
     (<Trace>result).handle = handle
     return result
+
+
+def seal(const double[:, ::1] vertices, const int32_t[:, ::1] triangles):
+    """(vertices with the seams between abutting parts closed, how many moved); see ``rigger.silhouette.sealed``."""
+    out = np.empty((vertices.shape[0], 3), dtype=np.float64)
+    cdef double[:, ::1] o = out
+    cdef int64_t moved = 0
+    cdef int code
+    if vertices.shape[0] == 0 or triangles.shape[0] == 0:
+        return out, 0
+    with nogil:
+        code = sil_seal(&vertices[0, 0], vertices.shape[0], &triangles[0, 0], triangles.shape[0], &o[0, 0], &moved)
+    if code != SIL_OK:
+        raise_for(code)
+    return out, moved
 
 
 cdef list _rows(int64_t n, const int64_t *offsets, const double *xy):

@@ -494,6 +494,36 @@ def test_layers_weld_split_vertices():
     assert np.allclose(sil.layers([[0.1, 0.2]])[0], [[-0.5, 0.5]])
 
 
+def test_sealed_joins_pieces_that_abut_along_an_open_seam():
+    """A box built of two open pieces whose seam vertices lie a hair apart (as game meshes built of pieces are):
+    sealed, a ray through the bottom and the lid sees one solid. A lid lifted by more than the seam gap stays a part
+    of its own (each open piece hit once is a zero-thickness layer), and a mesh of one piece comes back as given."""
+    v, t = box((0, 0, 0), (1, 1, 1))
+    lid = (v[t][:, :, 2] == 1).all(axis=1)
+    assert silhouette.sealed(v, t) is v
+    for lift in (1e-5, 0.1):
+        vertices, triangles = combine((v, t[~lid]), (v + [0, 0, lift], t[lid]))
+        sil = silhouette.trace(silhouette.sealed(vertices, triangles), triangles, "Z")
+        bottom, top = [(np.array(p) - sil.origin) @ sil.direction for p in ([0, 0, 0], [0, 0, 1 + lift])]
+        layers = sil.layers(frame_points(sil, [[0.3, 0.4, 0.0]]))[0]
+        if lift < silhouette.SEAM_GAP:
+            np.testing.assert_allclose(layers, [[bottom, top]], atol=1e-4)
+        else:
+            np.testing.assert_allclose(layers, [[bottom, bottom], [top, top]], atol=1e-12)
+
+
+def test_layers_keep_overlapping_pieces_of_one_part_solid():
+    """Two closed, consistently wound shells of one part (sharing a vertex) that overlap: where both enclose the ray
+    it is inside, by winding, not outside, by parity; turned inside out, the same."""
+    a, b = box((0, 0, 0), (2, 1, 1)), box((1, 0.2, 0.2), (3, 0.8, 0.8))
+    b[0][0] = a[0][0]  # one corner of the second shell pulled onto the first's: one part
+    vertices, triangles = combine(a, b)
+    for winding in (triangles, triangles[:, ::-1]):
+        sil = silhouette.trace(vertices, winding, "Z")
+        bottom, top = [(np.array(p) - sil.origin) @ sil.direction for p in ([0, 0, 0], [0, 0, 1])]
+        np.testing.assert_allclose(sil.layers(frame_points(sil, [[1.5, 0.5, 0.0]]))[0], [[bottom, top]])
+
+
 def test_layers_with_parts_shared_from_another_view_match_their_own():
     """The welded parts are the mesh's, not the view's: a view that takes them from another gives the same layers."""
     v, t = box((0, 0, 0), (1, 1, 1))

@@ -408,6 +408,21 @@ def test_split_legs_keep_their_sides_where_they_merge_into_the_hips():
     np.testing.assert_array_equal(sorted(line[1, 2] for line, _, _ in placed), [-3.0, 3.0])
 
 
+def test_split_twins_across_the_mirror_plane_stay_mirror_images():
+    """A leg pair seen across the mirror plane z = 0: apart at the tips, merged near the body, and in between only
+    the near leg seen (the far one hidden behind it, or touching it). The copy anchored on the far leg would step
+    onto the near one there; twins across the plane are mirror images instead, each on its own side. Without the
+    plane the copies go as followed."""
+    node_layers = [layers((-3.5, 3.5))] * 5 + [layers((-3.5, -2.5))] * 2 + [layers((-3.5, -2.5), (2.5, 3.5))] * 5
+    _, placed = placed_along_x(node_layers, mirror=(0.0, 0.05))
+    assert len(placed) == 2
+    near, far = sorted((line for line, _, _ in placed), key=lambda line: line[-1, 2])
+    np.testing.assert_array_equal(near[:, 2], -3.0)
+    np.testing.assert_array_equal(far[:, 2], 3.0)
+    _, placed = placed_along_x(node_layers)
+    assert sorted(line[5, 2] for line, _, _ in placed) == [-3.0, -3.0]
+
+
 def leaves(*lines):
     """The chains ``symmetric_joints`` takes: each line a leaf, without widths."""
     return [(line, None, True) for line in lines]
@@ -431,10 +446,10 @@ def test_twins_traced_apart_get_the_mirror_image_joints_of_their_mean_line():
     assert len(result[1]) == len(chain_joints(mean, cutting(), leaf=True))
 
 
-def test_twins_whose_lines_differ_keep_their_own_joints_with_one_bone_count():
+def test_twins_whose_lines_differ_get_one_bone_count():
     """Two legs whose ends mirror but whose shapes differ (one bent at the knee, one straight: a leg stepping
-    forward) keep their own joints but get one bone count: the smaller, unless the one with more bones needs them
-    for its corners; then the other gets as many."""
+    forward) get one bone count: the smaller, unless the one with more bones needs them for its corners; then the
+    other gets as many. Here their joints already lie at one share of their lengths, so they stay."""
     knee = np.array([[0.0, 0.0, 0.0], [0.2, 0.0, 0.15], [0.4, 0.0, 0.0]])
     own = [chain_joints(line, cutting(), leaf=True) for line in (knee, straight(-0.4))]
     assert (len(own[0]), len(own[1])) == (6, 5)
@@ -447,6 +462,26 @@ def test_twins_whose_lines_differ_keep_their_own_joints_with_one_bone_count():
     assert (len(own[0]), len(own[1])) == (5, 3)  # every corner gets a joint, whatever max_bones
     result = symmetric_joints(leaves(zigzag, straight(-0.4)), cutting(2), ACROSS_X)
     assert len(result[0]) == len(result[1]) == 5
+
+
+def test_twins_whose_lines_differ_bend_at_one_share_of_their_lengths():
+    """Twins whose lines are no mirror images (a leg bent at a third of its length, its twin straight), across an
+    exact mirror plane or one the body only roughly mirrors about, put their k-th joints at one share of their own
+    lines' lengths, each on its own line and keeping its first joint."""
+    bent, other = np.array([[0.0, 0.0, 0.0], [0.13, 0.0, 0.1], [0.4, 0.0, 0.0]]), straight(-0.45)
+
+    def shares(line, joints):
+        arc = arc_lengths(line)
+        nearest = segment_distances(joints, line[:-1], line[1:]).argmin(axis=1)
+        return (arc[nearest] + np.linalg.norm(joints - line[nearest], axis=1)) / arc[-1]
+
+    for exact in (True, False):
+        result = symmetric_joints(leaves(bent, other), cutting(4), ACROSS_X, exact)
+        assert len(result[0]) == len(result[1]) > 2
+        for line, joints in zip((bent, other), result):
+            np.testing.assert_array_equal(joints[0], line[0])
+            assert segment_distances(joints, line[:-1], line[1:]).min(axis=1).max() < 1e-9
+        np.testing.assert_allclose(shares(bent, result[0]), shares(other, result[1]), atol=1e-9)
 
 
 def test_a_leaf_running_on_along_its_twins_image_takes_that_image():

@@ -57,6 +57,20 @@ class Mesh:
                                   _scatter=self._scatter)  # taken at unit size already
         return moved
 
+    def with_vertices(self, vertices):
+        """This mesh with its vertices replaced by ``vertices`` of the same count (moved a hair, as
+        ``rigger.silhouette.sealed`` moves them), sharing its triangles; the measures are taken again when asked for.
+        Itself when ``vertices`` is its own array."""
+        if vertices is self.vertices:
+            return self
+        if np.shape(vertices) != self.vertices.shape:
+            raise ValueError(f"with_vertices needs {self.vertices.shape} vertices, got {np.shape(vertices)}")
+        moved = object.__new__(Mesh)
+        moved.vertices = _read_only(np.array(vertices, dtype=np.float64))
+        moved.triangles, moved.degenerate_count = self.triangles, self.degenerate_count
+        moved.__dict__["_used"] = self._used
+        return moved
+
     @cached_property
     def _used(self):
         """Which vertices triangles use, or None when all are."""

@@ -84,8 +84,10 @@ class SilhouetteMethod(RigMethod):
         # rig at unit size (a power of two away: exact), in the frame where the view is an axis; then map back
         placement = Placement(mesh.unit_factor, rotation)
         mesh = mesh.at_unit_size(rotation)
+        # the silhouettes see pieces that abut as the one solid they bound; the rules see the mesh as it is
+        traced = mesh.with_vertices(silhouette.sealed(mesh.vertices, mesh.triangles))
         try:
-            axis, primary = primary_view(mesh, view, params, tuning)
+            axis, primary = primary_view(traced, view, params, tuning)
         except silhouette.NoSilhouette as error:
             if rotation is None:
                 raise
@@ -99,7 +101,7 @@ class SilhouetteMethod(RigMethod):
 
         side, other_views = None, []  # side: the side view's axis, for depth where the primary view is occluded
         if params.side_view and mesh.flat_normal is None:  # a flat mesh has nothing to hide in depth
-            side_of, end_on = perpendicular_views(mesh, axis, params, tuning)
+            side_of, end_on = perpendicular_views(traced, axis, params, tuning)
             if side_of is not None:
                 side = SideAxis(side_of.sil, side_of.axis_graph.points, side_of.axis_graph.radius, sil)
             other_views = [found for found in (side_of, end_on) if found is not None]

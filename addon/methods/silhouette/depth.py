@@ -114,6 +114,8 @@ def place_chains(sil, points, radius, root, chains, placing):
         for part, count in pieces:
             first = len(placed)
             followed = _follow((parts if count > 1 else node_layers)[part], count, end_depth[chain.parent], plane)
+            if count == 2 and mirror is not None:
+                followed = _twin_copies(parts[part], followed, *mirror)
             for copy in range(count):
                 depths = resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
                                            followed[copy], placing, followed[:copy] + followed[copy + 1:])
@@ -255,6 +257,19 @@ def _follow(node_layers, copies, start, mirror=None):
                 previous = 0.5 * (low + high)
             depths[i] = previous
     return followed
+
+
+def _twin_copies(parts, followed, depth, tolerance):
+    """The two ``followed`` copies of a split chain whose parts mirror each other across the plane at ``depth`` (at
+    the outermost node that sees them apart: a pair of legs or ears seen from the side) as twins: the copy that keeps
+    to one side of the plane at more nodes, and its mirror image, since where one part hides the other the other copy
+    may have stepped across to it. Copies of parts on one side (fingers seen edge-on) are left as followed."""
+    anchor = max(i for i, layer in enumerate(parts) if len(layer) == 2)
+    if not _beside(parts[anchor], depth, tolerance):
+        return followed
+    kept = max((0, 1), key=lambda k: abs(np.sign(followed[k] - depth).sum()))
+    image = 2 * depth - followed[kept]
+    return [followed[0], image] if kept == 0 else [image, followed[1]]
 
 
 def _track(node_layers, order, previous, depths, stay=False, mirror=None):
