@@ -446,10 +446,10 @@ def test_twins_traced_apart_get_the_mirror_image_joints_of_their_mean_line():
     assert len(result[1]) == len(chain_joints(mean, cutting(), leaf=True))
 
 
-def test_twins_whose_lines_differ_get_one_bone_count():
+def test_twins_whose_lines_differ_keep_their_own_joints_with_one_bone_count():
     """Two legs whose ends mirror but whose shapes differ (one bent at the knee, one straight: a leg stepping
-    forward) get one bone count: the smaller, unless the one with more bones needs them for its corners; then the
-    other gets as many. Here their joints already lie at one share of their lengths, so they stay."""
+    forward) keep their own joints but get one bone count: the smaller, unless the one with more bones needs them
+    for its corners; then the other gets as many."""
     knee = np.array([[0.0, 0.0, 0.0], [0.2, 0.0, 0.15], [0.4, 0.0, 0.0]])
     own = [chain_joints(line, cutting(), leaf=True) for line in (knee, straight(-0.4))]
     assert (len(own[0]), len(own[1])) == (6, 5)
@@ -464,24 +464,20 @@ def test_twins_whose_lines_differ_get_one_bone_count():
     assert len(result[0]) == len(result[1]) == 5
 
 
-def test_twins_whose_lines_differ_bend_at_one_share_of_their_lengths():
-    """Twins whose lines are no mirror images (a leg bent at a third of its length, its twin straight), across an
-    exact mirror plane or one the body only roughly mirrors about, put their k-th joints at one share of their own
-    lines' lengths, each on its own line and keeping its first joint."""
+def test_twins_of_a_body_that_only_roughly_mirrors_meet_halfway():
+    """Across a plane the body only roughly mirrors about, twins whose lines differ (a leg bent at a third of its
+    length, its twin straight): each joint moves along its own line halfway to where its twin's image falls, first
+    joints kept, so the k-th joints come nearer mirroring each other than their own joints would (as near as lines
+    of different shapes allow)."""
     bent, other = np.array([[0.0, 0.0, 0.0], [0.13, 0.0, 0.1], [0.4, 0.0, 0.0]]), straight(-0.45)
-
-    def shares(line, joints):
-        arc = arc_lengths(line)
-        nearest = segment_distances(joints, line[:-1], line[1:]).argmin(axis=1)
-        return (arc[nearest] + np.linalg.norm(joints - line[nearest], axis=1)) / arc[-1]
-
-    for exact in (True, False):
-        result = symmetric_joints(leaves(bent, other), cutting(4), ACROSS_X, exact)
-        assert len(result[0]) == len(result[1]) > 2
-        for line, joints in zip((bent, other), result):
-            np.testing.assert_array_equal(joints[0], line[0])
-            assert segment_distances(joints, line[:-1], line[1:]).min(axis=1).max() < 1e-9
-        np.testing.assert_allclose(shares(bent, result[0]), shares(other, result[1]), atol=1e-9)
+    own = [chain_joints(line, cutting(4), leaf=True) for line in (bent, other)]
+    result = symmetric_joints(leaves(bent, other), cutting(4), ACROSS_X, mirror=False)
+    assert len(own[0]) == len(own[1]) == len(result[0]) == len(result[1]) > 2
+    for line, joints in zip((bent, other), result):
+        np.testing.assert_array_equal(joints[0], line[0])
+        assert segment_distances(joints, line[:-1], line[1:]).min(axis=1).max() < 1e-9
+    apart = [np.linalg.norm(joints - ACROSS_X.reflect(twin), axis=1)[1:] for joints, twin in (result, own)]
+    assert (apart[0] <= apart[1] + 1e-9).all() and apart[0].mean() < 0.8 * apart[1].mean()
 
 
 def test_a_leaf_running_on_along_its_twins_image_takes_that_image():

@@ -175,11 +175,11 @@ def symmetric_joints(chains, cutting, symmetry, mirror=True):
     mirrored, when the lines have one shape, else the joints of their mean line (each placed its knee otherwise).
     Where one runs on along the other's image past its tip (pruning kept a hand's branch on one side only), both get
     the joints of one of them: the shorter's when the longer is a leaf (both arms end at the wrist), else the
-    longer's when the shorter is a leaf. Twins whose lines differ (a leg stepping forward) get one bone count: the
-    smaller, unless the other's corners or the longest bone need more, then the larger; and their own joints move to
-    one share of their lines' lengths, the mean of the two (``_matched_fractions``). Each chain keeps its first
-    joint, where it attaches to its parent. Without ``mirror`` (a body that only roughly mirrors about the plane: its
-    twins are no images of each other) twins are treated as twins whose lines differ.
+    longer's when the shorter is a leaf. Twins whose lines differ (a leg stepping forward) keep their own joints but
+    get one bone count: the smaller, unless the other's corners or the longest bone need more, then the larger.
+    Each chain keeps its first joint, where it attaches to its parent. Without ``mirror`` (a body that only roughly
+    mirrors about the plane: its twins are no images of each other) twins get one bone count, and their joints meet
+    halfway (``_met_halfway``).
     """
     chains = [(line, np.zeros(len(line)) if widths is None else widths, leaf) for line, widths, leaf in chains]
     joints = [chain_joints(line, cutting, widths, leaf) for line, widths, leaf in chains]
@@ -192,7 +192,8 @@ def symmetric_joints(chains, cutting, symmetry, mirror=True):
         else:
             if len(joints[i]) != len(joints[j]):
                 joints[i], joints[j] = _one_count(chains[i], chains[j], joints[i], joints[j], cutting)
-            joints[i], joints[j] = _matched_fractions(lines[i], lines[j], joints[i], joints[j])
+            if not mirror:
+                joints[i], joints[j] = _met_halfway(lines[i], lines[j], joints[i], joints[j], symmetry)
     return joints
 
 
@@ -224,18 +225,19 @@ def _shared_joints(chain, twin, joints, twin_joints, cutting, symmetry):
     return None
 
 
-def _matched_fractions(line, other, joints, other_joints):
-    """The joints of twins whose lines are no mirror images of each other (one count each), moved to the mean of
-    their fractions of their own lines' lengths, first joints kept: the k-th joint of each sits as far along its
-    limb as its twin's, so posing one side and mirroring it to the other bends both at one place."""
+def _met_halfway(line, other, joints, other_joints, symmetry):
+    """The joints of twins whose lines are no mirror images of each other (one count each), each moved along its
+    own line halfway to where its twin's image falls on that line, first joints kept: the k-th joints of both
+    then lie as nearly mirrored as the two lines allow, so posing one side and mirroring it bends both alike."""
     arcs = arc_lengths(line), arc_lengths(other)
     if not (arcs[0][-1] > 0 and arcs[1][-1] > 0):
         return joints, other_joints
-    shares = [np.array([arc_nearest(points, arc, joint) / arc[-1] for joint in placed[1:]])
-              for points, arc, placed in zip((line, other), arcs, (joints, other_joints))]
-    mean = (shares[0] + shares[1]) / 2
-    return (np.vstack([joints[:1], point_at(line, arcs[0], mean * arcs[0][-1])]),
-            np.vstack([other_joints[:1], point_at(other, arcs[1], mean * arcs[1][-1])]))
+    moved = []
+    for points, arc, own, twin in ((line, arcs[0], joints, other_joints), (other, arcs[1], other_joints, joints)):
+        along = [(arc_nearest(points, arc, joint) + arc_nearest(points, arc, image)) / 2
+                 for joint, image in zip(own[1:], symmetry.reflect(twin[1:]))]
+        moved.append(np.vstack([own[:1], point_at(points, arc, np.array(along))]))
+    return moved[0], moved[1]
 
 
 def _at_fractions(line, values, fractions):
