@@ -146,6 +146,24 @@ def test_named_joints_are_where_roles_begin():
         named_joints(skeleton)  # a skeleton not recognised yet
 
 
+def test_named_joints_run_along_the_trunk_whichever_way_its_bones_point():
+    """A quadruped's trunk rooted at the withers, its bones pointing back to the hips (as the silhouette method roots
+    a deer), and the same trunk rooted at the hips: either way the hips begin at the rump, then the spine, the chest
+    and the neck, each where the role before it ends."""
+    front_to_back = np.array([[0, 0.6, 1], [0, 0.2, 1], [0, -0.2, 1], [0, -0.6, 1]], dtype=float)
+    neck = np.array([[0, 0.6, 1], [0, 0.9, 1.3]], dtype=float)
+    roles = [BoneRole("chest"), BoneRole("spine"), BoneRole("hips"), BoneRole("neck")]
+    rooted_at_withers = Skeleton(("a", "b", "c", "d"), np.r_[front_to_back[:3], neck[:1]],
+                                 np.r_[front_to_back[1:], neck[1:]], [-1, 0, 1, 0])
+    rooted_at_hips = Skeleton(("a", "b", "c", "d"), np.r_[front_to_back[1:], neck[:1]],
+                              np.r_[front_to_back[:3], neck[1:]], [1, 2, -1, 0])
+    for skeleton in (rooted_at_withers, rooted_at_hips):
+        joints = named_joints(skeleton, roles)
+        for role, expected in (("hips", front_to_back[3]), ("spine", front_to_back[2]),
+                               ("chest", front_to_back[1]), ("neck", front_to_back[0])):
+            np.testing.assert_allclose(joints[(role, None, None)], expected)
+
+
 # Where each role of the sample humanoid begins: the true joint a named joint should lie at (the sample names a
 # joint after the bone that ends there: its "thigh.L" joint is the knee).
 TRUE_JOINTS = {("hips", None): "root", ("thigh", "L"): "pelvis.L", ("shin", "L"): "thigh.L", ("foot", "L"): "shin.L",

@@ -519,15 +519,17 @@ def _point_of(skeleton, place):
 
 def _boundaries(skeleton, roles):
     """{(role, side, digit): place} where each role begins at a bone boundary: the end of the bones of the role
-    before it in its chain (a knee where the thigh ends, a hip joint where a leg's hips bone ends; a leg's thigh
-    follows its own side's hips, else the body's), else the start of its first bone (a finger's base); and where a
-    chain's role has no bone, after a last bone with nothing beyond it, that bone's end (the wrist of an arm whose
-    forearm ends there)."""
-    first, last = {}, {}  # (role, side, digit) -> bone
+    before it in its chain nearest its own bones (a knee where the thigh ends, a hip joint where a leg's hips bone
+    ends; a leg's thigh follows its own side's hips, else the body's); for a chain's first role, the end of its bones
+    farthest from the role after it (the back end of a quadruped's hips, whichever way its bones point); else the
+    start of its first bone (a finger's base); and where a chain's role has no bone, after a last bone with nothing
+    beyond it, that bone's end (the wrist of an arm whose forearm ends there)."""
+    first, last, bones_of = {}, {}, {}  # (role, side, digit) -> bone, bone, bones
     for bone, role in enumerate(roles):
         if role.role == "other":
             continue
         key = (role.role, role.side, role.digit)
+        bones_of.setdefault(key, []).append(bone)
         if key not in first or role.index < roles[first[key]].index:
             first[key] = bone
         if key not in last or role.index >= roles[last[key]].index:
@@ -535,13 +537,29 @@ def _boundaries(skeleton, roles):
     is_leaf = np.ones(len(skeleton), dtype=bool)
     is_leaf[skeleton.parents[skeleton.parents >= 0]] = False
     joints = {key: ((bone, 0.0, 1.0),) for key, bone in first.items()}
+
+    def end_of(bones, others, farthest=False):
+        """The (bone, share) of the end of ``bones`` nearest (``farthest``: farthest from) the ends of ``others``."""
+        ends = np.concatenate([skeleton.heads[others], skeleton.tails[others]])
+        candidates = [(bone, share) for bone in bones for share in (0.0, 1.0)]
+        gaps = [np.linalg.norm(ends - (skeleton.tails if share else skeleton.heads)[bone], axis=1).min()
+                for bone, share in candidates]
+        return candidates[int(np.argmax(gaps) if farthest else np.argmin(gaps))]
+
+    started = set()  # the first roles of chains placed already (the body's hips: by the trunk, not a leg)
     for chain in CHAINS:
         for side in ("L", "R", None):
+            start, after = (chain[0], side, None), (chain[1], side, None)
+            if start in bones_of and after in bones_of and start not in started:
+                joints[start] = (end_of(bones_of[start], bones_of[after], farthest=True) + (1.0,),)
+                started.add(start)
             for before, role in zip(chain, chain[1:]):
                 previous = next((key for key in ((before, side, None), (before, None, None)) if key in last), None)
                 if previous is None:
                     continue
-                if (role, side, None) in first or is_leaf[last[previous]]:
+                if (role, side, None) in first:
+                    joints[(role, side, None)] = (end_of(bones_of[previous], bones_of[(role, side, None)]) + (1.0,),)
+                elif is_leaf[last[previous]]:
                     joints[(role, side, None)] = ((last[previous], 1.0, 1.0),)
     return joints
 
