@@ -1,9 +1,9 @@
 """Batch throughput (issue 30): ``python -m rigger batch`` with the local engine at 1 and 2 jobs against the Ray
 engine at 1 and 2 workers, on the same generated models.
 
-Models: the sample characters (``rigger.samples``) at Skin level 3 (13k to 35k vertices; Blender, in a child
-process), each turned about the vertical axis in ``--turns`` steps of 5 degrees: 6 x 16 = 96 distinct OBJ files that
-take a second or more each, almost all of it one core's work (import, rig, bone-heat skinning, save).
+Models: the sample characters (``rigger.samples``) at Skin level 3 (10k to 35k vertices; Blender, in a child
+process), each turned about the vertical axis in ``--turns`` steps of 5 degrees: 12 x 16 = 192 distinct OBJ files
+that take a second or more each, almost all of it one core's work (import, rig, bone-heat skinning, save).
 
 Each configuration runs the command line as a user would, into a fresh folder, as a child process; its wall time
 gives the throughput. The run's active span runs from the first file's start to the last file's end (the summary
@@ -19,7 +19,7 @@ average to drop below ``--load-limit``, records the load before and after, and r
 start are on loopback, send no usage statistics, use no token file, and keep their session files in a temporary folder.
 Writes ``bench/results/batch.md`` and ``bench/results/batch.png``.
 
-    .venv/bin/python bench/batch.py              # the full run, about ten minutes on a quiet 2-core machine
+    .venv/bin/python bench/batch.py              # the full run, about 20 minutes on a quiet 2-core machine
     .venv/bin/python bench/batch.py --turns 1    # 6 models, a smoke test
 """
 import argparse
@@ -279,8 +279,7 @@ def plot(numbers, path):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--turns", type=int, default=16, help="turned copies of each character (default 16: 96 "
-                                                               "models)")
+    parser.add_argument("--turns", type=int, default=16, help="turned copies of each sample character (default 16)")
     parser.add_argument("--load-limit", type=float, default=1.5, help="wait for a 1-minute load below this")
     parser.add_argument("--quiet-wait", type=float, default=600, help="longest wait for that, seconds")
     parser.add_argument("--tries", type=int, default=3, help="runs of a configuration while other work loads the "
