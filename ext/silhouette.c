@@ -2062,6 +2062,9 @@ static int mark_boundary(int64_t n, const int32_t *tris, int64_t m, const int32_
     return SIL_OK;
 }
 
+#define SEAM_CANDIDATES 1024 /* most boundary vertices one is compared with: bounds the cost where thousands crowd
+                                * into a few cells (a degenerate soup), far beyond any seam's density */
+
 /* Join into clusters (in ``cluster``, lowest index the root) the boundary vertices of different parts that lie within
  * ``gap`` of each other, bucketing them on a grid of that spacing. */
 static int cluster_seams(const double *pos, int64_t n, const uint8_t *boundary, const int32_t *part, double gap,
@@ -2097,11 +2100,12 @@ static int cluster_seams(const double *pos, int64_t n, const uint8_t *boundary, 
     for (int64_t i = 0; i < n; i++) {
         if (!boundary[i]) continue;
         const double *p = pos + 3 * i;
-        for (int d = 0; d < 27; d++) { /* the 3 x 3 x 3 cells around i's */
+        int64_t budget = SEAM_CANDIDATES;
+        for (int d = 0; d < 27 && budget > 0; d++) { /* the 3 x 3 x 3 cells around i's */
             const int offset[3] = {d % 3 - 1, d / 3 % 3 - 1, d / 9 - 1};
             uint64_t h = 0;
             for (int c = 0; c < 3; c++) h = mix64(h ^ (uint64_t)(cell[3 * i + c] + offset[c]));
-            for (int32_t j = head[h & (uint64_t)(buckets - 1)]; j >= 0; j = next[j]) {
+            for (int32_t j = head[h & (uint64_t)(buckets - 1)]; j >= 0 && budget-- > 0; j = next[j]) {
                 const double *q = pos + 3 * j;
                 double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
                 if (part[i] != part[j] && dx * dx + dy * dy + dz * dz <= gap * gap)
