@@ -12,6 +12,7 @@ Example::
     sil.lift(points, front)       # back to 3D: origin + x*u + y*v + depth*direction
     sil.project(points3d)         # (points, depths) in the view's frame: the inverse of lift
     sil.encloses(points3d)        # the ray hits the mesh and the depth lies between its nearest and farthest hit
+    closed = silhouette.sealed(vertices, triangles)      # pieces that abut without shared vertices welded, to trace
 
 How it works, and why tracing cannot fail: the projected triangles are snapped to an integer lattice (65536 steps per
 grid cell) and every inside/outside decision is exact integer arithmetic under a symbolic perturbation, so no grid
