@@ -284,10 +284,6 @@ class Limb:
     side: int
     twin: int = -1
 
-    @property
-    def nodes(self):
-        return tuple(self.before)
-
 
 @dataclass(frozen=True)
 class Body:
@@ -297,7 +293,7 @@ class Body:
     ``connectors``, midline joints off the spine, each with the spine joint it leaves), the ``radius`` (local
     half-thickness of the mesh) at each joint, each limb's ``flatness`` (the mesh around it: thin across over wide
     across, 1 for a round limb, near 0 for a wing or a fin; 1 on a flat mesh) and how up was found
-    (``up_evidence``: "legs", "flat" or "preferred"; ``up_note`` in words)."""
+    (``up_evidence``: "legs", "flat" or "preferred")."""
 
     graph: JointGraph
     size: float
@@ -313,7 +309,6 @@ class Body:
     radius: np.ndarray
     flatness: tuple
     up_evidence: str
-    up_note: str
 
     def height(self, points):
         """Height above the mesh's lowest point, as a share of the mesh's height."""
@@ -341,8 +336,8 @@ def read_body(skeleton, mesh, tuning=BodyTuning(), plane=None, prefer_up=AXES[2]
     spine, limbs, bases, connectors = _midline_and_limbs(graph, found, size, tuning)
     limbs = _paired(limbs, graph, skeleton, found, size, tuning)
     tips = sorted({node for limb in limbs for node in limb.before if graph.degree(node) == 1})
-    up, up_evidence, up_note = _up_axis(graph, tips, radius, mesh, vertices, found, size, tuning,
-                                        np.asarray(prefer_up, dtype=np.float64))
+    up, up_evidence = _up_axis(graph, tips, radius, mesh, vertices, found, size, tuning,
+                               np.asarray(prefer_up, dtype=np.float64))
     heights = mesh.used_vertices @ up
     if mesh.flat_normal is not None:
         flatness = tuple(1.0 for _ in limbs)  # a cut-out's limbs are all flat: no telling wings by it
@@ -351,7 +346,7 @@ def read_body(skeleton, mesh, tuning=BodyTuning(), plane=None, prefer_up=AXES[2]
         flatness = tuple(_flatness(limb, graph, vertices, segments, nearest, (tuning.blade_from, tuning.blade_to))
                          for limb in limbs)
     return Body(graph, size, up, float(heights.min()), float(heights.max()), found, vertices, tuple(spine),
-                tuple(limbs), bases, connectors, radius, flatness, up_evidence, up_note)
+                tuple(limbs), bases, connectors, radius, flatness, up_evidence)
 
 
 def _sampled(rows, count):
@@ -414,10 +409,10 @@ def _span(points):
 # Up.
 
 def _up_axis(graph, tips, radius, mesh, sample, plane, size, tuning, prefer_up):
-    """(up, evidence, note) as :func:`read_body` says: each candidate axis scores ``leg_weight`` when separate limbs
+    """(up, evidence) as :func:`read_body` says: each candidate axis scores ``leg_weight`` when separate limbs
     touch the ground at its bottom (their leaf ``tips``: the body's own ends are no feet), plus its flat bottom area
     as a share of the best candidate's (or of ``flat_area`` when none has that much), spread over the vertex
-    ``sample``; ``prefer_up`` breaks ties. The evidence is "legs", "flat" or "preferred"; the note says it in words."""
+    ``sample``; ``prefer_up`` breaks ties. The evidence is "legs", "flat" or "preferred"."""
     candidates = []
     low, high = mesh.bbox
     for axis in range(3):
@@ -454,12 +449,11 @@ def _up_axis(graph, tips, radius, mesh, sample, plane, size, tuning, prefer_up):
               for up, (contacts, _, _), base in zip(candidates, measures, bases)]
     best = int(np.argmax(scores))
     up, (contacts, flat, _) = candidates[best], measures[best]
-    name = _axis_name(up)
     if contacts >= 2:
-        return up, "legs", f"up {name}: {contacts} separate limbs touch the ground"
+        return up, "legs"
     if flat >= tuning.flat_area:
-        return up, "flat", f"up {name}: the mesh rests on a flat bottom ({flat:.1%} of its area)"
-    return up, "preferred", f"up {name}: nothing touches the ground clearly, so the preferred up"
+        return up, "flat"
+    return up, "preferred"
 
 
 def _spread(base, vertices, up):
@@ -483,11 +477,6 @@ def _contacts(graph, radius, tips, up, low, high, size, tuning):
         if not any(graph.distances[first, leaf] <= tuning.contact_apart * size for first in groups):
             groups.append(leaf)
     return len(groups)
-
-
-def _axis_name(vector):
-    axis = int(np.argmax(np.abs(vector)))
-    return ("-" if vector[axis] < 0 else "+") + "XYZ"[axis]
 
 
 # Midline and limbs.
