@@ -19,7 +19,7 @@ import time
 
 from ..axes import axes_field, file_axes
 from ..core.files import remove_leftover_folders, remove_leftovers, replaced_on_success
-from .work import input_stamp, rigged_row
+from .work import failed_row, input_stamp, rigged_row
 
 SUMMARY = "summary.json"
 # The first bytes of a complete model file of each output format: .blend plain or zstd-compressed, binary glTF, FBX.
@@ -60,7 +60,7 @@ def run(sources, total, engine, output, fmt, settings, resume=False, progress=sy
         for source in pending:
             job = Job(source, output / f"{source.stem}.{fmt}", output / f"{source.stem}.json")
             if source.problem:
-                rows.append(_row(job, {"status": "failed", "message": source.problem, "seconds": 0.0}))
+                rows.append(_row(job, failed_row(source.problem)))
             elif resume and (report := finished_report(job, settings)):
                 rows.append(_row(job, {**rigged_row(report), "seconds": 0.0, "resumed": True}))
             else:

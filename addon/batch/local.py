@@ -10,7 +10,7 @@ import sys
 import threading
 import time
 
-from .work import rigged_row
+from .work import failed_row, rigged_row
 
 
 class LocalEngine:
@@ -53,7 +53,7 @@ class LocalEngine:
         try:
             return self._run_child(job)
         except Exception as error:
-            return {"status": "failed", "message": f"{type(error).__name__}: {error}", "seconds": 0.0}, False
+            return failed_row(f"{type(error).__name__}: {error}"), False
 
     def _run_child(self, job):
         command = [sys.executable, "-m", __package__.rpartition(".")[0], "rig", str(job.source.path),
@@ -61,7 +61,7 @@ class LocalEngine:
         start = time.perf_counter()
         with self._lock:
             if self._stopping:
-                return {"status": "failed", "message": "stopped", "seconds": 0.0}, False
+                return failed_row("stopped"), False
             child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                      encoding="utf-8", errors="replace")  # Blender may echo paths in any encoding
             self._children.add(child)
@@ -77,14 +77,13 @@ class LocalEngine:
                 self._children.discard(child)
         seconds = round(time.perf_counter() - start, 2)
         if timed_out:
-            return {"status": "failed", "message": f"timed out after {self._timeout:g} s", "seconds": seconds}, False
+            return failed_row(f"timed out after {self._timeout:g} s", seconds), False
         if child.returncode:
-            return {"status": "failed", "message": _failure(child.returncode, stderr), "seconds": seconds}, \
-                child.returncode < 0
+            return failed_row(_failure(child.returncode, stderr), seconds), child.returncode < 0
         try:
             row = rigged_row(json.loads(job.report.read_text()))
         except (OSError, ValueError, KeyError, TypeError) as error:
-            row = {"status": "failed", "message": f"finished without a readable report: {error}"}
+            row = failed_row(f"finished without a readable report: {error}")
         return {**row, "seconds": seconds}, False
 
 

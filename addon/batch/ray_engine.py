@@ -13,7 +13,7 @@ import os
 import time
 
 from . import BatchError
-from .work import Worker
+from .work import Worker, failed_row
 
 INSTALL = "pip install -r requirements-ray.txt (or pip install 'rigger[ray]')"
 POLL_SECONDS = 1.0  # longest wait for results before timeouts are looked at again
@@ -115,13 +115,12 @@ class RayEngine:
             if job is None:
                 return self._not_started(worker, _last_line(error))
             worker.ref = worker.job = None
-            return [(job, {"status": "failed", "message": _last_line(error), "seconds": seconds}, False)]
+            return [(job, failed_row(_last_line(error), seconds), False)]
         except exceptions.RayError as error:  # the worker process died (killed, segfault, out of memory, lost node)
             if job is None:
                 return self._not_started(worker, _reason(error))
             self._replace(worker)
-            return [(job, {"status": "failed", "message": f"the worker process died mid-file ({_reason(error)})",
-                           "seconds": seconds}, True)]
+            return [(job, failed_row(f"the worker process died mid-file ({_reason(error)})", seconds), True)]
         worker.ref = worker.job = None
         self._started = True
         return [] if job is None else [(job, {**value, "seconds": seconds}, False)]
@@ -140,8 +139,8 @@ class RayEngine:
                     and time.monotonic() - worker.since > self._timeout:
                 self._ray.kill(worker.actor)
                 self._ray.wait([worker.ref], timeout=KILL_WAIT)  # gone before the driver cleans up after it
-                results.append((worker.job, {"status": "failed", "message": f"timed out after {self._timeout:g} s",
-                                             "seconds": round(time.monotonic() - worker.since, 2)}, False))
+                seconds = round(time.monotonic() - worker.since, 2)
+                results.append((worker.job, failed_row(f"timed out after {self._timeout:g} s", seconds), False))
                 self._replace(worker)
         return results
 

@@ -113,6 +113,11 @@ def _test_hooks(source):
             time.sleep(60)
 
 
+def failed_row(message, seconds=0.0):
+    """The summary fields of a file that failed: status, the ``message`` saying why, the ``seconds`` it took."""
+    return {"status": "failed", "message": message, "seconds": seconds}
+
+
 def rigged_row(report):
     """The summary fields of a file rigged with ``report``: status, bone count, skinning outcome, warnings, and the
     seconds the file took inside its process, wall-clock and CPU (``work_seconds``, ``work_cpu_seconds``; absent
@@ -143,7 +148,7 @@ class Worker:
         try:
             row = rigged_row(rig_to_files(source, output, report, self._settings))
         except FileFailed as failure:
-            row = {"status": "failed", "message": str(failure)}
+            row = failed_row(str(failure))
         return {**row, **self.ready()}
 
 
