@@ -164,11 +164,7 @@ def trace(vertices, triangles, direction, *, resolution=None, tolerance=None):
             projection has zero area, or :class:`PartsTooSmall` (one too) for one that covers no grid cell (tiny
             parts far apart).
     """
-    verts = point_array(vertices, 3, "vertices")
-    if len(verts) > INT32_MAX:
-        raise ValueError(f"the mesh has {len(verts)} vertices; the tracer indexes at most {INT32_MAX}")
-    tris = index_array(triangles, 3, len(verts), name="triangles", item="triangle", target=("vertex", "vertices"),
-                       dtype=np.int32)
+    verts, tris = _mesh_arrays(vertices, triangles)
     if len(verts) == 0 or len(tris) == 0:
         raise ValueError(f"the mesh is empty ({len(verts)} vertices, {len(tris)} triangles)")
     view = _as_direction(direction)
@@ -202,13 +198,20 @@ def sealed(vertices, triangles):
     position, onto one shared position, so the pieces weld into the solid they bound; parts farther apart stay
     apart. Returns (N, 3) float64 vertices: a new array when any moved, else ``vertices`` as given (as float64).
     """
-    verts = point_array(vertices, 3, "vertices")
-    tris = index_array(triangles, 3, len(verts), name="triangles", item="triangle", target=("vertex", "vertices"),
-                       dtype=np.int32)
-    if len(verts) > INT32_MAX:
-        raise ValueError(f"the mesh has {len(verts)} vertices; the tracer indexes at most {INT32_MAX}")
+    verts, tris = _mesh_arrays(vertices, triangles)
     out, moved = _rigger_silhouette.seal(verts, tris)
     return out if moved else verts
+
+
+def _mesh_arrays(vertices, triangles):
+    """``vertices`` as finite (N, 3) float64 and ``triangles`` as in-range (M, 3) int32, as the compiled tracer takes
+    them; ValueError saying what is wrong."""
+    verts = point_array(vertices, 3, "vertices")
+    if len(verts) > INT32_MAX:
+        raise ValueError(f"the mesh has {len(verts)} vertices; the tracer indexes at most {INT32_MAX}")
+    tris = index_array(triangles, 3, len(verts), name="triangles", item="triangle", target=("vertex", "vertices"),
+                       dtype=np.int32)
+    return verts, tris
 
 
 def _as_direction(direction):

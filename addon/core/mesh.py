@@ -48,10 +48,7 @@ class Mesh:
             raise ValueError(f"vertex {far[0]} at {self.vertices[far[0]]} lies too far from a mesh {self.scale:.3g} "
                              f"big to rig it at unit size; move the mesh nearer the origin, or remove that vertex if "
                              f"it is loose")
-        moved = object.__new__(Mesh)
-        moved.vertices = _read_only(vertices if rotation is None else vertices @ np.asarray(rotation).T)
-        moved.triangles, moved.degenerate_count = self.triangles, self.degenerate_count
-        moved.__dict__["_used"] = self._used  # cached_property values live in the instance dict
+        moved = self._moved(vertices if rotation is None else vertices @ np.asarray(rotation).T)
         if rotation is None:
             moved.__dict__.update(bbox=_read_only(self.bbox * factor), centroid=_read_only(self.centroid * factor),
                                   _scatter=self._scatter)  # taken at unit size already
@@ -65,10 +62,15 @@ class Mesh:
             return self
         if np.shape(vertices) != self.vertices.shape:
             raise ValueError(f"with_vertices needs {self.vertices.shape} vertices, got {np.shape(vertices)}")
+        return self._moved(np.array(vertices, dtype=np.float64))
+
+    def _moved(self, vertices):
+        """This mesh at other ``vertices`` (a valid (N, 3) float64 array it may keep), sharing its triangles and
+        which vertices they use; the other measures are taken again when asked for."""
         moved = object.__new__(Mesh)
-        moved.vertices = _read_only(np.array(vertices, dtype=np.float64))
+        moved.vertices = _read_only(vertices)
         moved.triangles, moved.degenerate_count = self.triangles, self.degenerate_count
-        moved.__dict__["_used"] = self._used
+        moved.__dict__["_used"] = self._used  # cached_property values live in the instance dict
         return moved
 
     @cached_property

@@ -239,7 +239,7 @@ def _follow(node_layers, copies, start, mirror=None):
         depths = np.full(len(node_layers), np.nan)
         _track(node_layers, range(len(node_layers)), start, depths, mirror=mirror)
         return [depths]
-    anchor = max(i for i, layer in enumerate(node_layers) if len(layer) == copies)
+    anchor = _anchor(node_layers, copies)
     followed = [np.full(len(node_layers), np.nan) for _ in range(copies)]
     for copy, depths in enumerate(followed):
         depths[anchor] = _middle(node_layers[anchor][copy])
@@ -259,12 +259,17 @@ def _follow(node_layers, copies, start, mirror=None):
     return followed
 
 
+def _anchor(node_layers, copies):
+    """The outermost node crossing exactly ``copies`` intervals: where a split chain's copies are surely apart."""
+    return max(i for i, layer in enumerate(node_layers) if len(layer) == copies)
+
+
 def _twin_copies(parts, followed, depth, tolerance):
     """The two ``followed`` copies of a split chain whose parts mirror each other across the plane at ``depth`` (at
     the outermost node that sees them apart: a pair of legs or ears seen from the side) as twins: the copy that keeps
     to one side of the plane at more nodes, and its mirror image, since where one part hides the other the other copy
     may have stepped across to it. Copies of parts on one side (fingers seen edge-on) are left as followed."""
-    anchor = max(i for i, layer in enumerate(parts) if len(layer) == 2)
+    anchor = _anchor(parts, 2)
     if not _beside(parts[anchor], depth, tolerance):
         return followed
     kept = max((0, 1), key=lambda k: abs(np.sign(followed[k] - depth).sum()))
