@@ -5,7 +5,7 @@ import pytest
 import rigger
 from characters import load_character
 from rigger.core.game import game_skeleton
-from rigger.core.retarget import RetargetError, aliases, map_joints, normalised
+from rigger.core.retarget import RetargetError, aliases, map_joints, normalised, sole_points
 from rigger.core.roles import named_joints
 from rigger.core.targets import choose_target
 
@@ -112,3 +112,18 @@ def test_a_motion_that_cannot_drive_the_legs_names_the_bones_and_joints():
         map_joints(["Bone", "Bone1", "Bone2"], [-1, 0, 1], ["root", *sorted(MIXAMO)])
     message = str(error.value)
     assert "LeftUpLeg" in message and "Hips" in message and "Bone1" in message
+
+
+def test_sole_points_hold_a_turned_foots_lowest_point():
+    rng = np.random.default_rng(3)
+    foot = rng.normal(size=(4000, 3))
+    foot *= [0.04, 0.12, 0.03] / np.linalg.norm(foot, axis=1, keepdims=True)  # a foot-like ellipsoid, Z up
+    sole = sole_points(foot, np.array([0.0, 0.0, 1.0]))
+    assert len(sole) < len(foot) / 4 and all(any((point == foot).all(1)) for point in sole)
+    for _ in range(200):  # turned up to 80 degrees about a level axis: the lowest point is a sole point
+        angle = np.radians(rng.uniform(-80, 80))
+        axis = np.r_[rng.normal(size=2), 0.0]
+        axis /= np.linalg.norm(axis)
+        cross = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        turn = np.eye(3) + np.sin(angle) * cross + (1 - np.cos(angle)) * cross @ cross
+        assert (sole @ turn.T)[:, 2].min() == pytest.approx((foot @ turn.T)[:, 2].min(), abs=0.001)

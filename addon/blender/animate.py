@@ -6,7 +6,10 @@ import bpy
 import numpy as np
 
 from ..core.game import ROOT
-from ..core.retarget import Clip, Rig, retarget
+from ..core.retarget import Clip, Rig, retarget, sole_points
+from .skinning import weight_entries
+
+CARRIED = 0.5  # a skin vertex rides rigidly enough on the bone that carries more than this share of it
 
 
 def animate(armature, path):
@@ -92,8 +95,8 @@ def _clip(source, armature, scene):
 
 
 def game_rig(armature):
-    """The game armature at rest as a ``core.retarget.Rig``: its up is the root bone's direction and its ground the
-    root's head."""
+    """The game armature at rest as a ``core.retarget.Rig``: its up is the root bone's direction, its ground the
+    root's head, and its soles come from the meshes the armature deforms (:func:`_soles`)."""
     bones = list(armature.data.bones)
     names = tuple(bone.name for bone in bones)
     parents = np.array([names.index(bone.parent.name) if bone.parent else -1 for bone in bones])
@@ -102,7 +105,31 @@ def game_rig(armature):
     root = armature.data.bones[ROOT]
     up = np.array(root.tail_local) - np.array(root.head_local)
     up /= np.linalg.norm(up)
-    return Rig(names, parents, rest, tails, up, float(np.array(root.head_local) @ up))
+    return Rig(names, parents, rest, tails, up, float(np.array(root.head_local) @ up), _soles(armature, names, up))
+
+
+def _soles(armature, names, up):
+    """``Rig.soles``: per foot and toe bone, the sole points (``core.retarget.sole_points``) of the vertices that
+    bone carries more than ``CARRIED`` of, over the meshes ``armature`` deforms, in its space at rest."""
+    feet = [name for name in names if name[name.startswith("Right") and 5 or 4:] in ("Foot", "ToeBase")
+            and name.startswith(("Left", "Right"))]
+    carried = {name: [] for name in feet}
+    to_armature = np.linalg.inv(np.array(armature.matrix_world))
+    for obj in bpy.data.objects:
+        if obj.type != 'MESH' or not any(modifier.type == 'ARMATURE' and modifier.object == armature
+                                         for modifier in obj.modifiers):
+            continue
+        vertices, bones, weights = weight_entries(obj, feet)
+        if not len(vertices):
+            continue
+        points = np.empty(len(obj.data.vertices) * 3)
+        obj.data.vertices.foreach_get("co", points)
+        matrix = to_armature @ np.array(obj.matrix_world)
+        points = points.reshape(-1, 3) @ matrix[:3, :3].T + matrix[:3, 3]
+        for bone, name in enumerate(feet):
+            carried[name].append(points[vertices[(bones == bone) & (weights > CARRIED)]])
+    return {names.index(name): sole_points(np.concatenate(parts), up)
+            for name, parts in carried.items() if parts and sum(map(len, parts))}
 
 
 def bake(armature, rig, motion, name, start):

@@ -240,7 +240,7 @@ def _bind(mesh_obj, armature_obj, bone_names):
     mesh_obj[GROUPS_PROPERTY] = json.dumps(bone_names)
 
 
-def _weight_entries(obj, bone_names):
+def weight_entries(obj, bone_names):
     """Every positive deforming weight of ``obj`` as (vertex, bone index into ``bone_names``, weight) arrays."""
     column = {}
     for index, name in enumerate(bone_names):
@@ -382,7 +382,7 @@ def _bone_heat_weights(positions, triangles, armature_obj, bone_names, subsurf=F
         if subsurf:
             obj.modifiers.new(TEMPORARY_NAME, 'SUBSURF')
         result, messages = _bone_heat(obj, armature_obj)
-        return result, _weight_entries(obj, bone_names), messages
+        return result, weight_entries(obj, bone_names), messages
     finally:
         bpy.data.objects.remove(obj)
         bpy.data.meshes.remove(mesh)

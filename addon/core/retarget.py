@@ -13,18 +13,19 @@ Retargeting, frame by frame (all in the game armature's space):
 - Limb bones (shoulders, arms, legs, hands, fingers) take their joint's rotation since its rest, after a fixed swing
   that lays the character's bone along the mocap's bone at rest: their directions follow the mocap's whatever either
   rest pose is (a T-pose onto an A-pose). The trunk, neck and head take their joint's rotation since its rest as it
-  is: both stand upright at rest. Feet and toes too, after a fixed pitch that lays the character's foot flat where
-  the mocap's is planted (:func:`_flat_foot`). Bones without a joint turn with their parent.
+  is: both stand upright at rest. Feet and toes turn as their joint's line does from where it lies when the foot is
+  flat, without the twist about that line (:func:`_level`). Bones without a joint turn with their parent.
 - The hips move as the mocap's do, scaled by the ratio of the legs' lengths (hip joint to knee to ankle): across the
   ground from where the character stands, and up and down from its rest height where the mocap's hips would stand
   on straight legs with flat feet. Heights are measured from the mocap's ground (:func:`mocap_ground`, a plane
   through its planted toes); a flat foot's ankle and toe joint stand as high above it as they do, in the median, in
   the frames that foot lies flat (:func:`_flat_frames`).
 - Each leg then reaches, by two-bone IK bending the knee forward (the thigh's turned rest forward), for the
-  ankle height that puts the lower of its heel (ankle) and toes (the foot's far end) as high above their rest
-  heights as, scaled, the lower of the mocap's ankle and toe joint is above their heights when its foot lies flat
-  (never below): a heel raised to push off pivots on the toes. In a frame where a leg would not reach, the hips
-  come down until it does. Feet planted in the mocap are planted in the character whatever the legs' proportions.
+  ankle height that puts the foot's lowest sole point (:func:`_lowest_sole`: the skin the foot and toes carry, else
+  the bones' heel and far end) as high above its rest height as, scaled, the lower of the mocap's ankle and toe
+  joint is above their heights when its foot lies flat (never below): a heel raised to push off pivots on the toes,
+  and the sole neither sinks into the ground nor floats. In a frame where a leg would not reach, the hips come down
+  until it does. Feet planted in the mocap are planted in the character whatever the legs' proportions.
 """
 import re
 from dataclasses import dataclass, field
@@ -55,6 +56,7 @@ CONTACT_HEIGHT = 0.05  # a planted foot's joint is this close to the ground (leg
 CONTACT_SPEED = 0.5  # ... and slower than this (leg lengths a second)
 MAX_SLOPE = 0.05  # the steepest capture floor taken (a rise over a run) ...
 SLOPE_RUN = 2.0  # ... fitted only when the feet go this many leg lengths
+SOLE_DIRECTIONS = 1024  # directions around the sphere whose extreme skin points can be a foot's lowest
 
 
 class RetargetError(ValueError):
@@ -160,7 +162,8 @@ class Clip:
 class Rig:
     """The game armature at rest: bone ``names``, ``parents``, ``rest`` (B, 4, 4) matrices (Blender's
     ``bone.matrix_local``: the bone's frame, its head as translation), ``tails`` (B, 3), its ``up`` and the height
-    of its ``ground`` along it, all in the armature's space."""
+    of its ``ground`` along it, all in the armature's space; ``soles``: per foot or toe bone index, the points of the
+    skin that bone carries which can touch the ground (:func:`sole_points`), when the rig has a skin."""
 
     names: tuple
     parents: np.ndarray
@@ -168,6 +171,7 @@ class Rig:
     tails: np.ndarray
     up: np.ndarray
     ground: float
+    soles: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -206,17 +210,17 @@ def retarget(clip, rig, mapping=None):
             if end is not None:
                 swing[bone] = _between(directions[bone], turn @ (clip.rest[end, :3, 3] - clip.rest[joint, :3, 3]))
     ground, ankles = _planted(clip, mapping)
-    for side in ("Left", "Right"):
-        flat = _flat_foot(clip, mapping, ground, turn, up, side)
-        for word in ("Foot", "ToeBase"):
-            if f"{side}{word}" in mapping.driven and f"{side}{word}" in index:
-                swing[index[f"{side}{word}"]] = flat
+    level = {index[name]: _level(clip, mapping.driven[name], _flat_frames(clip, mapping, ground, side), turn, up)
+             for side in ("Left", "Right") for name in (f"{side}Foot", f"{side}ToeBase")
+             if name in mapping.driven and name in index}
     deltas = np.einsum("fjab,jcb->fjac", clip.poses[:, :, :3, :3], clip.rest[:, :3, :3])  # pose * rest^T
     deltas = np.einsum("ab,fjbc,dc->fjad", turn, deltas, turn)
     world = np.empty((frames, len(rig.names), 3, 3))
     for bone in range(len(rig.names)):
         parent = rig.parents[bone]
-        if bone in drive:
+        if bone in level:
+            world[:, bone] = level[bone]
+        elif bone in drive:
             world[:, bone] = deltas[:, drive[bone]] @ swing.get(bone, np.eye(3))
         else:
             world[:, bone] = world[:, parent] if parent >= 0 else np.eye(3)
@@ -251,6 +255,22 @@ def posed_points(rig, world, hips_at):
             posed_heads[:, bone] = posed_heads[:, parent] + world[:, parent] @ (heads[bone] - heads[parent])
     posed_tails = posed_heads + np.einsum("fbij,bj->fbi", world, rig.tails - heads)
     return posed_heads, posed_tails
+
+
+def sole_points(points, up):
+    """The points of ``points`` (N, 3), the skin one foot or toe bone carries, that can be its lowest however it
+    turns up to a right angle from rest: the extremes along ``SOLE_DIRECTIONS`` directions spread over the lower
+    half sphere about ``up`` (the lowest point of a turned rigid body is an extreme one)."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if not len(points):
+        return points
+    k = np.arange(SOLE_DIRECTIONS) + 0.5  # a Fibonacci sphere
+    height = 1 - 2 * k / SOLE_DIRECTIONS
+    angle = np.pi * (1 + 5 ** 0.5) * k
+    ring = np.sqrt(1 - height ** 2)
+    directions = np.column_stack([ring * np.cos(angle), ring * np.sin(angle), height])
+    directions = directions[directions @ _unit(up) < 0]
+    return points[np.unique(np.argmax(points @ directions.T, axis=0))]
 
 
 def contact_frames(clip, mapping, side):
@@ -342,23 +362,30 @@ def _alignment(clip, rig, driven, index, up):
     return frames[1] @ frames[0].T, frames[1][:, 2]
 
 
-def _flat_foot(clip, mapping, ground, turn, up, side):
-    """The fixed turn of the character's foot (and toes) on ``side`` that keeps it flat when the mocap's foot is
-    flat: it pitches the mocap's rest foot (ankle to toe) to the slope it has, in the median, in the frames it lies
-    flat on the ground (:func:`_flat_frames`; a capture's rest foot seldom lies as the planted one does)."""
-    ankle = mapping.driven.get(f"{side}Foot")
-    toe = None if ankle is None else _segment_end(clip, ankle, mapping, None, None)
-    planted = _flat_frames(clip, mapping, ground, side) if toe is not None else None
-    if planted is None or not planted.any():
-        return np.eye(3)
-    rest = turn @ (clip.rest[toe, :3, 3] - clip.rest[ankle, :3, 3])
-    along = (clip.poses[planted, toe, :3, 3] - clip.poses[planted, ankle, :3, 3]) @ turn.T
-    slope = float(np.median(along @ up / np.linalg.norm(along, axis=1)))
-    across = rest - (rest @ up) * up
-    if not np.linalg.norm(across) > 0:
-        return np.eye(3)
-    wanted = np.sqrt(max(1 - slope ** 2, 0.0)) * _unit(across) + slope * up
-    return _between(wanted, rest)
+def _level(clip, joint, flat, turn, up):
+    """World rotations (F, 3, 3) of the character's foot (or toe) bone that mocap ``joint`` drives: the turn taking
+    the joint's line as it lies when its foot is flat (the median slope over the frames ``flat``, its rest heading)
+    onto its line in each frame, keeping the line across the bone (at right angles to it and to up) level. Capture
+    solvers leave a foot's twist about its own line loose (CMU's walk rolls a planted foot by 25 degrees), so the
+    twist is not taken: a flat foot's sole lies level across."""
+    along = clip.poses[:, joint, :3, 1] @ turn.T  # a bone's line is its Y axis
+    rest = turn @ clip.rest[joint, :3, 1]
+    heading = rest - (rest @ up) * up
+    if np.linalg.norm(heading) < 1e-6:  # a rest foot pointing straight down: no heading to level it by
+        return np.einsum("ab,fbc,dc->fad", turn, clip.poses[:, joint, :3, :3] @ clip.rest[joint, :3, :3].T, turn)
+    slope = float(np.clip(np.median(along[flat] @ up) if flat.any() else rest @ up, -1.0, 1.0))
+    reference = np.sqrt(1 - slope ** 2) * _unit(heading) + slope * up
+    return _level_frames(along, up, reference) @ _level_frames(reference[None], up, reference)[0].T
+
+
+def _level_frames(lines, up, reference):
+    """Rotation frames (N, 3, 3) whose columns are each line of ``lines`` (N, 3), the level line across it and the
+    third; a line along ``up`` takes ``reference``'s across."""
+    lines = lines / np.linalg.norm(lines, axis=1, keepdims=True)
+    across = np.cross(lines, up)
+    length = np.linalg.norm(across, axis=1, keepdims=True)
+    across = np.where(length > 1e-6, across / np.maximum(length, 1e-12), _unit(np.cross(reference, up)))
+    return np.stack([lines, across, np.cross(across, lines)], axis=2)
 
 
 def _segment_end(clip, joint, mapping, rig, bone):
@@ -467,20 +494,19 @@ def _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale,
     """Turn each leg's UpLeg and Leg (in ``world``, in place) so the ankle reaches its height (module docstring),
     lowering the hips (``hips_at``, in place) in the frames a leg would not reach that far."""
     rest = rig.rest[:, :3, 3]
-    heads, tails = posed_points(rig, world, hips_at)
+    heads, _ = posed_points(rig, world, hips_at)
     legs = []
     for side in ("Left", "Right"):
         names = [f"{side}{word}" for word in ("UpLeg", "Leg", "Foot")]
         if any(name not in index for name in names):
             continue
         thigh, shin, foot = (index[name] for name in names)
-        end = index.get(f"{side}ToeBase", foot)  # the foot's far end
         source_ankle = ground.height(clip.poses[:, mapping.driven[f"{side}Foot"], :3, 3])
         source_toe = ground.height(clip.poses[:, _foot_joint(mapping, side), :3, 3])
         flat_ankle, flat_toe = ankles[side]
         sole = np.maximum(np.minimum(source_ankle - flat_ankle, source_toe - flat_toe), 0.0)
-        slope, rest_slope = (tails[:, end] - heads[:, foot]) @ up, (rig.tails[end] - rest[foot]) @ up
-        height = rest[foot] @ up + scale * sole - np.minimum(slope - rest_slope, 0.0)
+        lowest, rest_lowest = _lowest_sole(rig, index, side, world, heads)
+        height = rest[foot] @ up + scale * sole + rest_lowest - lowest
         target = heads[:, foot] + np.outer(height - heads[:, foot] @ up, up)
         reach = 0.999 * (np.linalg.norm(rest[shin] - rest[thigh]) + np.linalg.norm(rest[foot] - rest[shin]))
         legs.append((thigh, shin, foot, target, reach))
@@ -500,6 +526,25 @@ def _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale,
             new_knee = _two_bone(hip[frame], pole, target[frame], upper, lower)
             world[frame, thigh] = _between(knee[frame] - hip[frame], new_knee - hip[frame]) @ world[frame, thigh]
             world[frame, shin] = _between(ankle[frame] - knee[frame], target[frame] - new_knee) @ world[frame, shin]
+
+
+def _lowest_sole(rig, index, side, world, heads):
+    """(per frame, at rest) the height of the lowest sole point of the foot on ``side`` over its ankle (the Foot's
+    head), posed with world rotations ``world`` and heads ``heads``. Sole points: the skin's (``Rig.soles``) on the
+    Foot and ToeBase; without a skin, the foot's far end (the ToeBase's tail, else the Foot's) and the heel, below
+    the ankle at the far end's rest height when that is lower."""
+    up, rest = rig.up, rig.rest[:, :3, 3]
+    foot = index[f"{side}Foot"]
+    carried = [(bone, rig.soles[bone]) for bone in (foot, index.get(f"{side}ToeBase")) if len(rig.soles.get(bone, ()))]
+    if not carried:
+        end = index.get(f"{side}ToeBase", foot)
+        heel = rest[foot] + min((rig.tails[end] - rest[foot]) @ up, 0.0) * up
+        carried = [(foot, heel[None]), (end, rig.tails[end][None])]
+    lowest = np.min([np.min(((heads[:, bone] - heads[:, foot])[:, None, :]
+                             + np.einsum("fij,nj->fni", world[:, bone], points - rest[bone])) @ up, axis=1)
+                     for bone, points in carried], axis=0)
+    rest_lowest = min(float(np.min((points - rest[foot]) @ up)) for _, points in carried)
+    return lowest, rest_lowest
 
 
 def _two_bone(hip, pole, target, upper, lower):
