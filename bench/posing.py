@@ -353,12 +353,13 @@ def report(records, summary, run):
         f"- Seam cracks: the largest distance over poses between two vertices that share a rest position (closer "
         f"than {pm.COINCIDENT:g} of size), after the fit. Limb recall: share of the artist's chains from a branch "
         f"joint or the root to a leaf that some path of Rigger's bones from a leaf bone to the root follows within "
-        f"{pm.FOLLOWS} on average (points every {pm.CHAIN_STEP} along the chain). Mirror plane: of the axis planes "
-        f"through the bounding box's centre, the one the mesh is most symmetric about relative to its extent across "
-        f"the plane (asymmetry: the median distance from a mirrored vertex to the surface's vertices, edge midpoints "
-        f"and face centres); two-sided when that asymmetry is ≤ {pm.MIRROR_SYMMETRIC}. Twin mismatch: per `.L`/`.R` "
-        f"pair, the larger distance between a head (tail) and the mirror image of its twin's. Unsided: bones "
-        f"without `.L`/`.R` whose midpoint is more than {pm.OFF_PLANE} off the plane of a two-sided body.",
+        f"{pm.FOLLOWS} on average (points every {pm.CHAIN_STEP} along the chain). Mirror plane: of the axis planes, "
+        f"each at the offset within {pm.PLANE_SEARCH} of the bounding box's centre the mesh is most symmetric about, "
+        f"the one it is most symmetric about relative to its extent across the plane (asymmetry: the median "
+        f"distance from a mirrored vertex to the surface's vertices, edge midpoints and face centres); two-sided "
+        f"when that asymmetry is ≤ {pm.MIRROR_SYMMETRIC}. Twin mismatch: per `.L`/`.R` pair, the larger distance "
+        f"between a head (tail) and the mirror image of its twin's. Unsided: bones without `.L`/`.R` whose midpoint "
+        f"is more than {pm.OFF_PLANE} off the plane of a two-sided body.",
         "", "## Rigs", "",
     ]
     if not summary["models"]:

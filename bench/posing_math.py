@@ -24,6 +24,9 @@ COINCIDENT = 1e-5  # fraction of the size under which two rest vertices share a 
 CHAIN_STEP = 0.005  # spacing of the points along an artist chain, as a fraction of the size
 FOLLOWS = 0.03  # a chain is followed when its points lie this close (fraction of size) to a path on average
 MIRROR_SYMMETRIC = 0.01  # a body is two-sided when its mirror image lies this close to it (median, fraction of size)
+PLANE_SEARCH = 0.05  # the mirror plane's offset is searched this far (fraction of size) either side of the box's centre
+PLANE_STEP = 0.001  # ... in steps of this
+PLANE_PROBES = 3000  # ... with about this many of the vertices
 OFF_PLANE = 0.03  # a bone lies off the mid-plane when its midpoint is farther than this (fraction of size)
 SIDE = re.compile(r"^(.*)\.([LR])$")  # Rigger's side suffix: ``limb01.02.L`` / ``limb01.02.R``
 
@@ -446,21 +449,27 @@ class MirrorPlane:
 
 
 def mirror_plane(vertices, triangles, size):
-    """Of the three axis planes through the bounding box's centre, the one the mesh is most symmetric about.
+    """Of the three axis planes, each at the offset the mesh is most symmetric about, the one the mesh is most
+    symmetric about.
 
     Asymmetry: the median distance from a mirrored vertex to the nearest vertex, edge midpoint or face centre (so
     a mirror image that falls between vertices of a coarser side still lands on the surface's samples), as a fraction
-    of ``size``. The plane is chosen by the asymmetry relative to the mesh's extent across the plane: a thin body
-    mirrors onto itself front to back whatever its shape.
+    of ``size``. Offsets: every ``PLANE_STEP`` of ``size`` within ``PLANE_SEARCH`` of the bounding box's centre (a
+    symmetric body holding a prop to one side is not centred on its box). The plane is chosen by the asymmetry
+    relative to the mesh's extent across the plane: a thin body mirrors onto itself front to back whatever its shape.
     """
     corners = vertices[triangles]
     surface = np.concatenate([vertices, corners.mean(axis=1), (corners + np.roll(corners, 1, axis=1)).reshape(-1, 3)
                               / 2])
     tree = cKDTree(surface)
     low, high = vertices.min(axis=0), vertices.max(axis=0)
+    probe = vertices[::max(1, len(vertices) // PLANE_PROBES)]
     planes = []
     for axis in range(3):
-        plane = MirrorPlane(axis, float(low[axis] + high[axis]) / 2, 0.0)
+        centre = float(low[axis] + high[axis]) / 2
+        offsets = centre + size * np.arange(-PLANE_SEARCH, PLANE_SEARCH + PLANE_STEP / 2, PLANE_STEP)
+        rough = [np.median(tree.query(MirrorPlane(axis, offset, 0.0).mirrored(probe))[0]) for offset in offsets]
+        plane = MirrorPlane(axis, float(offsets[int(np.argmin(rough))]), 0.0)
         asymmetry = float(np.median(tree.query(plane.mirrored(vertices))[0])) / size
         planes.append(MirrorPlane(axis, plane.offset, asymmetry))
     extent = np.maximum(high - low, 1e-300)

@@ -171,6 +171,17 @@ def test_the_mirror_plane_of_a_two_sided_body_and_its_twins(body):
     assert pm.unsided_off_plane(names, heads, tails, centred, 1.0) == ["ear"]
 
 
+def test_the_mirror_plane_of_a_body_holding_a_prop_to_one_side_is_the_body_s(body):
+    vertices, triangles, _ = body
+    size = np.ptp(vertices, axis=0).max()
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    prop = np.array([[x, y, z] for x in (high[0], high[0] + 0.1 * size) for y in (0.0, 0.01) for z in (1.0, 1.01)])
+    faces = len(vertices) + np.array([[0, 1, 2], [1, 3, 2], [4, 6, 5], [5, 6, 7]])
+    plane = pm.mirror_plane(np.vstack([vertices, prop]), np.vstack([triangles, faces]), size)
+    assert 0.5 * (low[0] + high[0] + 0.1 * size) > 0.04 * size  # the box's centre is off the body's plane ...
+    assert plane.axis == 0 and abs(plane.offset) <= pm.PLANE_STEP * size and plane.two_sided()  # ... the plane is not
+
+
 def test_a_body_without_a_mirror_plane_is_not_two_sided():
     rng = np.random.default_rng(6)
     vertices = rng.uniform(0.0, 1.0, (400, 3)) ** [1.0, 3.0, 0.5]
