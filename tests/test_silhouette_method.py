@@ -657,6 +657,26 @@ def test_a_chain_on_the_mirror_plane_never_hangs_from_a_side_chain():
     np.testing.assert_array_equal(heads[first_head_bone], [0.0, 0.0, 0.0])
 
 
+def test_twin_legs_leave_the_middle_together_where_the_triangulation_split_the_junction():
+    """The junction of the spine and both legs split in two on the way down: one leg leaves the root, its twin the
+    end of a short first spine bone. Both legs hang from where the first leaves, so they mirror when posed."""
+    builder = bone_builder(0.3, plane=(0, 0.0))
+    spine = (np.array([[0.0, 0.0, 0.0], [-0.02, -0.06, 0.0]]), -1, np.full(2, 0.3))
+    rest_of_spine = (np.array([[-0.02, -0.06, 0.0], [0.0, -0.5, 0.0], [0.0, -1.0, 0.0]]), 0, np.full(3, 0.3))
+    left = (np.array([[0.0, 0.0, 0.0], [0.3, -0.3, 0.0], [0.4, -1.5, 0.0]]), -1, np.full(3, 0.1))
+    right = (np.array([[-0.02, -0.06, 0.0], [-0.3, -0.3, 0.0], [-0.4, -1.5, 0.0]]), 0, np.full(3, 0.1))
+    builder.add_island(np.zeros(3), [spine, rest_of_spine, left, right])
+    heads, tails, parents = builder.arrays()
+    names = builder.names()
+    first = {side: names.index(next(n for n in names if n.endswith(side))) for side in (".L", ".R")}
+    assert parents[first[".L"]] == parents[first[".R"]]
+    np.testing.assert_allclose(heads[first[".R"]], heads[first[".L"]] * [-1, 1, 1], atol=1e-9)
+    for name in names:
+        if name.endswith(".L"):
+            twin = names.index(name[:-2] + ".R")
+            np.testing.assert_allclose(tails[twin], tails[names.index(name)] * [-1, 1, 1], atol=1e-9)
+
+
 def test_on_a_four_armed_figure_each_arm_keeps_its_hand_and_the_head_hangs_from_the_spine():
     """rignet_17364's two arms on each side lie one behind the other seen from the front: each keeps its own depth
     into its own hand (no bone crosses from one arm's depth to the other's), and the head hangs from the spine."""

@@ -4,7 +4,7 @@ import numpy as np
 
 from ...core.graphs import components
 from ...core.joints import chain_joints, symmetric_joints
-from ...core.mirror import mirror_completed
+from ...core.mirror import mirror_chain_pairs, mirror_completed
 from ...core.naming import bone_names
 from ...core.polyline import nearest_on_segments
 
@@ -26,9 +26,12 @@ class BoneBuilder:
     def add_island(self, root_point, placed):
         """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk, the
         widest on the mirror plane when one leaves it there (a spine, not an arm, carries the body). Across a plane,
-        a chain on it never hangs from a chain off it (``_on_plane_parents``)."""
+        a chain on it never hangs from a chain off it (``_on_plane_parents``), and across the mesh's own plane twins
+        that leave the middle leave it together (``_twins_together``)."""
         if self.symmetry is not None:
             placed = self._on_plane_parents(placed)
+            if self.exact:
+                placed = self._twins_together(placed)
         roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
         on_plane = {i: self.symmetry is not None and self.symmetry.side(placed[i][0]) == 0 for i in roots}
         trunk = max(roots, key=lambda i: (on_plane[i], placed[i][2].mean()))
@@ -65,6 +68,23 @@ class BoneBuilder:
             while parent >= 0 and side[parent] != 0:
                 start, parent = placed[parent][0][0], placed[parent][1]
             moved[i] = (np.vstack([start, line[1:]]), parent, widths)
+        return moved
+
+    def _twins_together(self, placed):
+        """The placed chains with mirror twins that start apart, one of them on the plane, both starting there, from
+        that twin's parent: the triangulation splits a junction on the plane into two (a leg leaving the root, its
+        twin the end of a short trunk bone), and twins hanging from two places do not mirror when posed."""
+        lines = [line for line, _, _ in placed]
+        moved = list(placed)
+        axis, offset = self.symmetry.plane
+        for pair in mirror_chain_pairs(lines, self.symmetry):
+            near, far = sorted(pair, key=lambda i: abs(lines[i][0, axis] - offset))
+            start = lines[near][0]
+            if (self.symmetry.side(start[None]) != 0
+                    or np.linalg.norm(lines[far][0] - self.symmetry.reflect(start)) <= 1e-9 * self.bone_length):
+                continue
+            line, _, widths = placed[far]
+            moved[far] = (np.vstack([start, line[1:]]), placed[near][1], widths)
         return moved
 
     def add_limbs(self, limbs, views):
