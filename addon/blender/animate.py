@@ -111,8 +111,8 @@ def game_rig(armature):
 def _soles(armature, names, up):
     """``Rig.soles``: per foot and toe bone, the sole points (``core.retarget.sole_points``) of the vertices that
     bone carries more than ``CARRIED`` of, over the meshes ``armature`` deforms, in its space at rest."""
-    feet = [name for name in names if name[name.startswith("Right") and 5 or 4:] in ("Foot", "ToeBase")
-            and name.startswith(("Left", "Right"))]
+    feet = [name for name in (f"{side}{word}" for side in ("Left", "Right") for word in ("Foot", "ToeBase"))
+            if name in names]
     carried = {name: [] for name in feet}
     to_armature = np.linalg.inv(np.array(armature.matrix_world))
     for obj in bpy.data.objects:
