@@ -273,11 +273,11 @@ def sole_points(points, up):
     return points[np.unique(np.argmax(points @ directions.T, axis=0))]
 
 
-def contact_frames(clip, mapping, side):
+def contact_frames(clip, mapping, side, ground=None):
     """Frames (bool (F,)) where the mocap's foot on ``side`` ("Left"/"Right") is planted: its lowest joint (toe,
-    else ankle) within ``CONTACT_HEIGHT`` leg lengths of the mocap's ground (:func:`mocap_ground`) and slower than
-    ``CONTACT_SPEED`` leg lengths a second."""
-    ground = mocap_ground(clip, mapping)
+    else ankle) within ``CONTACT_HEIGHT`` leg lengths of the mocap's ground (``ground``, else
+    :func:`mocap_ground`) and slower than ``CONTACT_SPEED`` leg lengths a second."""
+    ground = mocap_ground(clip, mapping) if ground is None else ground
     joint = _foot_joint(mapping, side)
     path = clip.poses[:, joint, :3, 3]
     speed = np.linalg.norm(np.gradient(path, axis=0), axis=1) * clip.fps
@@ -473,7 +473,7 @@ def _flat_frames(clip, mapping, ground, side):
     than ``CONTACT_SPEED`` leg lengths a second too (a heel rising to push off or falling onto the ground is not)."""
     path = clip.poses[:, mapping.driven[f"{side}Foot"], :3, 3]
     speed = np.linalg.norm(np.gradient(path, axis=0), axis=1) * clip.fps
-    return contact_frames(clip, mapping, side) & (speed <= CONTACT_SPEED * ground.leg)
+    return contact_frames(clip, mapping, side, ground) & (speed <= CONTACT_SPEED * ground.leg)
 
 
 def _hips_path(clip, rig, driven, index, turn, up, scale, ground, ankles):
