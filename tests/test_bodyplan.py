@@ -7,6 +7,8 @@ import pytest
 
 import rigger
 from characters import load_character
+from conftest import shared_path
+from rigdata import load_obj
 from rigger import samples
 from rigger.core.body import read_body
 from rigger.core.bodyplan import KINDS, BodyPlan, recognise
@@ -103,6 +105,15 @@ def test_a_snake_is_a_head_a_spine_and_a_tail_from_its_thick_end(rigged):
         tails = [bone for bone, role in enumerate(roles) if role.role == "tail"]
         head_end = skeleton.heads[heads].mean(axis=0)
         assert head_end[1] < skeleton.heads[tails].mean(axis=0)[1]  # the head lies at the -Y end
+
+
+def test_a_head_on_the_midline_whose_tip_turns_aside_is_a_neck_and_head_not_an_arm():
+    """homer's head chain runs up the mirror plane and ends aside: it is the neck and head, and the arms are two."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "homer.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert skeleton.body_plan.kind == "humanoid" and skeleton.body_plan.parts["arms"] == 2
+    head = [role for name, role in zip(skeleton.names, skeleton.roles) if name.startswith("limb02")]
+    assert [role.role for role in head] == ["neck"] * 4 + ["head"] and all(role.side is None for role in head)
 
 
 @pytest.mark.parametrize("name", ["octopus", "tree"])

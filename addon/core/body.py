@@ -39,8 +39,9 @@ class BodyTuning(TuningTable):
                                    "posed or hand-made figure is not symmetric within 1%)")
     plane_pairs: int = tuned(4, "a plane fitted to the skeleton pairs at least this many joints (two twin limbs of "
                                 "two joints each)")
-    midline: float = tuned(0.03, "a leaf chain all of whose joints lie this close to the mirror plane is on the "
-                                 "midline (two legs close together are not)")
+    midline: float = tuned(0.03, "a leaf chain all of whose joints lie this close to the mirror plane, or that has no "
+                                 "twin and lies this close on average, is on the midline (two legs close together "
+                                 "are not; a head whose tip turns aside is)")
     contact_height: float = tuned(0.08, "a leaf tip whose mesh comes this share of the mesh's height near its lowest "
                                         "point touches the ground")
     contact_apart: float = tuned(0.25, "leaf tips this close along the skeleton touch the ground as one limb (a "
@@ -491,6 +492,10 @@ def _midline_and_limbs(graph, plane, size, tuning):
         return (spine, *_side_branches(graph, spine, set(range(count)), [], plane, size, tuning))
     distance = plane.distance(graph.points)
     off_plane = np.abs(distance) > tuning.midline * size
+
+    def leaves(chain):  # its course leaves the plane, not only its tip (a head turned aside)
+        return np.abs(distance[chain[1:]]).mean() > tuning.midline * size
+
     active = set(range(count))
     stripped = []  # chains (base first) stripped from the midline, in order
     while True:
@@ -501,11 +506,13 @@ def _midline_and_limbs(graph, plane, size, tuning):
                 path = chains[0][::-1]
                 middle = path[int(np.argmin(np.abs(distance[path])))]
                 for part in (path[:path.index(middle) + 1][::-1], path[path.index(middle):]):
-                    if len(part) > 1 and off_plane[part[-1]]:
+                    if len(part) > 1 and off_plane[part[-1]] and leaves(part):
                         stripped.append(part)
                         active -= set(part[1:])
             break
-        off = [chain for chain in chains if off_plane[chain[1:]].any()]
+        tips = np.array([graph.points[chain[-1]] for chain in chains])
+        off = [chain for chain in chains if off_plane[chain[1:]].any() and (
+            leaves(chain) or _mirrored_tip(plane, graph.points[chain[-1]], tips, tuning.midline * size))]
         if not off:
             break
         for chain in off:
@@ -514,6 +521,12 @@ def _midline_and_limbs(graph, plane, size, tuning):
     spine = graph.longest_path(active) if len(active) > 1 else sorted(active)
     limbs = _grouped(graph, stripped, active, plane, size, tuning)
     return (spine, *_side_branches(graph, spine, active, limbs, plane, size, tuning))
+
+
+def _mirrored_tip(plane, tip, tips, tolerance):
+    """Whether another of the leaf chains' ``tips`` lies within ``tolerance`` of ``tip``'s mirror image (not on it)."""
+    gaps = np.linalg.norm(tips - plane.reflect(tip), axis=1)
+    return bool(((gaps <= tolerance) & (np.linalg.norm(tips - tip, axis=1) > tolerance)).any())
 
 
 def _side_branches(graph, spine, allowed, limbs, plane, size, tuning):
