@@ -6,8 +6,9 @@ the first (CMU's frame 1 is a reference pose, not motion: ``../shared/anim/READM
 
 - feet: in the frames where the mocap's foot is planted (``core.retarget.contact_frames``: its toe joint within 5%
   of its leg's length of its contact level and slower than half a leg length a second), the lowest point of the
-  character's posed foot (its vertices weighted more than half to Foot or ToeBase) lies within 0.02 of the model's
-  size of the ground (the mesh's lowest point at rest); measured: the largest distance and the share within;
+  character's posed foot (its vertices weighted more than half to Foot or ToeBase; for a leg without a foot bone, to
+  its Leg) lies within 0.02 of the model's size of the ground (the mesh's lowest point at rest); measured: the
+  largest distance and the share within;
 - knees bend forward and elbows backwards in every frame: a knee (elbow) bent more than ``BENT`` degrees whose
   joint lies behind (in front of) the line from the hip to the ankle (shoulder to wrist), seen along the
   character's posed facing (the Hips' rest forward turned with the Hips), is a wrong frame;
@@ -116,8 +117,9 @@ def _posed_measures(obj, armature, rig, motion, clip, outcome, contact_frames):
     groups = {group.index: group.name for group in obj.vertex_groups}
     weights = [{groups[e.group]: e.weight for e in v.groups if e.weight > 0 and groups[e.group] in rig.names}
                for v in obj.data.vertices]
-    feet = {side: np.array([i for i, w in enumerate(weights)
-                            if w.get(f"{side}Foot", 0) + w.get(f"{side}ToeBase", 0) > 0.5])
+    carriers = {side: (f"{side}Foot", f"{side}ToeBase") if f"{side}Foot" in rig.names else (f"{side}Leg",)
+                for side in ("Left", "Right")}
+    feet = {side: np.array([i for i, w in enumerate(weights) if sum(w.get(name, 0) for name in carriers[side]) > 0.5])
             for side in ("Left", "Right")}
     seams = _seam_pairs(rest, size)
     planted = {side: contact_frames(clip, motion.mapping, side) for side in ("Left", "Right")}

@@ -4,6 +4,8 @@ import pytest
 
 import rigger
 from characters import load_character
+from conftest import shared_path
+from rigdata import load_obj
 from rigger.core.game import game_skeleton
 from rigger.core.retarget import RetargetError, aliases, map_joints, normalised, sole_points
 from rigger.core.roles import named_joints
@@ -95,8 +97,9 @@ def test_cmu_and_mixamo_joints_map_onto_the_game_names():
     assert by_name["Hips"] == "Hips" and by_name["LeftUpLeg"] == "LeftUpLeg" and by_name["RightForeArm"] == \
         "RightForeArm"
     assert [by_name[name] for name in ("Spine", "Spine1", "Spine2")] == ["LowerBack", "Spine", "Spine1"]
-    assert by_name["Neck"] == "Neck" and by_name["Head"] == "Head" and by_name["LeftToeBase"] == "LeftToeBase"
-    assert "LHipJoint" in mapping.unused and not mapping.undriven
+    # CMU's neck has two joints; the game's one Neck takes the one the head sits on (its turn is the upper neck's)
+    assert by_name["Neck"] == "Neck1" and by_name["Head"] == "Head" and by_name["LeftToeBase"] == "LeftToeBase"
+    assert {"LHipJoint", "Neck"} <= set(mapping.unused) and not mapping.undriven
     mixamo = [f"mixamorig:{name}" for name in ("Hips", "Spine", "Spine1", "Spine2", "Neck", "Head", "LeftUpLeg",
                                                "LeftLeg", "LeftFoot", "RightUpLeg", "RightLeg", "RightFoot",
                                                "LeftArm", "LeftForeArm", "RightArm", "RightForeArm")]
@@ -127,3 +130,14 @@ def test_sole_points_hold_a_turned_foots_lowest_point():
         cross = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
         turn = np.eye(3) + np.sin(angle) * cross + (1 - np.cos(angle)) * cross @ cross
         assert (sole @ turn.T)[:, 2].min() == pytest.approx((foot @ turn.T)[:, 2].min(), abs=0.001)
+
+
+def test_a_second_arm_s_forearm_and_hand_take_its_number():
+    """rignet_17364 has two arms a side: each forearm and hand takes the number of the arm it hangs from."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_17364", "rignet_17364.obj"))
+    bones = game_skeleton(rigger.rig_mesh(vertices, triangles), vertices).skeleton
+    chained = [name for name in bones.names if name.split("_")[0].endswith(("ForeArm", "Hand"))]
+    assert {"LeftForeArm_2", "RightHand_2"} <= set(chained)
+    for name in chained:
+        parent = bones.names[bones.parents[bones.names.index(name)]]
+        assert parent.partition("_")[2] == name.partition("_")[2], (name, parent)

@@ -11,6 +11,7 @@ bpy = pytest.importorskip("bpy")
 
 import rigger  # noqa: E402
 from characters import load_character  # noqa: E402
+from conftest import shared_path  # noqa: E402
 from rigger.blender.game import INFLUENCES  # noqa: E402
 from rigger.blender.pipeline import rig_object, skin_meshes  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
@@ -202,3 +203,33 @@ def test_a_planted_foot_rests_its_sole_on_the_ground(scene, tmp_path, turn):
         posed = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.vertices
         lowest = min((obj.matrix_world @ posed[i].co)[2] for i in foot)
         assert abs(lowest - ground) < 0.001 * size, frame
+
+
+def test_a_character_whose_legs_end_without_feet_still_walks_on_its_soles(scene, tmp_path):
+    """homer's leg chains end above its shoes: no Foot bones. The motion drives the legs all the same, and the skin
+    each Leg carries keeps its lowest point on the ground while the character stands."""
+    def standing(frame):
+        values = np.zeros((19, 3))
+        values[14], values[17] = (-60, 0, 0), (60, 0, 0)
+        values[1], values[2] = (0, 0, -10 * (frame % 3)), (0, 0, 15 * (frame % 3))  # a knee bends a little
+        return (0.0, 16.0, 0.0), values
+
+    from rigger.blender.animate import animate
+    rigger.register()
+    bpy.ops.wm.obj_import(filepath=str(shared_path("models", "nogt", "homer.obj")))
+    obj = next(o for o in bpy.context.scene.objects if o.type == 'MESH')
+    result = rig_object(obj, "silhouette", target="game")
+    skin_meshes([obj], result.armature)
+    assert "LeftFoot" not in result.armature.data.bones and "LeftLeg" in result.armature.data.bones
+    animate(result.armature, short_bvh(tmp_path / "stand.bvh", motion=standing))
+    weights = vertex_weights(obj)
+    rest = np.array([obj.matrix_world @ v.co for v in obj.data.vertices])
+    size, ground = np.ptp(rest, axis=0).max(), rest[:, 2].min()
+    scene = bpy.context.scene
+    for side in ("Left", "Right"):
+        carried = [i for i, w in enumerate(weights) if w.get(f"{side}Leg", 0) > 0.5]
+        for frame in range(scene.frame_start + 1, scene.frame_end + 1):
+            scene.frame_set(frame)
+            posed = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.vertices
+            lowest = min((obj.matrix_world @ posed[i].co)[2] for i in carried)
+            assert abs(lowest - ground) < 0.005 * size, (side, frame)

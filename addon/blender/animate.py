@@ -109,9 +109,11 @@ def game_rig(armature):
 
 
 def _soles(armature, names, up):
-    """``Rig.soles``: per foot and toe bone, the sole points (``core.retarget.sole_points``) of the vertices that
-    bone carries more than ``CARRIED`` of, over the meshes ``armature`` deforms, in its space at rest."""
-    feet = [name for name in (f"{side}{word}" for side in ("Left", "Right") for word in ("Foot", "ToeBase"))
+    """``Rig.soles``: per foot and toe bone (a leg without a foot: its Leg bone), the sole points
+    (``core.retarget.sole_points``) of the vertices that bone carries more than ``CARRIED`` of, over the meshes
+    ``armature`` deforms, in its space at rest."""
+    feet = [name for side in ("Left", "Right")
+            for name in ((f"{side}Foot", f"{side}ToeBase") if f"{side}Foot" in names else (f"{side}Leg",))
             if name in names]
     carried = {name: [] for name in feet}
     to_armature = np.linalg.inv(np.array(armature.matrix_world))

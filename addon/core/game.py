@@ -20,7 +20,8 @@ The naming scheme (one for every body plan; the README says the same for users):
   ``LeftEar1``, ``LeftWing1``, ``Fin1``, ``Extra1`` (role ``other``) and ``Stem1`` (role ``root``: a stem under the
   hips).
 - A second chain of the same name (a second pair of arms) gets ``_2`` after the name (``LeftArm_2``), a third ``_3``:
-  chains are numbered from the highest start down.
+  a chain takes the number of the chain it hangs from (``LeftArm_2``'s forearm is ``LeftForeArm_2``), else chains
+  are numbered from the highest start down.
 
 Each bone with a Mixamo name begins at its role's named joint (``core.roles.named_joints``: a knee where the artists'
 rigs have it, which may lie inside a bone of Rigger's) when it lies near (``core.roles.within_reach``), the bones
@@ -337,7 +338,9 @@ class _Bones:
                       chain.edges[low:high], chain.nodes[low + 1:high + 1])
 
     def name_instances(self, up):
-        """``_2``, ``_3`` after the names that several chains share, the chains ordered from the highest start."""
+        """``_2``, ``_3`` after the names that several chains share: ordered by the number of the bone each hangs
+        from (a forearm on ``LeftArm_2`` is ``LeftForeArm_2``), then from the highest start. Names are numbered
+        from the hips outwards, so a chain's parent is numbered before it."""
         first_of_chain = {}
         for index, bone in enumerate(self.bones):
             first_of_chain.setdefault(bone["chain"], index)
@@ -345,8 +348,15 @@ class _Bones:
         for chain, index in first_of_chain.items():
             bone = self.bones[index]
             by_name.setdefault((bone["side"], bone["base"]), []).append(chain)
+
+        def parent_number(chain):
+            owner = self.node_owner.get(self.bones[first_of_chain[chain]]["start"])
+            suffix = "" if owner is None or self.bones[owner]["chain"] == chain else self.bones[owner]["suffix"]
+            return int(suffix[1:] or 1)
+
         for chains in by_name.values():
-            chains.sort(key=lambda chain: (-round(float(self.bones[first_of_chain[chain]]["head"] @ up), 9),
+            chains.sort(key=lambda chain: (parent_number(chain),
+                                           -round(float(self.bones[first_of_chain[chain]]["head"] @ up), 9),
                                            first_of_chain[chain]))
             for count, chain in enumerate(chains[1:], start=2):
                 for bone in self.bones:

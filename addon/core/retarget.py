@@ -3,7 +3,9 @@
 Mapping: each game bone (``rigger.core.game``'s names) takes the mocap joint whose name, with any namespace
 (``mixamorig:``) and separators dropped and case ignored, is one of its aliases (``aliases``: CMU's ``LowerBack``,
 Mixamo's, ``LeftUpLeg`` / ``LeftThigh`` / ``lThigh`` / ``thigh_l`` and so on). The spine's joints between the hips
-and the neck are shared out over Spine, Spine1 and Spine2 in order. The mapping fails, naming what is missing, when
+and the neck are shared out over Spine, Spine1 and Spine2 in order; of several neck joints, the Neck takes the one
+the head sits on (CMU's Neck1, whose segment tilts as the neck does where CMU's lower Neck leans back and Neck1
+leans forward again). The mapping fails, naming what is missing, when
 the hips, a leg (UpLeg, Leg, Foot) or an arm (Arm, ForeArm) of the game skeleton finds no joint.
 
 Retargeting, frame by frame (all in the game armature's space):
@@ -57,6 +59,8 @@ CONTACT_SPEED = 0.5  # ... and slower than this (leg lengths a second)
 MAX_SLOPE = 0.05  # the steepest capture floor taken (a rise over a run) ...
 SLOPE_RUN = 2.0  # ... fitted only when the feet go this many leg lengths
 SOLE_DIRECTIONS = 1024  # directions around the sphere whose extreme skin points can be a foot's lowest
+SOLE_ROUNDS = 8  # a leg without a foot bone reaches at most this many times for its sole ...
+SOLE_SETTLED = 0.002  # ... until the sole's height over its ankle changes less than this share of a thigh
 
 
 class RetargetError(ValueError):
@@ -97,13 +101,15 @@ def aliases(game_name):
 @dataclass
 class Mapping:
     """Which mocap joint drives each game bone (``driven``: game name -> joint index), the game bones no joint drives
-    (``undriven``), the joints that drive nothing (``unused``) and the toe joints by side (``toes``: "Left" ->
-    joint index), which tell where the feet touch the ground even when the character has no toe bones."""
+    (``undriven``), the joints that drive nothing (``unused``), the toe joints by side (``toes``: "Left" -> joint
+    index) and each side's hip, knee and ankle joints (``legs``: "Left" -> three joint indices), which tell where
+    the feet touch the ground even when the character has no toe or foot bones."""
 
     driven: dict
     undriven: list
     unused: list
     toes: dict = field(default_factory=dict)
+    legs: dict = field(default_factory=dict)
 
 
 def map_joints(joint_names, joint_parents, game_names):
@@ -131,18 +137,25 @@ def map_joints(joint_names, joint_parents, game_names):
         for k, name in enumerate(spine):
             if chain:
                 driven[name] = chain[min(len(chain) - 1, round(k * (len(chain) - 1) / max(len(spine) - 1, 1)))]
+    head = driven.get("Head")
+    above = joint_parents[head] if head is not None and "Neck" in driven else -1
+    if above >= 0 and "neck" in normal[above] and above not in driven.values():
+        driven["Neck"] = above  # one game neck: the mocap's neck joint next to the head (CMU's Neck1, not Neck)
     undriven = [name for name in game_names if name not in driven and name != "root"]
-    toes = {side: driven.get(f"{side}ToeBase", next((first[alias] for alias in aliases(f"{side}ToeBase")
-                                                     if alias in first), None)) for side in ("Left", "Right")}
-    toes = {side: joint for side, joint in toes.items() if joint is not None}
-    used = set(driven.values()) | set(toes.values())
+    def joint_for(name):  # the joint driving game bone ``name``, or the one that would if the game had it
+        return driven.get(name, next((first[alias] for alias in aliases(name) if alias in first), None))
+
+    toes = {side: joint for side in ("Left", "Right") if (joint := joint_for(f"{side}ToeBase")) is not None}
+    legs = {side: joints for side in ("Left", "Right")
+            if None not in (joints := tuple(joint_for(f"{side}{word}") for word in ("UpLeg", "Leg", "Foot")))}
+    used = set(driven.values()) | set(toes.values()) | {joint for joints in legs.values() for joint in joints}
     unused = [joint_names[j] for j in range(len(joint_names)) if j not in used]
     missing = [name for name in REQUIRED if name in game_names and name not in driven]
     if missing:
         raise RetargetError(f"the motion cannot drive the game bones {', '.join(missing)}: none of its joints has a "
                             f"name they take (the common mocap names: Hips, LeftUpLeg, LeftLeg, LeftFoot, LeftArm, "
                             f"LeftForeArm, ...); joints it could not place: {', '.join(unused) or 'none'}")
-    return Mapping(driven, undriven, unused, toes)
+    return Mapping(driven, undriven, unused, toes, legs)
 
 
 @dataclass
@@ -192,10 +205,12 @@ def retarget(clip, rig, mapping=None):
     """The :class:`Motion` of ``clip`` on ``rig`` (see the module docstring)."""
     mapping = mapping or map_joints(clip.names, clip.parents, rig.names)
     index = {name: k for k, name in enumerate(rig.names)}
-    legs = [f"{side}{word}" for side in ("Left", "Right") for word in ("UpLeg", "Leg", "Foot")]
+    legs = [f"{side}{word}" for side in ("Left", "Right") for word in ("UpLeg", "Leg")]
     if "Hips" not in mapping.driven or any(name not in mapping.driven for name in legs):
-        raise RetargetError(f"a motion needs the character's hips and both legs (UpLeg, Leg, Foot) to carry it; "
+        raise RetargetError(f"a motion needs the character's hips and both legs (UpLeg, Leg) to carry it; "
                             f"this rig lacks {', '.join(n for n in ['Hips', *legs] if n not in mapping.driven)}")
+    if len(mapping.legs) < 2:
+        raise RetargetError("the motion needs both legs down to the ankles (UpLeg, Leg, Foot) to carry a character")
     drive = {index[name]: joint for name, joint in mapping.driven.items()}
     up = _unit(rig.up)
     turn, forward = _alignment(clip, rig, mapping.driven, index, up)
@@ -224,9 +239,9 @@ def retarget(clip, rig, mapping=None):
             world[:, bone] = deltas[:, drive[bone]] @ swing.get(bone, np.eye(3))
         else:
             world[:, bone] = world[:, parent] if parent >= 0 else np.eye(3)
-    scale = _leg_scale(clip, rig, mapping.driven, index)
+    scale = _leg_scale(clip, rig, mapping, index)
     hips = index["Hips"]
-    hips_at = _hips_path(clip, rig, mapping.driven, index, turn, up, scale, ground, ankles)
+    hips_at = _hips_path(clip, rig, mapping, index, turn, up, scale, ground, ankles)
     _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale, ground, ankles)
     rotations = np.empty((frames, len(rig.names), 4))
     for bone in range(len(rig.names)):
@@ -308,7 +323,7 @@ def mocap_ground(clip, mapping):
     leg lengths of one place (feet apart on a level floor would tilt it)."""
     up = _unit(clip.up)
     leg = np.mean([length for side in ("Left", "Right")
-                   if (length := _leg_length(clip.rest, mapping.driven, side))])
+                   if (length := _leg_length(clip.rest, mapping, side))])
     joints = [_foot_joint(mapping, side) for side in ("Left", "Right")]
     paths = clip.poses[:, joints, :3, 3]
     speed = np.linalg.norm(np.gradient(paths, axis=0), axis=2) * clip.fps
@@ -421,12 +436,12 @@ def _between(a, b):
     return np.eye(3) + sine * cross + (1 - cosine) * cross @ cross
 
 
-def _leg_length(points, driven, side):
-    """Hip joint to knee to ankle, from (J, 4, 4) matrices ``points``."""
-    joints = [driven.get(f"{side}{word}") for word in ("UpLeg", "Leg", "Foot")]
-    if None in joints:
+def _leg_length(points, mapping, side):
+    """The mocap's hip joint to knee to ankle on ``side``, from (J, 4, 4) matrices ``points``."""
+    joints = mapping.legs.get(side)
+    if joints is None:
         return None
-    at = points[joints, :3, 3]
+    at = points[list(joints), :3, 3]
     return float(np.linalg.norm(np.diff(at, axis=0), axis=1).sum())
 
 
@@ -437,10 +452,10 @@ def _rig_leg_length(rig, index, side):
     return float(sum(np.linalg.norm(rig.tails[bone] - rig.rest[bone, :3, 3]) for bone in bones))
 
 
-def _leg_scale(clip, rig, driven, index):
+def _leg_scale(clip, rig, mapping, index):
     """The character's leg length over the mocap's (the mean of both sides that both have)."""
     ratios = [target / source for side in ("Left", "Right")
-              for source, target in [(_leg_length(clip.rest, driven, side), _rig_leg_length(rig, index, side))]
+              for source, target in [(_leg_length(clip.rest, mapping, side), _rig_leg_length(rig, index, side))]
               if source and target]
     if not ratios:
         raise RetargetError("the motion and the character need legs (UpLeg, Leg, Foot) to be scaled to each other")
@@ -449,7 +464,7 @@ def _leg_scale(clip, rig, driven, index):
 
 def _foot_joint(mapping, side):
     """The mocap's joint that touches the ground on ``side``: its toe joint, else its ankle."""
-    return mapping.toes.get(side, mapping.driven.get(f"{side}Foot"))
+    return mapping.toes.get(side, mapping.legs[side][2])
 
 
 def _planted(clip, mapping):
@@ -458,7 +473,7 @@ def _planted(clip, mapping):
     ground = mocap_ground(clip, mapping)
     heights = {}
     for side in ("Left", "Right"):
-        ankle, toe = mapping.driven[f"{side}Foot"], _foot_joint(mapping, side)
+        ankle, toe = mapping.legs[side][2], _foot_joint(mapping, side)
         flat = _flat_frames(clip, mapping, ground, side)
         if flat.any():
             heights[side] = tuple(float(np.median(ground.height(clip.poses[flat, joint, :3, 3])))
@@ -471,19 +486,19 @@ def _planted(clip, mapping):
 def _flat_frames(clip, mapping, ground, side):
     """Frames where the mocap's foot on ``side`` lies flat: planted (:func:`contact_frames`) with its ankle slower
     than ``CONTACT_SPEED`` leg lengths a second too (a heel rising to push off or falling onto the ground is not)."""
-    path = clip.poses[:, mapping.driven[f"{side}Foot"], :3, 3]
+    path = clip.poses[:, mapping.legs[side][2], :3, 3]
     speed = np.linalg.norm(np.gradient(path, axis=0), axis=1) * clip.fps
     return contact_frames(clip, mapping, side, ground) & (speed <= CONTACT_SPEED * ground.leg)
 
 
-def _hips_path(clip, rig, driven, index, turn, up, scale, ground, ankles):
+def _hips_path(clip, rig, mapping, index, turn, up, scale, ground, ankles):
     """Where the character's hips go (F, 3): see the module docstring."""
     source_up = _unit(clip.up)
-    hips = driven["Hips"]
+    hips = mapping.driven["Hips"]
     path = clip.poses[:, hips, :3, 3]
     rest = clip.rest[:, :3, 3]
-    standing = np.mean([(rest[hips] - rest[driven[f"{side}UpLeg"]]) @ source_up
-                        + _leg_length(clip.rest, driven, side) + ankles[side][0] for side in ("Left", "Right")])
+    standing = np.mean([(rest[hips] - rest[mapping.legs[side][0]]) @ source_up
+                        + _leg_length(clip.rest, mapping, side) + ankles[side][0] for side in ("Left", "Right")])
     across = (path - path[0]) @ turn.T
     across -= np.outer(across @ up, up)
     height = ground.height(path) - standing
@@ -492,58 +507,79 @@ def _hips_path(clip, rig, driven, index, turn, up, scale, ground, ankles):
 
 def _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale, ground, ankles):
     """Turn each leg's UpLeg and Leg (in ``world``, in place) so the ankle reaches its height (module docstring),
-    lowering the hips (``hips_at``, in place) in the frames a leg would not reach that far."""
+    lowering the hips (``hips_at``, in place) in the frames a leg would not reach that far. The ankle is the Foot's
+    head, else the Leg's tail; a sole the Leg carries turns as the leg reaches, so such legs reach again until their
+    soles settle (within ``SOLE_SETTLED`` of a thigh's length; at most ``SOLE_ROUNDS`` times)."""
     rest = rig.rest[:, :3, 3]
-    heads, _ = posed_points(rig, world, hips_at)
     legs = []
     for side in ("Left", "Right"):
-        names = [f"{side}{word}" for word in ("UpLeg", "Leg", "Foot")]
-        if any(name not in index for name in names):
+        thigh, shin, foot = (index.get(f"{side}{word}") for word in ("UpLeg", "Leg", "Foot"))
+        if thigh is None or shin is None:
             continue
-        thigh, shin, foot = (index[name] for name in names)
-        source_ankle = ground.height(clip.poses[:, mapping.driven[f"{side}Foot"], :3, 3])
+        source_ankle = ground.height(clip.poses[:, mapping.legs[side][2], :3, 3])
         source_toe = ground.height(clip.poses[:, _foot_joint(mapping, side), :3, 3])
         flat_ankle, flat_toe = ankles[side]
-        sole = np.maximum(np.minimum(source_ankle - flat_ankle, source_toe - flat_toe), 0.0)
-        lowest, rest_lowest = _lowest_sole(rig, index, side, world, heads)
-        height = rest[foot] @ up + scale * sole + rest_lowest - lowest
-        target = heads[:, foot] + np.outer(height - heads[:, foot] @ up, up)
-        reach = 0.999 * (np.linalg.norm(rest[shin] - rest[thigh]) + np.linalg.norm(rest[foot] - rest[shin]))
-        legs.append((thigh, shin, foot, target, reach))
-    drop = np.zeros(len(world))
-    for thigh, _, _, target, reach in legs:
-        offset = heads[:, thigh] - target
-        rise = offset @ up
-        across = np.linalg.norm(offset - np.outer(rise, up), axis=1)
-        drop = np.maximum(drop, rise - np.sqrt(np.maximum(reach ** 2 - across ** 2, 0.0)))
-    hips_at -= np.outer(drop, up)
-    heads, _ = posed_points(rig, world, hips_at)
-    for thigh, shin, foot, target, reach in legs:
-        upper, lower = np.linalg.norm(rest[shin] - rest[thigh]), np.linalg.norm(rest[foot] - rest[shin])
-        hip, knee, ankle = heads[:, thigh], heads[:, shin], heads[:, foot]
-        for frame in range(len(world)):  # knees bend forward: towards the thigh's turned rest forward
-            pole = knee[frame] + world[frame, thigh] @ forward
-            new_knee = _two_bone(hip[frame], pole, target[frame], upper, lower)
-            world[frame, thigh] = _between(knee[frame] - hip[frame], new_knee - hip[frame]) @ world[frame, thigh]
-            world[frame, shin] = _between(ankle[frame] - knee[frame], target[frame] - new_knee) @ world[frame, shin]
+        lift = scale * np.maximum(np.minimum(source_ankle - flat_ankle, source_toe - flat_toe), 0.0)
+        carriers = [bone for bone in (foot, index.get(f"{side}ToeBase")) if bone is not None] if foot is not None \
+            else [shin]
+        legs.append((thigh, shin, foot, lift, carriers))
+    settled = SOLE_SETTLED * min((np.linalg.norm(rest[shin] - rest[thigh]) for thigh, shin, _, _, _ in legs),
+                                 default=0.0)
+    heights = None
+    for _ in range(1 if all(foot is not None for _, _, foot, _, _ in legs) else SOLE_ROUNDS):
+        heads, _ = posed_points(rig, world, hips_at)
+        targets, previous, heights = [], heights, []
+        for thigh, shin, foot, lift, carriers in legs:
+            ankle, rest_ankle = _ankle(rig, world, heads, shin, foot)
+            lowest, rest_lowest = _lowest_sole(rig, carriers, world, heads, ankle, rest_ankle)
+            heights.append(rest_lowest - lowest)
+            height = rest_ankle @ up + lift + heights[-1]
+            targets.append(ankle + np.outer(height - ankle @ up, up))
+        if previous is not None and max(np.abs(a - b).max() for a, b in zip(heights, previous)) <= settled:
+            break
+        drop = np.zeros(len(world))
+        for (thigh, shin, foot, _, _), target in zip(legs, targets):
+            reach = 0.999 * (np.linalg.norm(rest[shin] - rest[thigh])
+                             + np.linalg.norm(_ankle(rig, world, heads, shin, foot)[1] - rest[shin]))
+            offset = heads[:, thigh] - target
+            rise = offset @ up
+            across = np.linalg.norm(offset - np.outer(rise, up), axis=1)
+            drop = np.maximum(drop, rise - np.sqrt(np.maximum(reach ** 2 - across ** 2, 0.0)))
+        hips_at -= np.outer(drop, up)
+        heads, _ = posed_points(rig, world, hips_at)
+        for (thigh, shin, foot, _, _), target in zip(legs, targets):
+            ankle, rest_ankle = _ankle(rig, world, heads, shin, foot)
+            upper, lower = np.linalg.norm(rest[shin] - rest[thigh]), np.linalg.norm(rest_ankle - rest[shin])
+            hip, knee = heads[:, thigh], heads[:, shin]
+            for frame in range(len(world)):  # knees bend forward: towards the thigh's turned rest forward
+                pole = knee[frame] + world[frame, thigh] @ forward
+                new_knee = _two_bone(hip[frame], pole, target[frame], upper, lower)
+                world[frame, thigh] = _between(knee[frame] - hip[frame], new_knee - hip[frame]) @ world[frame, thigh]
+                world[frame, shin] = _between(ankle[frame] - knee[frame], target[frame] - new_knee) @ world[frame, shin]
 
 
-def _lowest_sole(rig, index, side, world, heads):
-    """(per frame, at rest) the height of the lowest sole point of the foot on ``side`` over its ankle (the Foot's
-    head), posed with world rotations ``world`` and heads ``heads``. Sole points: the skin's (``Rig.soles``) on the
-    Foot and ToeBase; without a skin, the foot's far end (the ToeBase's tail, else the Foot's) and the heel, below
-    the ankle at the far end's rest height when that is lower."""
+def _ankle(rig, world, heads, shin, foot):
+    """(per frame, at rest) where the leg's ankle is: the Foot's head, else the Leg's (``shin``) tail."""
+    if foot is not None:
+        return heads[:, foot], rig.rest[foot, :3, 3]
+    return heads[:, shin] + world[:, shin] @ (rig.tails[shin] - rig.rest[shin, :3, 3]), rig.tails[shin]
+
+
+def _lowest_sole(rig, carriers, world, heads, ankle, rest_ankle):
+    """(per frame, at rest) the height over the ``ankle`` of the lowest sole point of the bones ``carriers`` (the
+    Foot and ToeBase, else the Leg), posed with world rotations ``world`` and heads ``heads``. Sole points: the
+    skin's (``Rig.soles``); without a skin, the carriers' far end and the heel below the ankle at the far end's rest
+    height when that is lower."""
     up, rest = rig.up, rig.rest[:, :3, 3]
-    foot = index[f"{side}Foot"]
-    carried = [(bone, rig.soles[bone]) for bone in (foot, index.get(f"{side}ToeBase")) if len(rig.soles.get(bone, ()))]
+    carried = [(bone, rig.soles[bone]) for bone in carriers if len(rig.soles.get(bone, ()))]
     if not carried:
-        end = index.get(f"{side}ToeBase", foot)
-        heel = rest[foot] + min((rig.tails[end] - rest[foot]) @ up, 0.0) * up
-        carried = [(foot, heel[None]), (end, rig.tails[end][None])]
-    lowest = np.min([np.min(((heads[:, bone] - heads[:, foot])[:, None, :]
+        end = carriers[-1]
+        heel = rest_ankle + min((rig.tails[end] - rest_ankle) @ up, 0.0) * up
+        carried = [(carriers[0], heel[None]), (end, rig.tails[end][None])]
+    lowest = np.min([np.min(((heads[:, bone] - ankle)[:, None, :]
                              + np.einsum("fij,nj->fni", world[:, bone], points - rest[bone])) @ up, axis=1)
                      for bone, points in carried], axis=0)
-    rest_lowest = min(float(np.min((points - rest[foot]) @ up)) for _, points in carried)
+    rest_lowest = min(float(np.min((points - rest_ankle) @ up)) for _, points in carried)
     return lowest, rest_lowest
 
 
