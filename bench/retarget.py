@@ -38,6 +38,7 @@ SAMPLES = ("humanoid", "humanoid_hips", "humanoid_a_pose", "humanoid_knees", "hu
            "four_arms")
 SHARED = ("gt/CesiumMan/CesiumMan.obj", "gt/magicarticulate_0a59c5ff/magicarticulate_0a59c5ff.obj",
           "gt/rignet_8210/rignet_8210.obj", "gt/rignet_17364/rignet_17364.obj", "nogt/homer.obj")
+Z_UP = ("CesiumMan", "magicarticulate_0a59c5ff")  # OBJ files written Z up (the others Y up, Blender's default)
 FEET = 0.02  # the target: planted feet within this share of the size of the ground
 BENT = 5.0  # degrees: a knee or elbow bent less is straight, whichever way
 SEAM = 1e-6  # vertices this close at rest (a share of the size) are one place
@@ -88,7 +89,8 @@ def measure(name, path, bvh):
     if path is None:
         obj = build_character(name)
     else:
-        bpy.ops.wm.obj_import(filepath=str(path))
+        axes = {"up_axis": "Z", "forward_axis": "Y"} if name in Z_UP else {}
+        bpy.ops.wm.obj_import(filepath=str(path), **axes)
         obj = max((o for o in bpy.context.scene.objects if o.type == 'MESH'), key=lambda o: len(o.data.vertices))
     result = rig_object(obj, "silhouette", target="game")
     plan = result.skeleton.body_plan
