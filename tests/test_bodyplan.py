@@ -107,6 +107,22 @@ def test_a_snake_is_a_head_a_spine_and_a_tail_from_its_thick_end(rigged):
         assert head_end[1] < skeleton.heads[tails].mean(axis=0)[1]  # the head lies at the -Y end
 
 
+@pytest.mark.parametrize("path", [("nogt", "homer.obj"),
+                                  ("gt", "magicarticulate_0a59c5ff", "magicarticulate_0a59c5ff.obj")])
+def test_twin_limbs_get_twin_roles_though_the_mesh_differs_a_little_side_to_side(path):
+    """homer's arms and magicarticulate's fingers: the thickness and reach measured on each side differ a little,
+    which cut homer's arms at different joints and named the two hands' fingers differently."""
+    vertices, triangles = load_obj(shared_path("models", *path))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    names = list(skeleton.names)
+    twins = [(k, names.index(name[:-2] + ".R")) for k, name in enumerate(names)
+             if name.endswith(".L") and name[:-2] + ".R" in names]
+    assert twins
+    for left, right in twins:
+        a, b = skeleton.roles[left], skeleton.roles[right]
+        assert (a.role, a.index, a.digit, a.side, b.side) == (b.role, b.index, b.digit, "L", "R"), names[left]
+
+
 def test_a_head_on_the_midline_whose_tip_turns_aside_is_a_neck_and_head_not_an_arm():
     """homer's head chain runs up the mirror plane and ends aside: it is the neck and head, and the arms are two."""
     vertices, triangles = load_obj(shared_path("models", "nogt", "homer.obj"))

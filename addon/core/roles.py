@@ -171,7 +171,37 @@ def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
             _arm(body, limb, points, tuning, lambda nodes, names: put(nodes, names, side))
         for nodes in _paths(limb):
             put(nodes, [part] * (len(nodes) - 1), side)
+    _mirror_twin_roles(roles, body, segment_bone)
     return _filled(roles, skeleton, kind)
+
+
+def _mirror_twin_roles(roles, body, segment_bone):
+    """Give each twin limb (the later of a pair) its twin's roles, bone for bone, keeping its side: measures of the
+    mesh (thickness, reach, a hand's fingers) differ a little from side to side, and twins must get twin roles. Only
+    where every bone of the limb lies on a bone of its twin's mirror image, both ends within a tenth of its shortest
+    bone."""
+    if body.plane is None:
+        return
+    points = body.graph.points
+    for k, limb in enumerate(body.limbs):
+        if not 0 <= limb.twin < k:
+            continue
+        twin = body.limbs[limb.twin]
+        mine = [(before, node) for node, before in limb.before.items() if (before, node) in segment_bone]
+        theirs = [(before, node) for node, before in twin.before.items() if (before, node) in segment_bone]
+        if not mine or len(mine) != len(theirs):
+            continue
+        ends = points[np.array(mine)]  # (S, 2, 3)
+        images = body.plane.reflect(points[np.array(theirs)])
+        gaps = np.linalg.norm(ends[:, None] - images[None], axis=3).max(axis=2)  # (S, S): the farther end apart
+        match = np.argmin(gaps, axis=1)
+        shortest = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1).min()
+        if len(set(match)) != len(mine) or gaps[np.arange(len(mine)), match].max() > 0.1 * shortest:
+            continue
+        for segment, m in zip(mine, match):
+            bone, source = segment_bone[segment], segment_bone[theirs[m]]
+            if roles[source] is not None and roles[bone] is not None:
+                roles[bone] = BoneRole(roles[source].role, roles[bone].side, roles[source].index, roles[source].digit)
 
 
 def _filled(roles, skeleton, kind):
