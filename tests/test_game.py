@@ -133,7 +133,8 @@ def test_sole_points_hold_a_turned_foots_lowest_point():
 
 
 def test_a_second_arm_s_forearm_and_hand_take_its_number():
-    """rignet_17364 has two arms a side: each forearm and hand takes the number of the arm it hangs from."""
+    """rignet_17364 has two arms a side: each forearm and hand takes the number of the arm it hangs from, and twins
+    hang from one bone or from twins."""
     vertices, triangles = load_obj(shared_path("models", "gt", "rignet_17364", "rignet_17364.obj"))
     bones = game_skeleton(rigger.rig_mesh(vertices, triangles), vertices).skeleton
     chained = [name for name in bones.names if name.split("_")[0].endswith(("ForeArm", "Hand"))]
@@ -141,3 +142,8 @@ def test_a_second_arm_s_forearm_and_hand_take_its_number():
     for name in chained:
         parent = bones.names[bones.parents[bones.names.index(name)]]
         assert parent.partition("_")[2] == name.partition("_")[2], (name, parent)
+    for left, name in enumerate(bones.names):  # twins hang from one bone or from twins (both shoulders: the Neck)
+        if name.startswith("Left"):
+            right = bones.names.index("Right" + name[4:])
+            a, b = (bones.names[bones.parents[k]] for k in (left, right))
+            assert a == b or (a.startswith("Left") and b == "Right" + a[4:]), (name, a, b)

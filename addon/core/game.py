@@ -28,14 +28,15 @@ rigs have it, which may lie inside a bone of Rigger's) when it lies near (``core
 ending there moved with it.
 
 The hierarchy is Rigger's read from the hips outwards (Rigger may root a quadruped at its neck): a chain hangs from the
-game bone that holds the joint it starts from. Twins (``Left…`` and ``Right…`` bones that mirror each other within
-``TWIN_TOLERANCE`` of the size) get exactly mirrored points across the mirror plane.
+game bone that holds the joint it starts from, else the nearest joint on its way to the hips. Twins hang from one bone
+or from twins, and twins (``Left…`` and ``Right…`` bones that mirror each other within ``TWIN_TOLERANCE`` of the size)
+get exactly mirrored points across the mirror plane.
 """
 from dataclasses import dataclass
 
 import numpy as np
 
-from .polyline import arc_lengths, arc_nearest, point_at
+from .polyline import arc_lengths, arc_nearest, point_at, segment_distances
 from .roles import BoneRole, named_joints, within_reach
 from .skeleton import Skeleton
 
@@ -89,6 +90,7 @@ def game_skeleton(skeleton, vertices):
     bones.name_instances(up)
     bones.at_named_joints(MERGE_TOLERANCE * size)
     names, heads, tails, parents, roles = bones.finished(arriving)
+    parents = _twin_parents(names, heads, tails, parents)
     heads, tails = _mirrored_twins(names, heads, tails, skeleton.stages.get("mirror_plane"), size)
     hips = heads[bones.hips] if bones.hips is not None else graph.points[start]
     ground = float((vertices @ up).min()) if len(vertices) else float(hips @ up)
@@ -391,17 +393,26 @@ class _Bones:
             if bone["start"] is None:  # the next bone of a chain
                 parents.append(index - 1)
                 continue
-            node = bone["start"]
-            edge = arriving.get(node)
-            owner = self.node_owner.get(node) if edge is not None else None
-            if owner is None and edge is not None:
-                owner = self.edge_owner.get(edge)
-            if owner is None or owner == index:
+            owner = self._holder(bone["start"], arriving, index)
+            if owner is None:
                 owner = hips if hips is not None and hips != index else -1
             parents.append(owner)
         heads = np.array([bone["head"] for bone in self.bones])
         tails = np.array([bone["tail"] for bone in self.bones])
         return names, heads, tails, parents, [bone["role"] for bone in self.bones]
+
+    def _holder(self, node, arriving, index):
+        """The game bone (not ``index``) holding ``node``, else the nearest joint on the way from it to the hips
+        (a finger whose fork no bone ends at hangs from the bone it forks off), else None."""
+        seen = set()
+        while node not in seen and arriving.get(node) is not None:
+            seen.add(node)
+            edge = arriving[node]
+            for owner in (self.node_owner.get(node), self.edge_owner.get(edge)):
+                if owner is not None and owner != index:
+                    return owner
+            node = self.graph.other_end(edge, node)
+        return None
 
     def owners(self, count):
         """The game bone owning each of Rigger's ``count`` bones."""
@@ -427,6 +438,41 @@ def _finger_spans(points, real):
         cuts.append(min(max(best, cuts[-1] + 1), count - (FINGER_BONES - len(cuts))))
     cuts.append(count)
     return list(zip(cuts, cuts[1:]))
+
+
+def _twin_parents(names, heads, tails, parents):
+    """``parents`` with each ``Left…``/``Right…`` pair hanging from one bone or from twin bones: where the two hang
+    from bones that are no twins (their joint held by two game bones), both take the left one's parent or both the
+    right one's (its twin for the other side), whichever lies nearer their heads, unless that makes a loop."""
+    parents = list(parents)
+    index = {name: k for k, name in enumerate(names)}
+
+    def mirrored(bone):  # the bone's twin, itself when unsided, None when it has no twin
+        name = names[bone]
+        for this, other in (("Left", "Right"), ("Right", "Left")):
+            if name.startswith(this):
+                return index.get(other + name[len(this):])
+        return bone
+
+    def ancestors(bone):
+        found = {bone}
+        while parents[bone] >= 0:
+            bone = parents[bone]
+            found.add(bone)
+        return found
+
+    for left, name in enumerate(names):
+        right = index.get("Right" + name[4:]) if name.startswith("Left") else None
+        if right is None or parents[left] < 0 or parents[right] < 0 or mirrored(parents[left]) == parents[right]:
+            continue
+        options = [(parents[left], mirrored(parents[left])), (mirrored(parents[right]), parents[right])]
+        options = [(a, b) for a, b in options if a is not None and b is not None
+                   and left not in ancestors(a) and right not in ancestors(b)]
+        if options:
+            gap = [float(segment_distances(heads[[left]], heads[[a]], tails[[a]])[0, 0]
+                         + segment_distances(heads[[right]], heads[[b]], tails[[b]])[0, 0]) for a, b in options]
+            parents[left], parents[right] = options[int(np.argmin(gap))]
+    return parents
 
 
 def _mirrored_twins(names, heads, tails, plane, size):
