@@ -147,3 +147,22 @@ def test_a_second_arm_s_forearm_and_hand_take_its_number():
             right = bones.names.index("Right" + name[4:])
             a, b = (bones.names[bones.parents[k]] for k in (left, right))
             assert a == b or (a.startswith("Left") and b == "Right" + a[4:]), (name, a, b)
+
+
+@pytest.mark.parametrize("path", [("nogt", "homer.obj"),
+                                  ("gt", "magicarticulate_0a59c5ff", "magicarticulate_0a59c5ff.obj")])
+def test_a_humanoid_game_rig_has_hands_and_feet_though_its_limbs_end_without(path):
+    """homer's legs end above its shoes and magicarticulate's fingers fork at the wrist: no Rigger bone is a foot or a
+    hand. Game engines' humanoids need both: each forearm gets a Hand from its end, each shin a Foot, fingers on the
+    Hand."""
+    vertices, triangles = load_obj(shared_path("models", *path))
+    bones = game_skeleton(rigger.rig_mesh(vertices, triangles), vertices).skeleton
+    names = list(bones.names)
+    for side in ("Left", "Right"):
+        for limb, end in (("ForeArm", "Hand"), ("Leg", "Foot")):
+            limb_at, end_at = names.index(side + limb), names.index(side + end)
+            assert bones.parents[end_at] == limb_at
+            assert bones.heads[end_at] == pytest.approx(bones.tails[limb_at])
+            assert np.linalg.norm(bones.tails[end_at] - bones.heads[end_at]) > 0
+        fingers = [k for k, name in enumerate(names) if name.startswith(f"{side}Hand") and name[-1] == "1"]
+        assert all(names[bones.parents[k]] == f"{side}Hand" for k in fingers)

@@ -14,6 +14,7 @@ The naming scheme (one for every body plan; the README says the same for users):
   ``UpLeg`` (thigh), ``Leg`` (shin), ``Foot``, ``ToeBase``; sided ones get ``Left`` / ``Right`` before the word
   (``LeftForeArm``). A quadruped's front legs have the roles, so the names, of arms and its hind legs those of legs.
   A leg's ``hips`` bones (from the body's middle to the hip joint) are the pelvis: they merge into ``Hips``.
+- A humanoid's forearm (shin) that ends without a hand (foot) gets one: ``_completed_ends``.
 - Fingers: ``LeftHandThumb1``..``3``, ``Index``, ``Middle``, ``Ring``, ``Pinky``, at most three bones each (Rigger's
   bones merged at the joints nearest the thirds); a finger without a digit is ``LeftHandFinger1``..``3``.
 - Parts without a Mixamo name keep one bone per Rigger bone, numbered from 1 along the chain: ``Tail1``, ``Tail2``,
@@ -37,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .polyline import arc_lengths, arc_nearest, point_at, segment_distances
-from .roles import BoneRole, named_joints, within_reach
+from .roles import BoneRole, landmarks, named_joints, within_reach
 from .skeleton import Skeleton
 
 ROOT = "root"
@@ -55,6 +56,9 @@ DIGIT_WORDS = {"thumb": "Thumb", "index": "Index", "middle": "Middle", "ring": "
 FINGER_BONES = 3
 TRUNK = ("hips", "spine", "chest")
 SIDE_WORDS = {"L": "Left", "R": "Right", None: ""}
+ENDS = (("ForeArm", "Hand", ("hand",), ("hand_tip",)), ("Leg", "Foot", ("foot",), ("toe", "toe_tip")))  # a limb bone,
+# the end bone it may lack, the named joint that end bone begins at, where it ends (the first found)
+END_SHARE = 0.5  # an end bone with nowhere to end goes on along its limb bone for this share of that bone's length
 
 
 @dataclass(frozen=True)
@@ -90,6 +94,9 @@ def game_skeleton(skeleton, vertices):
     bones.name_instances(up)
     bones.at_named_joints(MERGE_TOLERANCE * size)
     names, heads, tails, parents, roles = bones.finished(arriving)
+    if skeleton.body_plan.kind == "humanoid":
+        names, heads, tails, parents, roles = _completed_ends(names, heads, tails, parents, roles,
+                                                              {**joints, **landmarks(skeleton)})
     parents = _twin_parents(names, heads, tails, parents)
     heads, tails = _mirrored_twins(names, heads, tails, skeleton.stages.get("mirror_plane"), size)
     hips = heads[bones.hips] if bones.hips is not None else graph.points[start]
@@ -438,6 +445,52 @@ def _finger_spans(points, real):
         cuts.append(min(max(best, cuts[-1] + 1), count - (FINGER_BONES - len(cuts))))
     cuts.append(count)
     return list(zip(cuts, cuts[1:]))
+
+
+def _completed_ends(names, heads, tails, parents, roles, places):
+    """A humanoid's ``Hand`` on every forearm and ``Foot`` on every shin (``Leg``) that ends without one (fingers
+    forking at the wrist, a leg ending at the ground), as ``ENDS`` says: from the named wrist (ankle) in ``places``
+    when it lies along the bone, which then ends there, else from the bone's end; to the hand's reach (the ball of
+    the foot, else its toes' tip) when that lies beyond, else on along the bone. The bone's fingers (toes) hang
+    from it. Game engines' humanoids and mocap need both."""
+    names, heads, tails, parents, roles = list(names), heads.copy(), tails.copy(), list(parents), list(roles)
+    for limb in range(len(names)):
+        side, _, suffix = names[limb].partition("_")
+        for word, end_word, starts, ends in ENDS:
+            if not side.endswith(word) or side[:-len(word)] not in ("Left", "Right"):
+                continue
+            end_name = f"{side[:-len(word)]}{end_word}{'_' + suffix if suffix else ''}"
+            if end_name in names:
+                continue
+            letter = side[0]
+            head, tail = heads[limb], tails[limb]
+            along = tail - head
+            bone_length = float(np.linalg.norm(along))
+            start = tail
+            for key in starts:
+                point = places.get((key, letter, None))
+                if point is not None:
+                    share = float((point - head) @ along) / max(bone_length ** 2, 1e-300)
+                    if 0.5 < share < 1.0 and segment_distances(point[None], head[None], tail[None])[0, 0] \
+                            <= 0.25 * bone_length:
+                        start = np.asarray(point, dtype=np.float64)
+            finish = start + END_SHARE * along
+            for key in ends:
+                point = places.get((key, letter, None))
+                if point is not None and np.linalg.norm(point - start) > 0.1 * bone_length:
+                    finish = np.asarray(point, dtype=np.float64)
+                    break
+            tails[limb] = start
+            names.append(end_name)
+            heads, tails = np.vstack([heads, start]), np.vstack([tails, finish])
+            end = len(names) - 1
+            parents.append(limb)
+            roles.append(BoneRole(end_word.lower(), letter))
+            carried = "finger" if end_word == "Hand" else "toe"
+            for child in range(end):
+                if parents[child] == limb and roles[child].role == carried:
+                    parents[child] = end
+    return names, heads, tails, parents, roles
 
 
 def _twin_parents(names, heads, tails, parents):
