@@ -677,6 +677,17 @@ def test_twin_legs_leave_the_middle_together_where_the_triangulation_split_the_j
             np.testing.assert_allclose(tails[twin], tails[names.index(name)] * [-1, 1, 1], atol=1e-9)
 
 
+def test_a_round_head_on_the_shoulders_keeps_its_bone_when_its_outline_s_corners_are_pruned():
+    """rignet_8333's round head sits on its shoulders. Pruning its outline's corner branches left the chain running on
+    from the head to one corner, and then the whole chain went as a bump: no bone reached the head. The corner goes,
+    the head stays."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_8333", "rignet_8333.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    top = vertices[:, 1].max()  # Y up; the head is the top fifth of the figure
+    assert max(skeleton.tails[:, 1].max(), skeleton.heads[:, 1].max()) > top - 0.2 * np.ptp(vertices[:, 1])
+    assert {"neck", "head"} <= {role.role for role in skeleton.roles}
+
+
 def test_on_a_four_armed_figure_each_arm_keeps_its_hand_and_the_head_hangs_from_the_spine():
     """rignet_17364's two arms on each side lie one behind the other seen from the front: each keeps its own depth
     into its own hand (no bone crosses from one arm's depth to the other's), and the head hangs from the spine."""

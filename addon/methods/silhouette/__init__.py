@@ -96,7 +96,8 @@ class SilhouetteMethod(RigMethod):
         clock.lap("silhouette_cdt_axis")
 
         rules = Rules.of(mesh, params, tuning)
-        graph, alive, merged, kept = pruned_tree(primary.axis_graph, params.merge, rules.pruning(sil, params.prune))
+        pruning = rules.pruning(sil, params.prune, heads=True)
+        graph, alive, merged, kept = pruned_tree(primary.axis_graph, params.merge, pruning)
         clock.lap("merge_prune")
 
         side, other_views = None, []  # side: the side view's axis, for depth where the primary view is occluded

@@ -40,13 +40,13 @@ class Rules:
         """How chains are cut into bones."""
         return Cutting(np.radians(self.params.bone_angle), self.unit, self.params.max_chain_bones, self.tuning)
 
-    def pruning(self, sil, prune):
+    def pruning(self, sil, prune, heads=False):
         """Spur pruning in view ``sil`` at ``prune`` times a branch's width: the primary view's is the ``prune``
-        parameter, the perpendicular views' ``hidden_prune`` of it."""
+        parameter and keeps ``heads`` (``Pruning.heads``), the perpendicular views' ``hidden_prune`` of it."""
         outline = np.concatenate(sil.loops)
         ground = (outline.min(axis=0), outline.max(axis=0), self.tuning.ground_reach * self.size)
         return Pruning(prune, min_reach=self.params.min_branch * self.unit,
                        max_reach=self.tuning.keep_reach * self.size,
                        pair_prune=self.tuning.pair_prune * self.params.prune,
                        mirror=reflection_in_view(sil, self.plane, self.tuning), local_pairs=self.plane is None,
-                       ground=ground, tuning=self.tuning)
+                       ground=ground, heads=heads, tuning=self.tuning)

@@ -69,6 +69,8 @@ class Pruning:
         local_pairs: without a mirror plane, pair spurs alike in size (``_local_pairs``).
         ground: (low (2,), high (2,), tolerance) of the view's outline: a stubby spur standing on a side of it that a
             kept leaf stands on too stays (``_standing``); None: no such rule.
+        heads: a spur running on past a round part (``_round_part_on``) goes only beyond it (the primary view's
+            heads; the hidden views look for limbs, and a remnant there is no limb).
         tuning: the method's tuning (``round_tip``, ``local_pair``, ``width_nodes``).
     """
 
@@ -79,6 +81,7 @@ class Pruning:
     mirror: object = None
     local_pairs: bool = False
     ground: tuple = None
+    heads: bool = False
     tuning: Tuning = Tuning()
 
 
@@ -148,7 +151,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
         # chain -> (base, tip) of the spurs; chain -> (base, nodes from base to tip, reach beyond the base, width) of
         # those that may pair; (chain, base, its nodes outside the base's disc) of the kept leaves and those that may
         # pair
-        spurs, pairable, leaves = {}, {}, []
+        spurs, pairable, leaves, heads = {}, {}, [], {}  # heads: spur -> its nodes up to a round part on it
         for i, chain in enumerate(chains):
             for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
                 if degree[tip] == 1 and degree[base] >= 3:
@@ -162,6 +165,10 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                     bump = beyond <= prune * width and not (  # the round-part test only where it can matter
                         blobs is not None and _round_part(apart, radius, blobs, base, tip, tuning.round_tip))
                     spur = beyond < max_reach and (beyond <= min_reach or bump)
+                    part = _round_part_on(ordered, points, radius, blobs, min_reach, tuning.round_tip) \
+                        if spur and pruning.heads and blobs is not None else None
+                    if part is not None:
+                        heads[i] = ordered[:part + 1].tolist()
                     may_pair = spur and pair_prune is not None and beyond > max(min_reach, pair_prune * width)
                     if spur:
                         spurs[i] = base, tip
@@ -174,7 +181,9 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
             spurs = _unmirrored(spurs, pairable, leaves, points, radius, pruning.mirror)
         if spurs and pruning.ground is not None:
             spurs = _standing(spurs, pairable, leaves, chains, points, radius, pruning.ground, stood)
-        if not spurs:
+        trims = {i: heads[i] for i in spurs if i in heads}  # a head the spur runs on past: only the rest goes
+        spurs = {i: ends for i, ends in spurs.items() if i not in trims}
+        if not spurs and not trims:
             links = links_of(chains)
             if not dropped:
                 return links
@@ -186,7 +195,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                 stood[base] = stood.get(base, set()) | stood.get(tip, set()) | _sides(tip, points, radius,
                                                                                         pruning.ground)
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
-        kept = [c for i, c in enumerate(chains) if i not in spurs]
+        kept = [trims.get(i, c) for i, c in enumerate(chains) if i not in spurs]
         if not kept:
             return np.zeros((0, 2), dtype=np.int64)
         _, chains = chains_of(sorted({n for c in kept for n in c}), links_of(kept))
@@ -231,6 +240,21 @@ def _round_part(apart, radius, blobs, base, tip, round_tip):
     """Whether leaf node ``tip``, ``apart`` from ``base``, is a blob at least ``round_tip`` as wide as the base (a
     part of its own), lying off the disc of ``base``."""
     return bool(blobs[tip]) and radius[tip] >= round_tip * radius[base] and apart > radius[base]
+
+
+def _round_part_on(ordered, points, radius, blobs, min_reach, round_tip):
+    """The index along a leaf chain (``ordered``: base first) of the farthest node before its tip that is a round
+    part (:func:`_round_part`) reaching more than ``min_reach`` beyond the base's disc, the chain running on from it
+    to its tip no farther than its radius and a half, else None: a head whose other branches went, leaving the chain
+    running on from it to a corner of its outline."""
+    base = ordered[0]
+    for k in range(len(ordered) - 2, 0, -1):
+        node = ordered[k]
+        apart = float(np.linalg.norm(points[node] - points[base]))
+        if (_round_part(apart, radius, blobs, base, node, round_tip) and apart + radius[node] - radius[base] > min_reach
+                and length(points[ordered[k:]]) <= 1.5 * radius[node]):
+            return k
+    return None
 
 
 def _unmirrored(spurs, pairable, leaves, points, radius, mirror):
