@@ -111,6 +111,8 @@ def measure(name, path, bvh):
 def _posed_measures(obj, armature, rig, motion, clip, outcome, contact_frames):
     import bpy
 
+    from rigger.core.retarget import sole_bones
+
     scene = bpy.context.scene
     rest = _world_vertices(obj, bpy.context.evaluated_depsgraph_get(), rest=True)
     size = float(np.ptp(rest, axis=0).max())
@@ -119,8 +121,7 @@ def _posed_measures(obj, armature, rig, motion, clip, outcome, contact_frames):
     groups = {group.index: group.name for group in obj.vertex_groups}
     weights = [{groups[e.group]: e.weight for e in v.groups if e.weight > 0 and groups[e.group] in rig.names}
                for v in obj.data.vertices]
-    carriers = {side: (f"{side}Foot", f"{side}ToeBase") if f"{side}Foot" in rig.names else (f"{side}Leg",)
-                for side in ("Left", "Right")}
+    carriers = {side: sole_bones(rig.names, side) for side in ("Left", "Right")}
     feet = {side: np.array([i for i, w in enumerate(weights) if sum(w.get(name, 0) for name in carriers[side]) > 0.5])
             for side in ("Left", "Right")}
     seams = _seam_pairs(rest, size)

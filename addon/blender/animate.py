@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 
 from ..core.game import ROOT
-from ..core.retarget import Clip, Rig, retarget, sole_points
+from ..core.retarget import Clip, Rig, retarget, sole_bones, sole_points
 from .skinning import weight_entries
 
 CARRIED = 0.5  # a skin vertex rides rigidly enough on the bone that carries more than this share of it
@@ -109,12 +109,10 @@ def game_rig(armature):
 
 
 def _soles(armature, names, up):
-    """``Rig.soles``: per foot and toe bone (a leg without a foot: its Leg bone), the sole points
+    """``Rig.soles``: per bone a leg stands on (``core.retarget.sole_bones``), the sole points
     (``core.retarget.sole_points``) of the vertices that bone carries more than ``CARRIED`` of, over the meshes
     ``armature`` deforms, in its space at rest."""
-    feet = [name for side in ("Left", "Right")
-            for name in ((f"{side}Foot", f"{side}ToeBase") if f"{side}Foot" in names else (f"{side}Leg",))
-            if name in names]
+    feet = [name for side in ("Left", "Right") for name in sole_bones(names, side)]
     carried = {name: [] for name in feet}
     to_armature = np.linalg.inv(np.array(armature.matrix_world))
     for obj in bpy.data.objects:

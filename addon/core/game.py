@@ -455,14 +455,14 @@ def _completed_ends(names, heads, tails, parents, roles, places):
     from it. Game engines' humanoids and mocap need both."""
     names, heads, tails, parents, roles = list(names), heads.copy(), tails.copy(), list(parents), list(roles)
     for limb in range(len(names)):
-        side, _, suffix = names[limb].partition("_")
+        stem, _, suffix = names[limb].partition("_")  # LeftForeArm, 2
         for word, end_word, starts, ends in ENDS:
-            if not side.endswith(word) or side[:-len(word)] not in ("Left", "Right"):
+            if not stem.endswith(word) or stem[:-len(word)] not in ("Left", "Right"):
                 continue
-            end_name = f"{side[:-len(word)]}{end_word}{'_' + suffix if suffix else ''}"
+            end_name = f"{stem[:-len(word)]}{end_word}{'_' + suffix if suffix else ''}"
             if end_name in names:
                 continue
-            letter = side[0]
+            letter = stem[0]
             head, tail = heads[limb], tails[limb]
             along = tail - head
             bone_length = float(np.linalg.norm(along))
@@ -498,14 +498,11 @@ def _twin_parents(names, heads, tails, parents):
     from bones that are no twins (their joint held by two game bones), both take the left one's parent or both the
     right one's (its twin for the other side), whichever lies nearer their heads, unless that makes a loop."""
     parents = list(parents)
-    index = {name: k for k, name in enumerate(names)}
+    pairs = _twin_pairs(names)
+    twin_of = {**dict(pairs), **{right: left for left, right in pairs}}
 
     def mirrored(bone):  # the bone's twin, itself when unsided, None when it has no twin
-        name = names[bone]
-        for this, other in (("Left", "Right"), ("Right", "Left")):
-            if name.startswith(this):
-                return index.get(other + name[len(this):])
-        return bone
+        return twin_of.get(bone, None if names[bone].startswith(("Left", "Right")) else bone)
 
     def ancestors(bone):
         found = {bone}
@@ -514,9 +511,8 @@ def _twin_parents(names, heads, tails, parents):
             found.add(bone)
         return found
 
-    for left, name in enumerate(names):
-        right = index.get("Right" + name[4:]) if name.startswith("Left") else None
-        if right is None or parents[left] < 0 or parents[right] < 0 or mirrored(parents[left]) == parents[right]:
+    for left, right in pairs:
+        if parents[left] < 0 or parents[right] < 0 or mirrored(parents[left]) == parents[right]:
             continue
         options = [(parents[left], mirrored(parents[left])), (mirrored(parents[right]), parents[right])]
         options = [(a, b) for a, b in options if a is not None and b is not None
@@ -528,12 +524,18 @@ def _twin_parents(names, heads, tails, parents):
     return parents
 
 
+def _twin_pairs(names):
+    """(left, right) indices of every ``Left…`` bone in ``names`` and its ``Right…`` twin."""
+    index = {name: k for k, name in enumerate(names)}
+    return [(k, index["Right" + name[4:]]) for k, name in enumerate(names)
+            if name.startswith("Left") and "Right" + name[4:] in index]
+
+
 def _mirrored_twins(names, heads, tails, plane, size):
     """Heads and tails with every ``Left…``/``Right…`` pair that mirrors within ``TWIN_TOLERANCE`` of ``size`` made
     exact mirror images (their mean across the plane): the method's mirror plane, else the plane fitted to the
     pairs."""
-    pairs = [(names.index(name), names.index("Right" + name[4:])) for name in names
-             if name.startswith("Left") and "Right" + name[4:] in names]
+    pairs = _twin_pairs(names)
     if not pairs:
         return heads, tails
     left = np.concatenate([heads[[a for a, _ in pairs]], tails[[a for a, _ in pairs]]])

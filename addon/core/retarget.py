@@ -272,6 +272,13 @@ def posed_points(rig, world, hips_at):
     return posed_heads, posed_tails
 
 
+def sole_bones(names, side):
+    """The names of the bones whose skin a leg on ``side`` ("Left"/"Right") stands on, of those in ``names``: its
+    Foot and ToeBase, else (a leg without a foot bone) its Leg."""
+    carriers = (f"{side}Foot", f"{side}ToeBase") if f"{side}Foot" in names else (f"{side}Leg",)
+    return tuple(name for name in carriers if name in names)
+
+
 def sole_points(points, up):
     """The points of ``points`` (N, 3), the skin one foot or toe bone carries, that can be its lowest however it
     turns up to a right angle from rest: the extremes along ``SOLE_DIRECTIONS`` directions spread over the lower
@@ -520,17 +527,16 @@ def _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale,
         source_toe = ground.height(clip.poses[:, _foot_joint(mapping, side), :3, 3])
         flat_ankle, flat_toe = ankles[side]
         lift = scale * np.maximum(np.minimum(source_ankle - flat_ankle, source_toe - flat_toe), 0.0)
-        carriers = [bone for bone in (foot, index.get(f"{side}ToeBase")) if bone is not None] if foot is not None \
-            else [shin]
-        legs.append((thigh, shin, foot, lift, carriers))
-    settled = SOLE_SETTLED * min((np.linalg.norm(rest[shin] - rest[thigh]) for thigh, shin, _, _, _ in legs),
-                                 default=0.0)
+        carriers = [index[name] for name in sole_bones(index, side)]
+        rest_ankle = rig.rest[foot, :3, 3] if foot is not None else rig.tails[shin]
+        legs.append((thigh, shin, foot, lift, carriers, rest_ankle))
+    settled = SOLE_SETTLED * min((np.linalg.norm(rest[shin] - rest[thigh]) for thigh, shin, *_ in legs), default=0.0)
     heights = None
-    for _ in range(1 if all(foot is not None for _, _, foot, _, _ in legs) else SOLE_ROUNDS):
+    for _ in range(1 if all(foot is not None for _, _, foot, *_ in legs) else SOLE_ROUNDS):
         heads, _ = posed_points(rig, world, hips_at)
         targets, previous, heights = [], heights, []
-        for thigh, shin, foot, lift, carriers in legs:
-            ankle, rest_ankle = _ankle(rig, world, heads, shin, foot)
+        for thigh, shin, foot, lift, carriers, rest_ankle in legs:
+            ankle = _ankle(rig, world, heads, shin, foot)
             lowest, rest_lowest = _lowest_sole(rig, carriers, world, heads, ankle, rest_ankle)
             heights.append(rest_lowest - lowest)
             height = rest_ankle @ up + lift + heights[-1]
@@ -538,17 +544,16 @@ def _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale,
         if previous is not None and max(np.abs(a - b).max() for a, b in zip(heights, previous)) <= settled:
             break
         drop = np.zeros(len(world))
-        for (thigh, shin, foot, _, _), target in zip(legs, targets):
-            reach = 0.999 * (np.linalg.norm(rest[shin] - rest[thigh])
-                             + np.linalg.norm(_ankle(rig, world, heads, shin, foot)[1] - rest[shin]))
+        for (thigh, shin, _, _, _, rest_ankle), target in zip(legs, targets):
+            reach = 0.999 * (np.linalg.norm(rest[shin] - rest[thigh]) + np.linalg.norm(rest_ankle - rest[shin]))
             offset = heads[:, thigh] - target
             rise = offset @ up
             across = np.linalg.norm(offset - np.outer(rise, up), axis=1)
             drop = np.maximum(drop, rise - np.sqrt(np.maximum(reach ** 2 - across ** 2, 0.0)))
         hips_at -= np.outer(drop, up)
         heads, _ = posed_points(rig, world, hips_at)
-        for (thigh, shin, foot, _, _), target in zip(legs, targets):
-            ankle, rest_ankle = _ankle(rig, world, heads, shin, foot)
+        for (thigh, shin, foot, _, _, rest_ankle), target in zip(legs, targets):
+            ankle = _ankle(rig, world, heads, shin, foot)
             upper, lower = np.linalg.norm(rest[shin] - rest[thigh]), np.linalg.norm(rest_ankle - rest[shin])
             hip, knee = heads[:, thigh], heads[:, shin]
             for frame in range(len(world)):  # knees bend forward: towards the thigh's turned rest forward
@@ -559,10 +564,10 @@ def _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale,
 
 
 def _ankle(rig, world, heads, shin, foot):
-    """(per frame, at rest) where the leg's ankle is: the Foot's head, else the Leg's (``shin``) tail."""
+    """Where the leg's ankle is in each frame: the Foot's head, else the Leg's (``shin``) tail."""
     if foot is not None:
-        return heads[:, foot], rig.rest[foot, :3, 3]
-    return heads[:, shin] + world[:, shin] @ (rig.tails[shin] - rig.rest[shin, :3, 3]), rig.tails[shin]
+        return heads[:, foot]
+    return heads[:, shin] + world[:, shin] @ (rig.tails[shin] - rig.rest[shin, :3, 3])
 
 
 def _lowest_sole(rig, carriers, world, heads, ankle, rest_ankle):
