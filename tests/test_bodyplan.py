@@ -132,6 +132,18 @@ def test_a_head_on_the_midline_whose_tip_turns_aside_is_a_neck_and_head_not_an_a
     assert [role.role for role in head] == ["neck"] * 4 + ["head"] and all(role.side is None for role in head)
 
 
+def test_arms_reaching_out_from_where_the_legs_hang_are_arms():
+    """woody, a gingerbread figure, has one junction for a torso: its arms leave it where its legs do. Arms that reach
+    out level, not down to the ground, are arms there too."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "woody.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert skeleton.body_plan.kind == "humanoid" and skeleton.body_plan.parts == {"legs": 2, "arms": 2}
+    for side in "LR":
+        arm = [role.role for role in skeleton.roles if role.side == side and role.role not in ("hips", "thigh", "shin",
+                                                                                             "foot", "toe")]
+        assert {"shoulder", "upper_arm", "forearm", "hand"} <= set(arm), arm
+
+
 @pytest.mark.parametrize("name", ["octopus", "tree"])
 def test_an_unknown_plan_keeps_plain_roles_and_says_why(rigged, name):
     for plan, roles in (truth(name), (rigged[name].body_plan, rigged[name].roles)):

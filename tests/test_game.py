@@ -8,7 +8,7 @@ from conftest import shared_path
 from rigdata import load_obj
 from rigger.core.game import game_skeleton
 from rigger.core.retarget import RetargetError, aliases, map_joints, normalised, sole_points
-from rigger.core.roles import named_joints
+from rigger.core.roles import landmarks, named_joints
 from rigger.core.targets import choose_target
 
 MIXAMO = {"Hips", "Spine", "Spine1", "Spine2", "Neck", "Head"} | {
@@ -166,3 +166,17 @@ def test_a_humanoid_game_rig_has_hands_and_feet_though_its_limbs_end_without(pat
             assert np.linalg.norm(bones.tails[end_at] - bones.heads[end_at]) > 0
         fingers = [k for k, name in enumerate(names) if name.startswith(f"{side}Hand") and name[-1] == "1"]
         assert all(names[bones.parents[k]] == f"{side}Hand" for k in fingers)
+
+
+def test_a_neck_running_into_a_round_head_gets_a_head():
+    """woody's neck bone runs into the middle of its round head and no bone goes on: the game rig's Head hangs from the
+    Neck's end and reaches the top of the head, as Mixamo's do."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "woody.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    names = list(bones.names)
+    neck, head = names.index("Neck"), names.index("Head")
+    assert bones.parents[head] == neck and bones.roles[head].role == "head"
+    assert bones.heads[head] == pytest.approx(bones.tails[neck])
+    assert bones.tails[head] == pytest.approx(landmarks(skeleton)[("head_top", None, None)])
+    assert {"LeftArm", "LeftForeArm", "LeftHand", "RightArm", "RightForeArm", "RightHand"} <= set(names)

@@ -10,7 +10,8 @@ The rules, in order (``Body`` gives the up axis, the mirror plane, the spine and
 - legs in two rows, front and back (``front_back`` apart), make a quadruped;
 - two legs in one row, hanging from ``biped_lift`` or higher, make a biped: a humanoid when its
   torso, from the hips to the spine's upper end, leans less than ``upright`` from up, or leans more but has round
-  arms (a hunched monster); a bird when it leans forward with flat wings (``wing_flat``) or no arms;
+  arms (a hunched monster); a bird when it leans forward with flat wings (``wing_flat``) or no arms; arms hang
+  above the hips, else from the hips reaching out or up (``_chest``);
 - without legs: one pair of long limbs on a small body is a bird in flight (wings); an upright body with long limbs
   high on it is a humanoid without legs; a long body lying down (the mesh lower than it is long) whose limbs are
   short beside it (fins, or none) and that tapers, curves or has fins is a fish or a serpent (not a plain log or
@@ -353,14 +354,17 @@ def _angle_from_up(body, vector):
 
 def _chest(body, spine, hips, legs, lengths, tuning):
     """Index of the chest on the spine: where the longest limbs off the plane that are not legs hang above the hips
-    (hands on the hips may join an arm to them), else -1."""
+    (hands on the hips may join an arm to them); else the hips, when such limbs hang there and reach out or up
+    without running down as legs do (a gingerbread figure's torso is one junction); else -1."""
     best = None
     for k, limb in enumerate(body.limbs):
         if k in legs or limb.side == 0 or lengths[k] < tuning.min_limb * body.size:
             continue
         at = _spine_index(spine, body, k)
-        if (at > hips or not legs) and (best is None or lengths[k] > best[0]):
-            best = (lengths[k], at)
+        level = (_tip(body, k) - body.graph.points[body.bases[k]]) @ body.up > -tuning.leg_drop * lengths[k]
+        rank = (at > hips or not legs, at == hips and level, lengths[k])
+        if (rank[0] or rank[1]) and (best is None or rank > best[0]):
+            best = (rank, at)
     return -1 if best is None else best[1]
 
 

@@ -14,7 +14,7 @@ The naming scheme (one for every body plan; the README says the same for users):
   ``UpLeg`` (thigh), ``Leg`` (shin), ``Foot``, ``ToeBase``; sided ones get ``Left`` / ``Right`` before the word
   (``LeftForeArm``). A quadruped's front legs have the roles, so the names, of arms and its hind legs those of legs.
   A leg's ``hips`` bones (from the body's middle to the hip joint) are the pelvis: they merge into ``Hips``.
-- A humanoid's forearm (shin) that ends without a hand (foot) gets one: ``_completed_ends``.
+- A humanoid's forearm (shin, neck) that ends without a hand (foot, head) gets one: ``_completed_ends``.
 - Fingers: ``LeftHandThumb1``..``3``, ``Index``, ``Middle``, ``Ring``, ``Pinky``, at most three bones each (Rigger's
   bones merged at the joints nearest the thirds); a finger without a digit is ``LeftHandFinger1``..``3``.
 - Parts without a Mixamo name keep one bone per Rigger bone, numbered from 1 along the chain: ``Tail1``, ``Tail2``,
@@ -56,8 +56,10 @@ DIGIT_WORDS = {"thumb": "Thumb", "index": "Index", "middle": "Middle", "ring": "
 FINGER_BONES = 3
 TRUNK = ("hips", "spine", "chest")
 SIDE_WORDS = {"L": "Left", "R": "Right", None: ""}
-ENDS = (("ForeArm", "Hand", ("hand",), ("hand_tip",)), ("Leg", "Foot", ("foot",), ("toe", "toe_tip")))  # a limb bone,
-# the end bone it may lack, the named joint that end bone begins at, where it ends (the first found)
+# a bone, the end bone it may lack, the named joint that begins at, where it ends (the first found), what it carries
+ENDS = (("ForeArm", "Hand", ("hand",), ("hand_tip",), ("finger",)),
+        ("Leg", "Foot", ("foot",), ("toe", "toe_tip"), ("toe",)),
+        ("Neck", "Head", ("head",), ("head_top",), ("jaw", "ear")))
 END_SHARE = 0.5  # an end bone with nowhere to end goes on along its limb bone for this share of that bone's length
 
 
@@ -448,21 +450,23 @@ def _finger_spans(points, real):
 
 
 def _completed_ends(names, heads, tails, parents, roles, places):
-    """A humanoid's ``Hand`` on every forearm and ``Foot`` on every shin (``Leg``) that ends without one (fingers
-    forking at the wrist, a leg ending at the ground), as ``ENDS`` says: from the named wrist (ankle) in ``places``
-    when it lies along the bone, which then ends there, else from the bone's end; to the hand's reach (the ball of
-    the foot, else its toes' tip) when that lies beyond, else on along the bone. The bone's fingers (toes) hang
-    from it. Game engines' humanoids and mocap need both."""
+    """A humanoid's ``Hand`` on every forearm, ``Foot`` on every shin (``Leg``) and ``Head`` on a ``Neck`` that ends
+    without one (fingers forking at the wrist, a leg ending at the ground, a neck bone running into a round head), as
+    ``ENDS`` says: from the named wrist (ankle, head joint) in ``places`` when it lies along the bone, which then ends
+    there, else from the bone's end; to the hand's reach (the ball of the foot, else its toes' tip; the head's top)
+    when that lies beyond, else on along the bone. The bone's fingers (toes; jaw and ears) hang from it. Game
+    engines' humanoids and mocap need all three."""
     names, heads, tails, parents, roles = list(names), heads.copy(), tails.copy(), list(parents), list(roles)
     for limb in range(len(names)):
         stem, _, suffix = names[limb].partition("_")  # LeftForeArm, 2
-        for word, end_word, starts, ends in ENDS:
-            if not stem.endswith(word) or stem[:-len(word)] not in ("Left", "Right"):
+        for word, end_word, starts, ends, carried in ENDS:
+            side_word = stem[:-len(word)]
+            if not stem.endswith(word) or side_word not in ("Left", "Right", ""):
                 continue
-            end_name = f"{stem[:-len(word)]}{end_word}{'_' + suffix if suffix else ''}"
+            end_name = f"{side_word}{end_word}{'_' + suffix if suffix else ''}"
             if end_name in names:
                 continue
-            letter = stem[0]
+            letter = side_word[:1] or None
             head, tail = heads[limb], tails[limb]
             along = tail - head
             bone_length = float(np.linalg.norm(along))
@@ -486,9 +490,8 @@ def _completed_ends(names, heads, tails, parents, roles, places):
             end = len(names) - 1
             parents.append(limb)
             roles.append(BoneRole(end_word.lower(), letter))
-            carried = "finger" if end_word == "Hand" else "toe"
             for child in range(end):
-                if parents[child] == limb and roles[child].role == carried:
+                if parents[child] == limb and roles[child].role in carried:
                     parents[child] = end
     return names, heads, tails, parents, roles
 
