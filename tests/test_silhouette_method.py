@@ -750,3 +750,23 @@ def test_a_bear_s_ears_are_twins_though_its_front_view_prunes_one_ear_s_tip():
     followed = rig_checks.limbs(samples.ground_truth_bones("bear"), skeleton, size)
     assert followed["ear.L"].distance < 0.03 and followed["ear.R"].distance < 0.03
     assert rig_checks.side_counts(skeleton)[0] == rig_checks.side_counts(skeleton)[1]
+
+
+@pytest.mark.parametrize("name", ["quadruped", "bear"])
+def test_legs_seen_from_the_side_hang_from_hips_beside_the_middle(name):
+    """Seen from the side, a pair of legs is one chain split in depth. Each copy starts at its own depth where the
+    chain leaves the body's middle: a hips bone reaches across to it, level, and the thigh hangs straight down
+    from there, beside the middle as the artists' hips are, not slanting in from the middle to the knee."""
+    vertices, triangles = load_character(name)
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    size = float(np.ptp(vertices, axis=0).max())
+    for bone, role in enumerate(skeleton.roles):
+        if role.role != "thigh" or role.index:
+            continue
+        parent = skeleton.parents[bone]
+        across = skeleton.tails[parent] - skeleton.heads[parent]
+        assert skeleton.roles[parent].role == "hips" and abs(across[2]) <= 0.01 * size, skeleton.names[parent]
+        assert abs(skeleton.heads[parent][0]) <= 0.01 * size
+        leg = [b for b, r in enumerate(skeleton.roles) if r.side == role.side and r.role in ("thigh", "shin", "foot")]
+        lowest = skeleton.tails[min(leg, key=lambda b: skeleton.tails[b][2])]
+        assert abs(skeleton.heads[bone][0] - lowest[0]) <= 0.01 * size, skeleton.names[bone]

@@ -4,7 +4,7 @@ Each axis node is a ray along the view direction; ``Silhouette.layers`` gives th
 inside the mesh. A node is centred in one of them, chosen for continuity along its chain. Where a chain's rays cross
 the mesh in k > 1 separate parts over much of its length (a quadruped's left and right legs seen from the side),
 the chain is split into k chains, one per part, from where the parts come apart (a hand's fingers seen edge-on fork
-off the one arm). Where the chosen interval is much thicker than the part is wide
+off the one arm); each copy reaches its own depth from its parent's end first (a leg's hips bone). Where the chosen interval is much thicker than the part is wide
 (an arm in front of the body merges with it along the ray), the perpendicular silhouette decides, as in Pan et al.:
 its own chordal axis, seen from the side, says at which depth a part of that width and height lies. The thresholds
 are the tuning's depth section (``tuning.py``).
@@ -120,17 +120,29 @@ def place_chains(sil, points, radius, root, chains, placing):
                 depths = resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
                                            followed[copy], placing, followed[:copy] + followed[copy + 1:])
                 line = sil.lift(chain_points[part], depths)
+                part_widths = widths[part]
                 parent = -1
                 if parents:
                     # a copy hangs from the copy of its parent chain that ends nearest to it
                     probe = line[min(1, len(line) - 1)]
                     parent = min(parents, key=lambda p: np.linalg.norm(placed[p][0][-1] - probe))
-                    line[0] = placed[parent][0][-1]
-                placed.append((line, parent, widths[part]))
+                    line, part_widths = _hung(line, part_widths, placed[parent][0][-1], count, sil.cell)
+                placed.append((line, parent, part_widths))
             parents = list(range(first, len(placed)))
         ends_of[ci] = parents
         end_depth[ci] = depths[-1]
     return sil.lift(points[[root]], [root_depth])[0], placed
+
+
+def _hung(line, widths, start, copies, cell):
+    """A placed ``line`` (and its ``widths``) made to start at its parent's end ``start``. A copy of a split chain
+    keeps its own first point, where its part begins at its own depth, and reaches it from ``start`` across the
+    depth: a leg seen from the side hangs straight down from its hip beside the body's middle, not slanting from the
+    middle to the first node below it. A single chain's first point becomes ``start``."""
+    if copies > 1 and np.linalg.norm(line[0] - start) > cell:
+        return np.vstack([start, line]), np.r_[widths[:1], widths]
+    line[0] = start
+    return line, widths
 
 
 def _middle(interval):
