@@ -4,10 +4,11 @@ Each axis node is a ray along the view direction; ``Silhouette.layers`` gives th
 inside the mesh. A node is centred in one of them, chosen for continuity along its chain. Where a chain's rays cross
 the mesh in k > 1 separate parts over much of its length (a quadruped's left and right legs seen from the side),
 the chain is split into k chains, one per part, from where the parts come apart (a hand's fingers seen edge-on fork
-off the one arm); each copy reaches its own depth from its parent's end first (a leg's hips bone). Where the chosen interval is much thicker than the part is wide
-(an arm in front of the body merges with it along the ray), the perpendicular silhouette decides, as in Pan et al.:
-its own chordal axis, seen from the side, says at which depth a part of that width and height lies. The thresholds
-are the tuning's depth section (``tuning.py``).
+off the one arm); copies that mirror each other across the plane reach their own depth from their parent's end
+first (a leg's hips bone). Where the chosen interval is much thicker than the part is wide (an arm in front of the
+body merges with it along the ray), the perpendicular silhouette decides, as in Pan et al.: its own chordal axis,
+seen from the side, says at which depth a part of that width and height lies. The thresholds are the tuning's depth
+section (``tuning.py``).
 """
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -114,8 +115,9 @@ def place_chains(sil, points, radius, root, chains, placing):
         for part, count in pieces:
             first = len(placed)
             followed = _follow((parts if count > 1 else node_layers)[part], count, end_depth[chain.parent], plane)
-            if count == 2 and mirror is not None:
-                followed = _twin_copies(parts[part], followed, *mirror)
+            twins = count == 2 and mirror is not None and _twin_parts(parts[part], *mirror)
+            if twins:
+                followed = _twin_copies(followed, mirror[0])
             for copy in range(count):
                 depths = resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
                                            followed[copy], placing, followed[:copy] + followed[copy + 1:])
@@ -126,7 +128,7 @@ def place_chains(sil, points, radius, root, chains, placing):
                     # a copy hangs from the copy of its parent chain that ends nearest to it
                     probe = line[min(1, len(line) - 1)]
                     parent = min(parents, key=lambda p: np.linalg.norm(placed[p][0][-1] - probe))
-                    line, part_widths = _hung(line, part_widths, placed[parent][0][-1], count, sil.cell)
+                    line, part_widths = _hung(line, part_widths, placed[parent][0][-1], twins, sil.cell)
                 placed.append((line, parent, part_widths))
             parents = list(range(first, len(placed)))
         ends_of[ci] = parents
@@ -134,12 +136,13 @@ def place_chains(sil, points, radius, root, chains, placing):
     return sil.lift(points[[root]], [root_depth])[0], placed
 
 
-def _hung(line, widths, start, copies, cell):
-    """A placed ``line`` (and its ``widths``) made to start at its parent's end ``start``. A copy of a split chain
-    keeps its own first point, where its part begins at its own depth, and reaches it from ``start`` across the
-    depth: a leg seen from the side hangs straight down from its hip beside the body's middle, not slanting from the
-    middle to the first node below it. A single chain's first point becomes ``start``."""
-    if copies > 1 and np.linalg.norm(line[0] - start) > cell:
+def _hung(line, widths, start, twins, cell):
+    """A placed ``line`` (and its ``widths``) made to start at its parent's end ``start``. A copy of a chain split
+    into ``twins`` (parts that mirror each other across the plane) keeps its own first point, where its part begins
+    at its own depth, and reaches it from ``start`` across the depth: a leg seen from the side hangs straight down
+    from its hip beside the body's middle, not slanting from the middle to the first node below it. Other chains
+    (fingers fanning out from the hand they fork off) start at ``start``."""
+    if twins and np.linalg.norm(line[0] - start) > cell:
         return np.vstack([start, line]), np.r_[widths[:1], widths]
     line[0] = start
     return line, widths
@@ -276,14 +279,17 @@ def _anchor(node_layers, copies):
     return max(i for i, layer in enumerate(node_layers) if len(layer) == copies)
 
 
-def _twin_copies(parts, followed, depth, tolerance):
-    """The two ``followed`` copies of a split chain whose parts mirror each other across the plane at ``depth`` (at
-    the outermost node that sees them apart: a pair of legs or ears seen from the side) as twins: the copy that keeps
-    to one side of the plane at more nodes, and its mirror image, since where one part hides the other the other copy
-    may have stepped across to it. Copies of parts on one side (fingers seen edge-on) are left as followed."""
-    anchor = _anchor(parts, 2)
-    if not _beside(parts[anchor], depth, tolerance):
-        return followed
+def _twin_parts(parts, depth, tolerance):
+    """Whether a chain split in two runs through parts that mirror each other across the plane at ``depth`` (at the
+    outermost node that sees them apart: a pair of legs or ears seen from the side), not parts on one side of it
+    (fingers seen edge-on)."""
+    return _beside(parts[_anchor(parts, 2)], depth, tolerance)
+
+
+def _twin_copies(followed, depth):
+    """The two ``followed`` copies of a chain split into twin parts (:func:`_twin_parts`) as twins: the copy that
+    keeps to one side of the plane at more nodes, and its mirror image, since where one part hides the other the
+    other copy may have stepped across to it."""
     kept = max((0, 1), key=lambda k: abs(np.sign(followed[k] - depth).sum()))
     image = 2 * depth - followed[kept]
     return [followed[0], image] if kept == 0 else [image, followed[1]]
