@@ -755,18 +755,20 @@ def test_a_bear_s_ears_are_twins_though_its_front_view_prunes_one_ear_s_tip():
 @pytest.mark.parametrize("name", ["quadruped", "bear"])
 def test_legs_seen_from_the_side_hang_from_hips_beside_the_middle(name):
     """Seen from the side, a pair of legs is one chain split in depth. Each copy starts at its own depth where the
-    chain leaves the body's middle: a hips bone reaches across to it, level, and the thigh hangs straight down
-    from there, beside the middle as the artists' hips are, not slanting in from the middle to the knee."""
+    chain leaves the body's middle (or the root): one bone, the hips (shoulder), reaches across to it, level, and
+    the leg goes down from there, beside the middle as the artists' hips are, not slanting in from the middle."""
     vertices, triangles = load_character(name)
     skeleton = rigger.rig_mesh(vertices, triangles)
     size = float(np.ptp(vertices, axis=0).max())
+    legs = {"hips": ("thigh", "shin", "foot"), "shoulder": ("upper_arm", "forearm", "hand")}
+    found = 0
     for bone, role in enumerate(skeleton.roles):
-        if role.role != "thigh" or role.index:
+        if role.role not in legs or role.index or role.side is None:
             continue
-        parent = skeleton.parents[bone]
-        across = skeleton.tails[parent] - skeleton.heads[parent]
-        assert skeleton.roles[parent].role == "hips" and abs(across[2]) <= 0.01 * size, skeleton.names[parent]
-        assert abs(skeleton.heads[parent][0]) <= 0.01 * size
-        leg = [b for b, r in enumerate(skeleton.roles) if r.side == role.side and r.role in ("thigh", "shin", "foot")]
+        head, tail = skeleton.heads[bone], skeleton.tails[bone]
+        assert abs(head[0]) <= 0.01 * size and abs(tail[2] - head[2]) <= 0.01 * size, skeleton.names[bone]
+        leg = [b for b, r in enumerate(skeleton.roles) if r.side == role.side and r.role in legs[role.role]]
         lowest = skeleton.tails[min(leg, key=lambda b: skeleton.tails[b][2])]
-        assert abs(skeleton.heads[bone][0] - lowest[0]) <= 0.01 * size, skeleton.names[bone]
+        assert abs(tail[0] - lowest[0]) <= 0.01 * size, skeleton.names[bone]
+        found += 1
+    assert found == 4

@@ -412,11 +412,15 @@ def test_split_twins_across_the_mirror_plane_stay_mirror_images():
     """A leg pair seen across the mirror plane z = 0: apart at the tips, merged near the body, and in between only
     the near leg seen (the far one hidden behind it, or touching it). The copy anchored on the far leg would step
     onto the near one there; twins across the plane are mirror images instead, each on its own side. Without the
-    plane the copies go as followed."""
+    plane the copies go as followed. Each twin hangs from a bone across from the middle to where it begins."""
     node_layers = [layers((-3.5, 3.5))] * 5 + [layers((-3.5, -2.5))] * 2 + [layers((-3.5, -2.5), (2.5, 3.5))] * 5
-    _, placed = placed_along_x(node_layers, mirror=(0.0, 0.05))
-    assert len(placed) == 2
-    near, far = sorted((line for line, _, _ in placed), key=lambda line: line[-1, 2])
+    root, placed = placed_along_x(node_layers, mirror=(0.0, 0.05))
+    legs = [(line, parent) for line, parent, widths in placed if widths.any()]
+    across = {k: line for k, (line, _, widths) in enumerate(placed) if not widths.any()}
+    assert len(legs) == 2 and len(across) == 2
+    for line, parent in legs:
+        np.testing.assert_array_equal(across[parent], [root, line[0]])
+    near, far = sorted((line for line, _ in legs), key=lambda line: line[-1, 2])
     np.testing.assert_array_equal(near[:, 2], -3.0)
     np.testing.assert_array_equal(far[:, 2], 3.0)
     _, placed = placed_along_x(node_layers)

@@ -151,10 +151,15 @@ class BoneBuilder:
         return groups
 
     def _joints(self, chains):
-        """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror twins made symmetric."""
+        """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror twins made symmetric; a
+        bone across the depth (two points, no part around them: ``depth._across``) is one bone."""
+        across = [len(line) == 2 and not widths.any() for line, widths, _ in chains]
+        cut = [chain for chain, one in zip(chains, across) if not one]
         if self.symmetry is None:
-            return [chain_joints(line, self.cutting, widths, leaf) for line, widths, leaf in chains]
-        return symmetric_joints(chains, self.cutting, self.symmetry, self.exact)
+            joints = iter([chain_joints(line, self.cutting, widths, leaf) for line, widths, leaf in cut])
+        else:
+            joints = iter(symmetric_joints(cut, self.cutting, self.symmetry, self.exact))
+        return [line.copy() if one else next(joints) for (line, _, _), one in zip(chains, across)]
 
     def _add_chain(self, line, joints, up):
         """Bones between consecutive ``joints`` of one chain, the first hanging from bone ``up``; returns the

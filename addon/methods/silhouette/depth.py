@@ -81,7 +81,8 @@ def place_chains(sil, points, radius, root, chains, placing):
         placing: how (``Placing``).
 
     Returns (root_point, placed) with ``placed`` a list of (polyline (k, 3), parent_index, half-widths (k,)) —
-    parents first; a split chain yields several entries with the same parent.
+    parents first; a split chain yields several entries with the same parent, or, split into twin parts, each its
+    bone across (``_across``) and itself hanging from it.
     """
     tuning, mirror = placing.tuning, placing.mirror
     used = sorted({root} | {n for c in chains for n in c.nodes})
@@ -89,6 +90,7 @@ def place_chains(sil, points, radius, root, chains, placing):
     layers = [solid_layers(layer, radius[n], tuning) for layer, n in zip(sil.layers(points[used]), used)]
     root_layers = layers[slot[root]]
     root_depth = _middle(root_layers[np.argmax(root_layers[:, 1] - root_layers[:, 0])]) if len(root_layers) else 0.0
+    root_point = sil.lift(points[[root]], [root_depth])[0]
     end_depth = {-1: root_depth}
     ends_of = {-1: []}  # chain -> the placed entries its child chains hang from (its outer copies)
     root_is_end = sum(chain.parent < 0 for chain in chains) == 1
@@ -112,8 +114,9 @@ def place_chains(sil, points, radius, root, chains, placing):
         fork = fork_point(parts, chain_radius, copies, tuning) if copies > 1 else 0
         pieces = [(slice(0, fork + 1), 1), (slice(fork, None), copies)] if fork else [(slice(None), copies)]
         parents = ends_of[chain.parent]
+        copies_placed = []  # this chain's entries, without the bones across (``_across``)
         for part, count in pieces:
-            first = len(placed)
+            first = len(copies_placed)
             followed = _follow((parts if count > 1 else node_layers)[part], count, end_depth[chain.parent], plane)
             twins = count == 2 and mirror is not None and _twin_parts(parts[part], *mirror)
             if twins:
@@ -122,30 +125,31 @@ def place_chains(sil, points, radius, root, chains, placing):
                 depths = resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
                                            followed[copy], placing, followed[:copy] + followed[copy + 1:])
                 line = sil.lift(chain_points[part], depths)
-                part_widths = widths[part]
-                parent = -1
+                parent, start = -1, root_point if chain.parent < 0 else None
                 if parents:
                     # a copy hangs from the copy of its parent chain that ends nearest to it
                     probe = line[min(1, len(line) - 1)]
                     parent = min(parents, key=lambda p: np.linalg.norm(placed[p][0][-1] - probe))
-                    line, part_widths = _hung(line, part_widths, placed[parent][0][-1], twins, sil.cell)
-                placed.append((line, parent, part_widths))
-            parents = list(range(first, len(placed)))
+                    start = placed[parent][0][-1]
+                if twins and start is not None and np.linalg.norm(line[0] - start) > sil.cell:
+                    placed.append(_across(start, line[0], parent))
+                    parent = len(placed) - 1
+                elif parents:
+                    line[0] = start
+                placed.append((line, parent, widths[part]))
+                copies_placed.append(len(placed) - 1)
+            parents = copies_placed[first:]
         ends_of[ci] = parents
         end_depth[ci] = depths[-1]
-    return sil.lift(points[[root]], [root_depth])[0], placed
+    return root_point, placed
 
 
-def _hung(line, widths, start, twins, cell):
-    """A placed ``line`` (and its ``widths``) made to start at its parent's end ``start``. A copy of a chain split
-    into ``twins`` (parts that mirror each other across the plane) keeps its own first point, where its part begins
-    at its own depth, and reaches it from ``start`` across the depth: a leg seen from the side hangs straight down
-    from its hip beside the body's middle, not slanting from the middle to the first node below it. Other chains
-    (fingers fanning out from the hand they fork off) start at ``start``."""
-    if twins and np.linalg.norm(line[0] - start) > cell:
-        return np.vstack([start, line]), np.r_[widths[:1], widths]
-    line[0] = start
-    return line, widths
+def _across(start, end, parent):
+    """The placed entry of a bone across the depth, from its parent's end (or the root) ``start`` to where a copy of
+    a chain split into twin parts begins at its own depth, ``end``: a leg seen from the side hangs straight down from
+    its hip beside the body's middle, not slanting from the middle to its first node below, and this is its hips
+    bone, one bone (no part around it: zero widths, ``BoneBuilder._joints``) on top of the leg's own."""
+    return np.vstack([start, end]), parent, np.zeros(2)
 
 
 def _middle(interval):
