@@ -4,11 +4,11 @@ Each axis node is a ray along the view direction; ``Silhouette.layers`` gives th
 inside the mesh. A node is centred in one of them, chosen for continuity along its chain. Where a chain's rays cross
 the mesh in k > 1 separate parts over much of its length (a quadruped's left and right legs seen from the side),
 the chain is split into k chains, one per part, from where the parts come apart (a hand's fingers seen edge-on fork
-off the one arm); copies that mirror each other across the plane reach their own depth from their parent's end
-first (a leg's hips bone). Where the chosen interval is much thicker than the part is wide (an arm in front of the
-body merges with it along the ray), the perpendicular silhouette decides, as in Pan et al.: its own chordal axis,
-seen from the side, says at which depth a part of that width and height lies. The thresholds are the tuning's depth
-section (``tuning.py``).
+off the one arm); copies that mirror each other across the plane each hang from one bone across the depth, from
+their parent's end or the root (a leg's hips bone). Where the chosen interval is much thicker than the part is wide
+(an arm in front of the body merges with it along the ray), the perpendicular silhouette decides, as in Pan et al.:
+its own chordal axis, seen from the side, says at which depth a part of that width and height lies. The thresholds
+are the tuning's depth section (``tuning.py``).
 """
 from dataclasses import dataclass
 from typing import NamedTuple
