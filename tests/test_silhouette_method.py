@@ -772,3 +772,26 @@ def test_legs_seen_from_the_side_hang_from_hips_beside_the_middle(name):
         assert abs(tail[0] - lowest[0]) <= 0.01 * size, skeleton.names[bone]
         found += 1
     assert found == 4
+
+
+def test_a_limb_from_another_view_does_not_hang_from_a_leg_s_bone_across():
+    """A body seen from the side: a spine on the mirror plane x = 0, a pair of legs each hanging from its bone across
+    the depth, and two ears found in another view that start near the plane, on the legs' bones across. The ears
+    hang from the spine: a bone across belongs to its leg, and a limb leaving the middle hangs from the middle
+    (lifting a leg must not carry an ear)."""
+    builder = bone_builder(0.5, (0, 0.0))
+    spine = np.array([[0.0, 1.0, -1.0], [0.0, 1.0, 0.0]])
+    placed = [(spine, -1, np.full(2, 0.4))]
+    for side in (-1, 1):
+        placed.append((np.array([[0.0, 1.0, 0.0], [0.3 * side, 1.0, 0.0]]), 0, np.zeros(2)))
+        placed.append((np.array([[0.3 * side, 1.0, 0.0], [0.3 * side, 0.0, 0.0]]), len(placed) - 1, np.full(2, 0.1)))
+    builder.add_island(spine[0], placed)
+    first = len(builder.heads)
+    ears = [np.array([[0.04 * side, 1.0, 0.0], [0.2 * side, 1.6, 0.3]]) for side in (-1, 1)]
+    builder.add_limbs([(ear, np.full(2, 0.05)) for ear in ears], ())
+    _, _, parents = builder.arrays()
+    across = [bone for bone in range(first) if abs(builder.heads[bone][0]) < 1e-9 and builder.tails[bone][1] == 1.0
+              and abs(builder.tails[bone][0]) == 0.3]
+    assert len(across) == 2 and len([b for b in range(first) if parents[b] in across]) == 2
+    ear_roots = [bone for bone in range(first, len(parents)) if parents[bone] < first]
+    assert ear_roots and all(builder.chain_of_bone[parents[bone]] == 0 for bone in ear_roots)

@@ -22,6 +22,7 @@ class BoneBuilder:
         self.heads, self.tails, self.parents = [], [], []
         self.chain_of_bone, self.index_in_chain = [], []
         self.lines = []  # one polyline per chain, indexed by chain number
+        self.across = set()  # the bones across the depth (``depth._across``): a leg's, no limb hangs from them
 
     def add_island(self, root_point, placed):
         """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk, the
@@ -37,7 +38,8 @@ class BoneBuilder:
         trunk = max(roots, key=lambda i: (on_plane[i], placed[i][2].mean()))
         order = [trunk] + [i for i in range(len(placed)) if i != trunk]
         inner = {parent for _, parent, _ in placed}
-        joints = self._joints([(line, widths, i not in inner) for i, (line, _, widths) in enumerate(placed)])
+        across = [len(line) == 2 and not widths.any() for line, _, widths in placed]  # two points, no part around
+        joints = self._joints([(line, widths, i not in inner) for i, (line, _, widths) in enumerate(placed)], across)
         attach, _ = self.attachment(root_point)
         last_bone, first_bone = {}, {}
         for i in order:
@@ -50,6 +52,8 @@ class BoneBuilder:
                 up = first_bone[trunk]
             added = self._add_chain(line, joints[i], up)
             first_bone[i], last_bone[i] = (added[0], added[-1]) if added else (up, up)
+            if across[i]:
+                self.across.update(added)
 
     def _on_plane(self, line):
         """Whether the chain ``line`` lies on the builder's mirror plane (False without one)."""
@@ -90,8 +94,9 @@ class BoneBuilder:
     def add_limbs(self, limbs, views):
         """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone already there that their
         start reaches within the mesh as all the silhouettes ``views`` see it (the primary one and the one the limbs
-        come from); a chain starting far from that bone (a foot below a leg too stubby to show) is extended back
-        along the path to it, so the leg between them gets bones of its own, and mirror pairs stay mirror pairs.
+        come from), on the mirror plane for a chain starting on it (ears, not a leg beside them); a chain starting
+        far from that bone (a foot below a leg too stubby to show) is extended back along the path to it, so the leg
+        between them gets bones of its own, and mirror pairs stay mirror pairs.
         Limbs that far from one bone whose starts, and the points where they meet the bone, all lie within half a
         bone length of each other (a pair of ears, horns on a neck) share that extension: one chain from the middle
         of those points to the middle of their starts, from which each hangs (through a bone to its own start when
@@ -103,7 +108,7 @@ class BoneBuilder:
             limbs = mirror_completed(limbs, self.symmetry)
         chains, ups, meets_of = [], [], {}  # meets_of: limb number -> where it meets its bone, for the limbs to extend
         for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
-            up, meets = self.attachment(line[0], views, self._on_plane(line))  # from the left one's extension)
+            up, meets = self.attachment(line[0], views, self._on_plane(line[:1]))  # from the left one's extension)
             if meets is not None and np.linalg.norm(line[0] - meets) > self.tuning.bridge_reach * self.bone_length:
                 meets_of[len(chains)] = meets
             chains.append((line, widths, True))
@@ -121,7 +126,7 @@ class BoneBuilder:
                 ends.update(dict.fromkeys(members, len(chains)))
                 chains.append((np.vstack([meets, start]), np.zeros(2), False))
                 ups.append(ups[members[0]])
-        joints = self._joints(chains)
+        joints = self._joints(chains, [False] * len(chains))
         last_bone = {}
         for c in sorted(range(len(chains)), key=lambda c: c in ends):  # bridge chains before the limbs they carry
             line, along = chains[c][0], joints[c]
@@ -150,10 +155,9 @@ class BoneBuilder:
             groups += [members] if whole else [[k] for k in members]
         return groups
 
-    def _joints(self, chains):
+    def _joints(self, chains, across):
         """Joints along each of the (polyline, half-widths, is a leaf) ``chains``, mirror twins made symmetric; a
-        bone across the depth (two points, no part around them: ``depth._across``) is one bone."""
-        across = [len(line) == 2 and not widths.any() for line, widths, _ in chains]
+        bone ``across`` the depth is one bone."""
         cut = [chain for chain, one in zip(chains, across) if not one]
         if self.symmetry is None:
             joints = iter([chain_joints(line, self.cutting, widths, leaf) for line, widths, leaf in cut])
@@ -190,8 +194,9 @@ class BoneBuilder:
 
     def attachment(self, point, views=(), on_plane=False):
         """(bone, where a path from ``point`` meets it): the bone nearest ``point``, or -1 before the first island,
-        met nowhere in particular (None); ``on_plane``: of the bones on the mirror plane, if any (a head found in a
-        perpendicular view hangs from the spine, not from an arm near it). With silhouettes ``views``, the nearest
+        met nowhere in particular (None), never a bone across the depth (it belongs to its leg); ``on_plane``: of the
+        bones on the mirror plane, if any (a head found in a perpendicular view hangs from the spine, not from an arm
+        near it). With silhouettes ``views``, the nearest
         bone that a straight path from
         ``point`` reaches within the mesh as each of them sees it (``Silhouette.encloses``, sampled every grid cell,
         up to ``path_slack`` outside: a path may graze the surface, but a foot beside a hanging hand belongs to the
@@ -202,6 +207,8 @@ class BoneBuilder:
             return -1, None
         targets = nearest_on_segments(point[None], np.array(self.heads), np.array(self.tails))[0]
         distance = np.linalg.norm(targets - point, axis=1)
+        if len(self.across) < len(distance):
+            distance[list(self.across)] = np.inf
         if on_plane:
             sided = np.array([not self._on_plane(self.lines[chain]) for chain in self.chain_of_bone])
             if not sided.all():
