@@ -196,13 +196,12 @@ class BoneBuilder:
         """(bone, where a path from ``point`` meets it): the bone nearest ``point``, or -1 before the first island,
         met nowhere in particular (None), never a bone across the depth (it belongs to its leg); ``on_plane``: of the
         bones on the mirror plane, if any (a head found in a perpendicular view hangs from the spine, not from an arm
-        near it). With silhouettes ``views``, the nearest
-        bone that a straight path from
-        ``point`` reaches within the mesh as each of them sees it (``Silhouette.encloses``, sampled every grid cell,
-        up to ``path_slack`` outside: a path may graze the surface, but a foot beside a hanging hand belongs to the
-        body, not the hand), and the point the path meets it at; the nearest bone, met nowhere (None), when no path
-        to the ``path_candidates`` nearest stays in (a soup of triangles strewn at random has a
-        thousand bones at a small ``bone_length``, and paths through it rarely stay in)."""
+        near it). With silhouettes ``views``, the nearest bone that a straight path from ``point`` reaches within the
+        mesh as each of them sees it (``Silhouette.encloses``, sampled every grid cell, up to ``path_slack`` outside:
+        a path may graze the surface, but a foot beside a hanging hand belongs to the body, not the hand), and the
+        point the path meets it at; the nearest bone, met nowhere (None), when no path to the ``path_candidates``
+        nearest stays in (a soup of triangles strewn at random has a thousand bones at a small ``bone_length``, and
+        paths through it rarely stay in)."""
         if not self.heads:
             return -1, None
         targets = nearest_on_segments(point[None], np.array(self.heads), np.array(self.tails))[0]
