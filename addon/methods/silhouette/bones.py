@@ -7,6 +7,7 @@ from ...core.joints import chain_joints, symmetric_joints
 from ...core.mirror import mirror_chain_pairs, mirror_completed
 from ...core.naming import bone_names
 from ...core.polyline import nearest_on_segments
+from .depth import is_across
 
 
 class BoneBuilder:
@@ -22,7 +23,7 @@ class BoneBuilder:
         self.heads, self.tails, self.parents = [], [], []
         self.chain_of_bone, self.index_in_chain = [], []
         self.lines = []  # one polyline per chain, indexed by chain number
-        self.across = set()  # the bones across the depth (``depth._across``): a leg's, no limb hangs from them
+        self.across = set()  # the bones across the depth (``depth.is_across``): a leg's, no limb hangs from them
 
     def add_island(self, root_point, placed):
         """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk, the
@@ -38,7 +39,7 @@ class BoneBuilder:
         trunk = max(roots, key=lambda i: (on_plane[i], placed[i][2].mean()))
         order = [trunk] + [i for i in range(len(placed)) if i != trunk]
         inner = {parent for _, parent, _ in placed}
-        across = [len(line) == 2 and not widths.any() for line, _, widths in placed]  # two points, no part around
+        across = [is_across(line, widths) for line, _, widths in placed]
         joints = self._joints([(line, widths, i not in inner) for i, (line, _, widths) in enumerate(placed)], across)
         attach, _ = self.attachment(root_point)
         last_bone, first_bone = {}, {}

@@ -148,8 +148,14 @@ def _across(start, end, parent):
     """The placed entry of a bone across the depth, from its parent's end (or the root) ``start`` to where a copy of
     a chain split into twin parts begins at its own depth, ``end``: a leg seen from the side hangs straight down from
     its hip beside the body's middle, not slanting from the middle to its first node below, and this is its hips
-    bone, one bone (no part around it: zero widths, ``BoneBuilder._joints``) on top of the leg's own."""
+    bone, one bone on top of the leg's own (:func:`is_across`)."""
     return np.vstack([start, end]), parent, np.zeros(2)
+
+
+def is_across(line, widths):
+    """Whether a placed chain (its ``line`` and ``widths``) is a bone across the depth (:func:`_across`): two points
+    with no part around them (zero widths)."""
+    return len(line) == 2 and not widths.any()
 
 
 def _middle(interval):
