@@ -384,6 +384,20 @@ def test_ears_of_a_symmetric_quadruped_seen_from_the_side_are_a_mirror_pair(mode
     assert ears, "no bone reaches up to the ears"
 
 
+def test_a_foxs_ears_hang_from_its_head_on_a_neck():
+    """The Fox's side view prunes its neck and head, a stubby branch off its deep chest; the end-on view finds its
+    ears starting on the head, far from the chest and 0.8 bone lengths apart. They share one extension, a neck and
+    a head on the mirror plane, and hang from its end: the head is a bone of its own, not carried by an ear."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_Fox", "Quaternius_Fox.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    roles = {index: role.role for index, role in enumerate(skeleton.roles)}
+    head = [b for b, role in roles.items() if role == "head"]
+    assert len(head) == 1 and roles[skeleton.parents[head[0]]] == "neck"
+    ears = [b for b, role in roles.items() if role == "ear"]
+    assert {skeleton.names[b][-2:] for b in ears} == {".L", ".R"}
+    assert {skeleton.parents[b] for b in ears if roles[skeleton.parents[b]] != "ear"} == set(head)
+
+
 @pytest.mark.parametrize("model, images", [("nogt/homer.obj", True), ("gt/rignet_17364/rignet_17364.obj", True),
                                            ("gt/rignet_8210/rignet_8210.obj", True),
                                            ("gt/rignet_2586/rignet_2586.obj", False)])
@@ -500,10 +514,11 @@ def test_a_hidden_limb_tries_paths_to_the_nearest_bones_only():
 
 
 def test_mirror_image_hidden_limbs_get_mirror_image_bones():
-    """Two feet mirrored across x = 0, both far below the body's bone and 0.6 bone lengths apart (too far to share
-    an extension), each hangs from the body (not the right foot from the left one's extension, which passes nearer
-    it) through mirror-image bones; so do they with a tail between them, whichever order they come in."""
-    left = np.array([[0.3, 0.3, 0.5], [0.3, 0.1, 0.9]])
+    """Two feet mirrored across x = 0, both far below the body's bone and 0.8 bone lengths apart (their extensions
+    part by more than 30°: too far apart to share one), each hangs from the body (not the right foot from the left
+    one's extension, which passes nearer it) through mirror-image bones; so do they with a tail between them,
+    whichever order they come in."""
+    left = np.array([[0.4, 0.3, 0.5], [0.4, 0.1, 0.9]])
     tail = np.array([[0.0, 0.3, 0.5], [0.0, 0.1, 0.9]])
     for feet in ([left, left * [-1, 1, 1]], [left, tail, left * [-1, 1, 1]], [tail, left, left * [-1, 1, 1]]):
         builder, first = _body_with_feet(feet, plane=(0, 0.0))
@@ -516,10 +531,12 @@ def test_mirror_image_hidden_limbs_get_mirror_image_bones():
             np.testing.assert_allclose(points[sides[".R"]], points[sides[".L"]] * [-1, 1, 1], atol=1e-12)
 
 
-def test_hidden_limbs_starting_together_share_their_extension():
-    """Two ears starting at one point far below the body's bone (as the end-on view places a pair): one chain runs
-    to them, both hang from its end, and no two bones lie on each other."""
-    ear = np.array([[0.0, 0.3, 0.5], [0.3, 0.1, 0.9]])
+@pytest.mark.parametrize("start", [0.0, 0.35])
+def test_hidden_limbs_starting_together_share_their_extension(start):
+    """Two ears starting far below the body's bone (as the end-on view places a pair), at one point or 0.7 bone
+    lengths apart (a fox's ears, on a head at the end of a neck that the side view pruned): one chain runs to the
+    middle of their starts, both hang from its end, and no two bones lie on each other."""
+    ear = np.array([[start, 0.1, 0.5], [start + 0.3, 0.0, 0.9]])
     builder, first = _body_with_feet([ear, ear * [-1, 1, 1]], plane=(0, 0.0))
     heads, tails, parents = builder.arrays()
     names = builder.names()
@@ -529,7 +546,7 @@ def test_hidden_limbs_starting_together_share_their_extension():
     sided = [name.endswith((".L", ".R")) for name in names]
     carried = [b for b in range(first, len(heads)) if sided[b] and not sided[parents[b]]]  # each ear's first bone
     assert len(carried) == 2 and parents[carried[0]] == parents[carried[1]] >= first  # both from the shared chain
-    np.testing.assert_allclose(tails[parents[carried[0]]], ear[0])
+    np.testing.assert_allclose(tails[parents[carried[0]]], ear[0] * [0, 1, 1])
 
 
 def test_an_open_tube_rigs_though_it_shows_nothing_end_on():

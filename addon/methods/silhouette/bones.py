@@ -98,11 +98,10 @@ class BoneBuilder:
         come from), on the mirror plane for a chain starting on it (ears, not a leg beside them); a chain starting
         far from that bone (a foot below a leg too stubby to show) is extended back along the path to it, so the leg
         between them gets bones of its own, and mirror pairs stay mirror pairs.
-        Limbs that far from one bone whose starts, and the points where they meet the bone, all lie within half a
-        bone length of each other (a pair of ears, horns on a neck) share that extension: one chain from the middle
-        of those points to the middle of their starts, from which each hangs (through a bone to its own start when
-        apart), instead of bones lying on each other. Which limbs share does not depend on their order, so mirror
-        pairs stay mirror pairs."""
+        Limbs that far from one bone that start and meet it together (``_sharing``: a pair of ears, horns on a
+        neck) share that extension: one chain from the middle of those points to the middle of their starts, from
+        which each hangs (through a bone to its own start when apart), instead of bones lying on each other. Which
+        limbs share does not depend on their order, so mirror pairs stay mirror pairs."""
         if not limbs:
             return
         if self.symmetry is not None and self.exact:
@@ -137,15 +136,18 @@ class BoneBuilder:
 
     def _sharing(self, meets, ups, starts):
         """The limbs to extend (the keys of ``meets``, where each meets its bone) in groups that share one
-        extension: linked when they hang from the same bone and their starts and meeting points each lie within half
-        a bone length; a linked group is kept only when every two of its limbs are linked (else each goes alone), so
-        the groups do not depend on the limbs' order."""
-        reach = self.tuning.share_reach * self.bone_length
+        extension: linked when they hang from the same bone, meet it within half a bone length of each other, and
+        start within half a bone length or half the longer extension (two extensions that part by less than about
+        30° lie on each other: a fox's ears, which start on its head far from the chest); a linked group is kept only
+        when every two of its limbs are linked (else each goes alone), so the groups do not depend on the limbs'
+        order."""
+        share = self.tuning.share_reach
         limbs = list(meets)
 
         def linked(a, b):
-            return (ups[a] == ups[b] and np.linalg.norm(starts[a] - starts[b]) <= reach
-                    and np.linalg.norm(meets[a] - meets[b]) <= reach)
+            extension = max(np.linalg.norm(starts[a] - meets[a]), np.linalg.norm(starts[b] - meets[b]))
+            return (ups[a] == ups[b] and np.linalg.norm(meets[a] - meets[b]) <= share * self.bone_length
+                    and np.linalg.norm(starts[a] - starts[b]) <= share * max(self.bone_length, extension))
 
         pairs = [(i, j) for i in range(len(limbs)) for j in range(i) if linked(limbs[i], limbs[j])]
         labels = components(len(limbs), np.array(pairs, dtype=np.int64).reshape(-1, 2))

@@ -76,4 +76,5 @@ class Tuning(JointTuning, MirrorTuning):
                                     "(grazing its surface)")
     bridge_reach: float = tuned(1.0, "a hidden limb starting farther than this from its bone is extended back to it")
     share_reach: float = tuned(0.5, "limbs extended from one bone share the extension when their starts and "
-                                    "meeting points lie this close")
+                                    "meeting points lie this close (their starts: or this share of the longer "
+                                    "extension, parting by under 30°)")
