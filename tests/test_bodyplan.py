@@ -8,6 +8,7 @@ import pytest
 import rigger
 from characters import load_character
 from conftest import shared_path
+from meshes import box, combine
 from rigdata import load_obj
 from rigger import samples
 from rigger.core.body import read_body
@@ -15,7 +16,7 @@ from rigger.core.bodyplan import KINDS, BodyPlan, recognise
 from rigger.core.mesh import Mesh
 from rigger.core.roles import LANDMARKS, ROLES, BoneRole, Roles, landmarks, named_joints
 from rigger.core.skeleton import Skeleton
-from rigger.core.stages import Labels
+from rigger.core.stages import Labels, MirrorPlane
 
 PLANS = {"humanoid": "humanoid", "humanoid_hips": "humanoid", "quadruped": "quadruped", "octopus": "other",
          "tree": "other", "snake": "fish"}
@@ -337,6 +338,17 @@ def test_a_plain_stick_is_no_known_plan():
     stick = Skeleton(["stick"], [[0.05, 0.05, 0.0]], [[0.05, 0.05, 1.0]], [-1])
     plan, roles = recognise(stick, Mesh(vertices, triangles))
     assert plan.kind == "other" and roles == (BoneRole("other"),) and plan.kind in KINDS
+
+
+def test_two_parts_far_apart_across_their_mirror_plane_stand_some_way():
+    """Two cubes 1000 apart along x: thin along y and z beside that, and the mirror plane's normal is x, so no axis
+    is a candidate for up among the thick ones: up is then chosen among all, and a plan read."""
+    vertices, triangles = combine(box((0, 0, 0), (1, 1, 1)), box((1000, 0, 0), (1001, 1, 1)))
+    two = Skeleton(["left", "right"], [[0.5, 0.0, 0.5], [1000.5, 0.0, 0.5]], [[0.5, 1.0, 0.5], [1000.5, 1.0, 0.5]],
+                   [-1, -1])
+    plane = MirrorPlane(0, 500.5, np.eye(3)[0])
+    plan, roles = recognise(two, Mesh(vertices, triangles), plane=plane)
+    assert plan.kind in KINDS and len(roles) == 2
 
 
 @pytest.mark.parametrize("arguments, message", [

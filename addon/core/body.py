@@ -414,19 +414,11 @@ def _up_axis(graph, tips, radius, mesh, sample, plane, size, tuning, prefer_up):
     touch the ground at its bottom (their leaf ``tips``: the body's own ends are no feet), plus its flat bottom area
     as a share of the best candidate's (or of ``flat_area`` when none has that much), spread over the vertex
     ``sample``; ``prefer_up`` breaks ties. The evidence is "legs", "flat" or "preferred"."""
-    candidates = []
     low, high = mesh.bbox
-    for axis in range(3):
-        if high[axis] - low[axis] <= 2 * tuning.midline * size:
-            continue  # a flat mesh stands in its own plane
-        for sign in (1.0, -1.0):
-            up = sign * AXES[axis]
-            if plane is not None and abs(up @ plane.normal) > 0.5:
-                continue
-            if plane is not None:
-                up = up - (up @ plane.normal) * plane.normal
-                up /= np.linalg.norm(up)
-            candidates.append(up)
+    thick = [axis for axis in range(3) if high[axis] - low[axis] > 2 * tuning.midline * size]
+    # a flat mesh stands in its own plane; a mesh flat but along the mirror plane's normal (two parts far apart
+    # across it) stands any way
+    candidates = _up_candidates(thick, plane) or _up_candidates(range(3), plane)
     corners = mesh.vertices[_sampled(mesh.triangles, tuning.sample_triangles)]
     normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     areas = np.linalg.norm(normals, axis=1)
@@ -455,6 +447,22 @@ def _up_axis(graph, tips, radius, mesh, sample, plane, size, tuning, prefer_up):
     if flat >= tuning.flat_area:
         return up, "flat"
     return up, "preferred"
+
+
+def _up_candidates(axes, plane):
+    """Both directions of each of ``axes`` (indices) as up candidates, none along the mirror ``plane``'s normal (a
+    body's up lies in its mirror plane), each made to lie in the plane."""
+    candidates = []
+    for axis in axes:
+        for sign in (1.0, -1.0):
+            up = sign * AXES[axis]
+            if plane is not None:
+                if abs(up @ plane.normal) > 0.5:
+                    continue
+                up = up - (up @ plane.normal) * plane.normal
+                up /= np.linalg.norm(up)
+            candidates.append(up)
+    return candidates
 
 
 def _spread(base, vertices, up):
