@@ -13,6 +13,7 @@ import pathlib
 import sys
 
 from .axes import AXES, AXIS_SUFFIXES, file_axes
+from .core import bvh
 from .core.targets import TARGETS
 
 INPUTS = (".obj", ".glb", ".gltf", ".fbx", ".blend")
@@ -168,6 +169,10 @@ def _run_rig(args):
                            f"--target {settings.target}")
         if not args.animate.is_file():
             raise CliError(f"{args.animate}: no such BVH file")
+        try:
+            bvh.check(args.animate)  # before the slow rigging
+        except bvh.BvhError as error:
+            raise CliError(str(error)) from None
     try:
         file_axes(source.suffix, args.up, args.forward)
     except ValueError as error:

@@ -4,6 +4,7 @@ import json
 import numpy as np
 import pytest
 
+from rigger.core import bvh
 from rigger.core.mesh import Mesh, triangulate_polygons
 from rigger.core.params import Param, resolve
 from rigger.core.skeleton import Skeleton
@@ -332,3 +333,54 @@ def test_every_body_plan_fills_the_plain_target_and_unknown_targets_are_named():
         assert choose_target("plain", plan) == (TARGETS["plain"], None)
     with pytest.raises(ValueError, match="unknown target 'mocap'; targets are plain"):
         check_target("mocap")
+
+
+BVH = """HIERARCHY
+ROOT Hips
+{
+\tOFFSET 0 0 0
+\tCHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation
+\tJOINT Spine
+\t{
+\t\tOFFSET 0 1 0
+\t\tCHANNELS 3 Zrotation Yrotation Xrotation
+\t\tEnd Site
+\t\t{
+\t\t\tOFFSET 0 1 0
+\t\t}
+\t}
+}
+MOTION
+Frames:\t2
+Frame Time: 0.04
+0 0 0 0 0 0 0 0 0
+0 0 1 0 0 0 10 0 0
+"""
+
+
+def test_a_bvh_file_is_checked_without_blender(tmp_path):
+    path = tmp_path / "walk.bvh"
+    path.write_text(BVH)
+    assert bvh.check(path) == bvh.BvhSummary(("Hips", "Spine"), 9, 2, 0.04)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("", "not a BVH file (no MOTION section)"),
+    ("v 0 0 0\nf 1 2 3\n", "not a BVH file (no MOTION section)"),
+    (BVH.replace("HIERARCHY", "HIERARCHIES"), "not a BVH file (it does not begin with HIERARCHY and a ROOT joint)"),
+    (BVH.replace("\t}\n}", "\t}\n"), "the HIERARCHY's braces do not balance"),
+    (BVH.replace("\t\tCHANNELS", "\t\tCHANNELZ"), "unexpected 'CHANNELZ' in the HIERARCHY"),
+    (BVH.replace("Frames:\t2", "Frames: 0"), "the BVH file holds no frames"),
+    (BVH.replace("Frames:\t2", "Frames: two"), "'Frames:' is not followed by a number"),
+    (BVH.replace("Frame Time: 0.04", "Frame Time: 0"), "'Frame Time:' must be a positive number"),
+    (BVH.replace("Frames:\t2", "Frames: 3"), "holds 2 frame lines of the 3 it announces (cut short?)"),
+    (BVH.replace("0 0 1 0 0 0 10 0 0", "0 0 1 0 0 0 10 0"), "frame 2 has 8 values, not the 9 the HIERARCHY's"),
+    (BVH.replace("0 0 1 0 0 0 10 0 0", "0 0 1 0 0 0 ten 0 0"), "frame 2 holds 'ten', not a finite number"),
+    (BVH.replace("0 0 1 0 0 0 10 0 0", "0 0 1 0 0 0 nan 0 0"), "frame 2 holds 'nan', not a finite number"),
+])
+def test_a_file_that_is_no_readable_bvh_says_why_in_one_line(tmp_path, text, message):
+    path = tmp_path / "bad.bvh"
+    path.write_text(text)
+    with pytest.raises(bvh.BvhError) as error:
+        bvh.check(path)
+    assert message in str(error.value) and "\n" not in str(error.value)

@@ -173,6 +173,18 @@ def test_an_unmappable_bvh_names_what_it_could_not_place(humanoid_file, tmp_path
     assert error.startswith("rigger: error:") and "LeftUpLeg" in error and "Bone3" in error
 
 
+def test_a_bvh_that_is_no_motion_is_one_error_line_before_the_rigging(humanoid_file, tmp_path):
+    cut = tmp_path / "cut.bvh"
+    cut.write_text("".join(short_bvh(tmp_path / "step.bvh").read_text().splitlines(keepends=True)[:-3]))
+    for bvh, message in ((cut, "holds 9 frame lines of the 12 it announces (cut short?)"),
+                         (humanoid_file, "not a BVH file (no MOTION section)")):
+        output = tmp_path / "x.glb"
+        result = run("rig", humanoid_file, "--animate", bvh, "-o", output)
+        assert result.returncode == 1 and not output.exists()
+        assert result.stderr.strip() == f"rigger: error: {bvh}: {message}"
+        assert not result.stdout.strip()  # before Blender imported the model
+
+
 def test_animate_needs_the_game_target(humanoid_file, tmp_path):
     bvh = short_bvh(tmp_path / "step.bvh")
     result = run("rig", humanoid_file, "--animate", bvh, "--target", "plain", "-o", tmp_path / "x.glb")

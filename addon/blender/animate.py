@@ -5,6 +5,7 @@ import pathlib
 import bpy
 import numpy as np
 
+from ..core import bvh
 from ..core.game import ROOT
 from ..core.retarget import Clip, Rig, retarget, sole_bones, sole_points
 from .skinning import weight_entries
@@ -21,6 +22,7 @@ def animate(armature, path):
     path = pathlib.Path(path)
     if not path.is_file():
         raise ValueError(f"{path}: no such BVH file")
+    bvh.check(path)
     if ROOT not in armature.data.bones or "Hips" not in armature.data.bones:
         raise ValueError(f"{armature.name} is no game armature (no {ROOT!r} and 'Hips' bones): rig with the game "
                          f"target to animate")
@@ -50,8 +52,9 @@ def _imported(path):
     before = set(bpy.data.objects)
     try:
         bpy.ops.import_anim.bvh(filepath=str(path), update_scene_fps=True, update_scene_duration=True)
-    except RuntimeError as error:
-        raise ValueError(f"{path}: Blender could not read it as BVH: {str(error).strip()}") from None
+    except RuntimeError as error:  # its message ends a traceback with the error's own line
+        reason = str(error).strip().splitlines()[-1] if str(error).strip() else "no reason given"
+        raise ValueError(f"{path}: Blender could not read it as BVH: {reason}") from None
     made = [obj for obj in bpy.data.objects if obj not in before and obj.type == 'ARMATURE']
     if not made:
         raise ValueError(f"{path}: the BVH file holds no skeleton")
