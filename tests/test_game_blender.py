@@ -12,12 +12,14 @@ bpy = pytest.importorskip("bpy")
 import rigger  # noqa: E402
 from characters import load_character  # noqa: E402
 from conftest import shared_path  # noqa: E402
+from rigger.blender.armature import build_armature  # noqa: E402
 from rigger.blender.game import INFLUENCES  # noqa: E402
 from rigger.blender.pipeline import rig_object, skin_meshes  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
 from rigger.blender.scenefiles import save_scene  # noqa: E402
 from rigger.core.game import ROOT  # noqa: E402
-from test_cli import Y_UP_TO_Z_UP, run, write_obj  # noqa: E402
+from rigger.core.skeleton import Skeleton  # noqa: E402
+from test_cli import Y_UP_TO_Z_UP, glb_document, run, write_obj  # noqa: E402
 
 FRAMES = 12
 
@@ -183,6 +185,31 @@ def test_a_bvh_that_is_no_motion_is_one_error_line_before_the_rigging(humanoid_f
         assert result.returncode == 1 and not output.exists()
         assert result.stderr.strip() == f"rigger: error: {bvh}: {message}"
         assert not result.stdout.strip()  # before Blender imported the model
+
+
+def test_a_replaced_armature_takes_its_motion_along(scene, tmp_path):
+    """A file's armature with a motion of its own: the rig replaces both, so the glTF written holds the new motion
+    alone, not the old bones' too (players play the first one), and the exporter has nothing to warn about."""
+    body = build_character("humanoid", subdivisions=0)
+    old = build_armature(Skeleton(["old"], [(0, 0, 0)], [(0, 0, 1)], [-1]), "OldRig")
+    body.vertex_groups.new(name="old").add(range(len(body.data.vertices)), 1.0, 'REPLACE')
+    body.modifiers.new("Armature", 'ARMATURE').object = old
+    old.pose.bones["old"].rotation_mode = 'XYZ'
+    for frame, angle in ((1, 0.0), (10, 1.0)):
+        old.pose.bones["old"].rotation_euler = (angle, 0.0, 0.0)
+        old.pose.bones["old"].keyframe_insert("rotation_euler", frame=frame)
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "scene.blend"))
+    bpy.ops.export_scene.gltf(filepath=str(tmp_path / "scene.glb"), export_format='GLB')
+    bvh = short_bvh(tmp_path / "step.bvh")
+    for source, output in (("scene.blend", "rigged.blend"), ("scene.glb", "rigged.glb")):
+        result = run("rig", tmp_path / source, "--animate", bvh, "-o", tmp_path / output)
+        assert result.returncode == 0 and "warning: replaced the file's armature 'OldRig'" in result.stderr
+    animations = glb_document(tmp_path / "rigged.glb")["animations"]
+    assert [animation["name"] for animation in animations] == ["humanoid_rig|step"]
+    assert "not found" not in result.stdout
+
+    result = run("rig", tmp_path / "rigged.blend", "-o", tmp_path / "again.blend")  # Rigger's own rig, rigged again
+    assert result.returncode == 0 and "warning: replaced the armature Rigger made for the file before" in result.stderr
 
 
 def test_animate_needs_the_game_target(humanoid_file, tmp_path):

@@ -30,11 +30,19 @@ def build_armature(skeleton, name, collection=None, frame=None):
 
 
 def delete_armature(obj):
-    """Remove armature object ``obj``, and its armature data unless another object uses it too."""
+    """Remove armature object ``obj``, and its armature data and actions (its own and its NLA strips') unless
+    something else uses them too: an exporter writes the actions it finds, and the file's old motion does not fit
+    the new bones."""
     data = obj.data
+    animation = obj.animation_data
+    actions = set() if animation is None else {strip.action for track in animation.nla_tracks
+                                               for strip in track.strips if strip.action} | {animation.action} - {None}
     bpy.data.objects.remove(obj)
     if data.users == 0:
         bpy.data.armatures.remove(data)
+    for action in actions:
+        if action.users == 0:
+            bpy.data.actions.remove(action)
 
 
 def _edit_bones(obj, skeleton, frame):

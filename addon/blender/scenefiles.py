@@ -44,6 +44,7 @@ def rig_file(source, output, method, params, *, target="plain", skin=True, up=No
     meshes.sort(key=lambda obj: -len(obj.data.vertices))
     warnings = release_from_armatures(meshes)
     result = rig_object(meshes[0], method, params, target=target, parts=meshes[1:])
+    warnings += ["replaced the armature Rigger made for the file before"] if result.replaced else []
     outcomes = None
     if skin:
         outcomes, skin_warnings = skin_meshes(meshes, result.armature)
