@@ -11,6 +11,7 @@ import contextlib
 import os
 import pathlib
 import sys
+import tempfile
 
 from .axes import AXES, AXIS_SUFFIXES, file_axes
 from .core import bvh
@@ -28,17 +29,27 @@ class CliError(Exception):
 
 def main(argv=None):
     parser = _parser()
-    args = parser.parse_args(_axis_values_joined(sys.argv[1:] if argv is None else list(argv)))
     try:
+        args = parser.parse_args(_axis_values_joined(sys.argv[1:] if argv is None else list(argv)))
         return args.run(args)
     except CliError as error:
         print(f"rigger: error: {error}", file=sys.stderr)
         return EXIT_FAILED
+    except KeyboardInterrupt:  # outputs are written through temporary files: none is left half-written
+        print("rigger: interrupted; nothing was written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+
+
+class _Parser(argparse.ArgumentParser):
+    """Usage mistakes are one ``rigger: error:`` line and status 1, as every other bad input is."""
+
+    def error(self, message):
+        raise CliError(f"{message} (see `{self.prog} --help`)")
 
 
 def _parser():
-    parser = argparse.ArgumentParser(prog="python -m rigger", description=__doc__.split("\n\n")[0])
-    commands = parser.add_subparsers(dest="command", required=True)
+    parser = _Parser(prog="python -m rigger", description=__doc__.split("\n\n")[0])
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     rig = commands.add_parser("rig", help="rig one model file")
     rig.add_argument("input", type=pathlib.Path, help=f"model file ({', '.join(INPUTS)})")
@@ -154,6 +165,8 @@ def _print_tuning(table):
 
 def _run_rig(args):
     source = args.input
+    if source.is_dir():
+        raise CliError(f"{source}: is a folder, not a model file (`batch` rigs every model in a folder)")
     if not source.is_file():
         raise CliError(f"{source}: no such file")
     if source.suffix.lower() not in INPUTS:
@@ -244,6 +257,12 @@ def _check_folder(folder, role):
         raise CliError(f"{existing}: is not a folder, so {role} cannot go in {folder}")
     if not os.access(existing, os.W_OK | os.X_OK):
         raise CliError(f"{existing}: cannot write there, so {role} cannot go in {folder}")
+    if existing == folder.absolute():  # try it: access() says yes to root, and to file systems that refuse files
+        try:
+            tempfile.TemporaryFile(dir=existing).close()
+        except OSError as error:
+            raise CliError(f"{existing}: cannot write there ({error.strerror or error}), so {role} cannot go "
+                           f"in it") from None
 
 
 def _run_batch(args):

@@ -1,5 +1,6 @@
 """``python -m rigger``: rig files end to end in child processes, as a pipeline would, including the error paths."""
 import json
+import pathlib
 
 import numpy as np
 import pytest
@@ -147,6 +148,8 @@ def test_no_skin_and_fbx_output(humanoid_obj, tmp_path):
     ("bad_target", "invalid choice: 'nope'"),
     ("bad_output", "cannot write"),
     ("unreadable", "Blender could not import it"),
+    ("folder", "is a folder, not a model file"),
+    ("refusing_folder", "/proc: cannot write there"),
 ])
 def test_errors_exit_non_zero_with_a_message_and_write_nothing(case, message, humanoid_obj, tmp_path):
     source = humanoid_obj[0]
@@ -169,14 +172,18 @@ def test_errors_exit_non_zero_with_a_message_and_write_nothing(case, message, hu
         extra = ["--method", "nope"]
     elif case == "bad_target":
         extra = ["--target", "nope"]
+    elif case == "folder":
+        source = tmp_path
     out = tmp_path / "out"
     out.mkdir()
     output = out / ("rig.txt" if case == "bad_output" else "rig.blend")
+    if case == "refusing_folder":  # writable by its permissions, but it makes no files (root may write anywhere else)
+        output = pathlib.Path("/proc/rig.blend")
     before = set(files_below(tmp_path))
     result = run("rig", source, "-o", output, "--report", out / "report.json", *extra)
-    assert result.returncode != 0
+    assert result.returncode == 1
     assert message in result.stderr, result.stderr
-    assert "Traceback" not in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and result.stderr.startswith("rigger: error: ")
     assert files_below(out) == []
     assert set(files_below(tmp_path)) == before
 
@@ -308,3 +315,16 @@ def test_methods_lists_every_method_and_its_parameters():
     tuned = run("methods", "--tuning")
     assert tuned.returncode == 0 and "tuning (rigger.methods.silhouette.tuning." in tuned.stdout
     assert "body plan and bone roles (after every method):" in tuned.stdout and "knee_at = " in tuned.stdout
+
+
+def test_ctrl_c_is_one_line_and_the_shell_s_status(monkeypatch, capsys, tmp_path):
+    """Interrupted while rigging (outputs go through temporary files, so none is half-written): one line, no
+    traceback, status 130 as a shell gives a command ended by Ctrl-C."""
+    from rigger import cli
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "_run_rig", interrupted)
+    assert cli.main(["rig", str(tmp_path / "model.obj")]) == 130
+    assert capsys.readouterr().err == "rigger: interrupted; nothing was written\n"
