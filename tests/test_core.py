@@ -384,3 +384,14 @@ def test_a_file_that_is_no_readable_bvh_says_why_in_one_line(tmp_path, text, mes
     with pytest.raises(bvh.BvhError) as error:
         bvh.check(path)
     assert message in str(error.value) and "\n" not in str(error.value)
+
+
+def test_a_blender_operator_error_is_one_clause():
+    """bpy puts "Error:" before an operator's message, and an add-on's operator may put its whole traceback there
+    (Blender's BVH importer, Rigify's generate): the last line says what went wrong."""
+    from rigger.blender.headless import blender_message
+
+    assert blender_message(RuntimeError("Error: Cannot read file\n")) == "Cannot read file"
+    traceback = "Error: Python: Traceback (most recent call last):\n  File \"x.py\", line 3\nIndexError: list index\n"
+    assert blender_message(RuntimeError(traceback)) == "IndexError: list index"
+    assert blender_message(RuntimeError("")) == "no reason given"

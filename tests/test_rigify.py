@@ -344,6 +344,21 @@ def test_rigging_again_replaces_the_rig_its_metarig_and_rigifys_widgets(register
     assert scene_objects() == ["humanoid", "humanoid_rig"] and not bpy.data.collections and not bpy.data.texts
 
 
+def test_a_model_a_million_times_smaller_gets_the_same_rig_scaled(registered, rigged):
+    """A humanoid modelled in kilometres (1e-6 of the sample's size): Blender lengthens bones under about 1e-6, so
+    the metarig is built magnified in its own space and its object, like the rig's, shrinks it back. The rig is the
+    full-size one's, shrunk: the same DEF bones at a millionth of their places, every vertex weighted."""
+    _, full, _ = rigged
+    empty_scene()
+    obj = build_character("humanoid")
+    obj.data.transform(Matrix.Scale(1e-6, 4))
+    result = rig_object(obj, "silhouette", target="rigify")
+    assert list(result.bones.names) == list(full.bones.names)
+    np.testing.assert_allclose(result.bones.heads, 1e-6 * full.bones.heads, atol=1e-3 * 1e-6)
+    outcomes, _ = skin_meshes([obj], result.armature)
+    assert outcomes[obj.name].unweighted == 0
+
+
 def test_a_snake_falls_back_to_the_game_rig_with_a_message(registered):
     empty_scene()
     result = rig_object(build_character("snake"), "silhouette", target="rigify")

@@ -76,6 +76,7 @@ def rig_to_files(source, output, report, settings):
     ``timings["file_cpu"]`` the CPU time the process spent on it meanwhile (less than that when it waited for a
     core). FileFailed says what went wrong."""
     from ..blender import scenefiles
+    from ..blender.headless import blender_message
 
     start, cpu = time.perf_counter(), time.process_time()
     try:
@@ -92,7 +93,7 @@ def rig_to_files(source, output, report, settings):
     except ValueError as error:
         raise FileFailed(str(error)) from None
     except RuntimeError as error:  # a Blender operator failed (an exporter, say)
-        raise FileFailed(f"{source}: {scenefiles.blender_message(error)}") from None
+        raise FileFailed(f"{source}: {blender_message(error)}") from None
     except OSError as error:  # a folder that cannot be written, a full disk
         raise FileFailed(f"{error.filename or output}: {error.strerror or error}") from None
     return data

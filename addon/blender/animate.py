@@ -8,6 +8,7 @@ import numpy as np
 from ..core import bvh
 from ..core.game import ROOT
 from ..core.retarget import Clip, Rig, retarget, sole_bones, sole_points
+from .headless import blender_message
 from .skinning import weight_entries
 
 CARRIED = 0.5  # a skin vertex rides rigidly enough on the bone that carries more than this share of it
@@ -52,9 +53,8 @@ def _imported(path):
     before = set(bpy.data.objects)
     try:
         bpy.ops.import_anim.bvh(filepath=str(path), update_scene_fps=True, update_scene_duration=True)
-    except RuntimeError as error:  # its message ends a traceback with the error's own line
-        reason = str(error).strip().splitlines()[-1] if str(error).strip() else "no reason given"
-        raise ValueError(f"{path}: Blender could not read it as BVH: {reason}") from None
+    except RuntimeError as error:
+        raise ValueError(f"{path}: Blender could not read it as BVH: {blender_message(error)}") from None
     made = [obj for obj in bpy.data.objects if obj not in before and obj.type == 'ARMATURE']
     if not made:
         raise ValueError(f"{path}: the BVH file holds no skeleton")

@@ -27,3 +27,10 @@ def empty_scene():
 
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
     return bpy.context.scene
+
+
+def blender_message(error):
+    """A Blender operator's error (its RuntimeError) as one clause: the last line of its text (an add-on's operator
+    may put its whole traceback there) without the "Error:" prefix bpy puts before it."""
+    lines = str(error).strip().splitlines()
+    return (lines[-1] if lines else "no reason given").strip().removeprefix("Error:").strip()

@@ -23,12 +23,14 @@ from mathutils import Matrix, Vector
 from ..core.metarig import METARIGS, MetaBone, choose_metarig, fit_metarig
 from ..core.roles import BoneRole
 from ..core.skeleton import Skeleton
+from .headless import blender_message
 from .meshdata import world_points
 
 ADDON = "rigify"
 METARIG_PROPERTY = "rigger_metarig"  # custom property on the generated rig: its metarig object
 KIND_PROPERTY = "rigger_metarig_kind"  # custom property on the metarig: which of Rigify's metarigs it is
 DEFORM_PREFIX, ORIGINAL_PREFIX = "DEF-", "ORG-"  # Rigify's deforming bones and the metarig's bones in the rig
+SHORTEST_BONE = 1e-4  # the shortest metarig bone built (Blender lengthens bones under about 1e-6)
 
 
 def ensure_rigify():
@@ -64,8 +66,9 @@ def build_rigify(skeleton, name, collection, frame, mesh=None):
     rig = None
     try:
         fit = fit_metarig(skeleton, mesh, metarig_name, read_metarig(metarig))
-        metarig.matrix_world = Matrix(fit.frame.tolist()).to_4x4()
-        place_bones(metarig, fit)
+        scale = working_scale(fit)
+        metarig.matrix_world = Matrix(fit.frame.tolist()).to_4x4() @ Matrix.Scale(1.0 / scale, 4)
+        place_bones(metarig, fit, scale)
         rig = bpy.data.objects.new(name, bpy.data.armatures.new(name))
         collection.objects.link(rig)
         generate(metarig, rig)
@@ -139,13 +142,25 @@ def read_metarig(metarig):
     return bones
 
 
-def place_bones(metarig, fit):
-    """Move the metarig's bones where ``fit`` (a ``core.metarig.Fit``) puts them, remove the ones it removed (their
-    children hang from the nearest kept bone above) and roll each as the metarig rolled it; a bone stays connected
-    to its parent where its head still lies on the parent's tail."""
+def working_scale(fit):
+    """1, or the power of two (exact) by which the metarig's bones are magnified in its own space, its object
+    shrinking them back, so that the shortest fitted bone is at least ``SHORTEST_BONE`` long: Blender lengthens
+    shorter bones, which then no longer meet their parents, and Rigify's chains break (a model made in metres
+    read as kilometres)."""
+    shortest = min(float(np.linalg.norm(np.subtract(fit.tails[name], fit.heads[name]))) for name in fit.heads)
+    if shortest >= SHORTEST_BONE:
+        return 1.0
+    return float(2.0 ** np.ceil(np.log2(SHORTEST_BONE / max(shortest, 1e-300))))
+
+
+def place_bones(metarig, fit, scale=1.0):
+    """Move the metarig's bones where ``fit`` (a ``core.metarig.Fit``) puts them, magnified ``scale`` times
+    (``working_scale``), remove the ones it removed (their children hang from the nearest kept bone above) and roll
+    each as the metarig rolled it; a bone stays connected to its parent where its head still lies on the parent's
+    tail."""
     def change(bones):
         connected = {bone.name for bone in bones if bone.use_connect}
-        ends = np.array([end for name in fit.heads for end in (fit.heads[name], fit.tails[name])])
+        ends = scale * np.array([end for name in fit.heads for end in (fit.heads[name], fit.tails[name])])
         size = max(float(np.ptp(ends, axis=0).max()), 1e-300)
         removed = set(fit.removed)
         for bone in bones:
@@ -159,7 +174,8 @@ def place_bones(metarig, fit):
             bones.remove(bones[name])
         for name in fit.heads:
             bone = bones[name]
-            bone.head, bone.tail = Vector(fit.heads[name]), Vector(fit.tails[name])
+            bone.head = Vector(scale * np.asarray(fit.heads[name]))
+            bone.tail = Vector(scale * np.asarray(fit.tails[name]))
             bone.align_roll(Vector(fit.z_axes[name]))
         for bone in bones:
             if bone.name in connected and bone.parent is not None and \
@@ -179,11 +195,11 @@ def generate(metarig, rig):
     view_layer.objects.active = metarig
     metarig.select_set(True)
     printed = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(printed):
+    try:  # Rigify prints its progress, and a traceback when it fails: the error says what went wrong
+        with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(printed):
             result = bpy.ops.pose.rigify_generate()
     except RuntimeError as error:
-        raise ValueError(f"Rigify could not generate the rig: {str(error).strip()}") from None
+        raise ValueError(f"Rigify could not generate the rig: {blender_message(error)}") from None
     if 'FINISHED' not in result:
         raise ValueError(f"Rigify could not generate the rig: {printed.getvalue().strip()[-300:]}")
     _object_mode()

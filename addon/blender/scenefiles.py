@@ -9,7 +9,7 @@ from ..axes import axes_field, file_axes, to_blender
 from ..core.files import replaced_on_success
 from . import overlays, skinning
 from .armature import delete_armature
-from .headless import empty_scene
+from .headless import blender_message, empty_scene
 from .pipeline import METHOD_PROPERTY, TARGET_PROPERTY, rig_object, skin_meshes, skin_summary
 from .properties import ARMATURE_POINTER
 
@@ -104,11 +104,6 @@ def _drives_something(armature):
     return any(obj.parent == armature or any(modifier.type == 'ARMATURE' and modifier.object == armature
                                              for modifier in obj.modifiers)
                for obj in bpy.data.objects)
-
-
-def blender_message(error):
-    """A Blender operator's error as one clause: its text without the "Error:" prefix bpy puts before it."""
-    return str(error).strip().removeprefix("Error:").strip()
 
 
 def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warnings=(), axes=None):
