@@ -43,6 +43,25 @@ def bones_of(armature):
             for bone in armature.data.bones}
 
 
+def test_a_humanoid_game_rig_without_forearms_says_which_bones_it_lacks(scene):
+    """Arms that end at the upper arm (the method found no forearm, as on homer seen from the front): the game rig
+    has no ForeArm or Hand, and a warning names them, since a motion's elbows and wrists will drive nothing."""
+    from rigger.blender import game
+
+    vertices, triangles = load_character("humanoid")
+    full = rigger.rig_mesh(vertices, triangles)
+    keep = [b for b, role in enumerate(full.roles) if role.role not in ("forearm", "hand", "finger")]
+    index = {b: k for k, b in enumerate(keep)}
+    armless = Skeleton([full.names[b] for b in keep], full.heads[keep], full.tails[keep],
+                       [index[full.parents[b]] if full.parents[b] >= 0 else -1 for b in keep],
+                       roles=[full.roles[b] for b in keep], body_plan=full.body_plan)
+    built = game.build(armless, "armless", scene.collection, np.eye(3), mesh=(vertices, triangles))
+    assert {"LeftArm", "RightArm"} <= set(built.bones.names) and "LeftForeArm" not in built.bones.names
+    assert built.warnings == ["the humanoid's game rig has no LeftForeArm, LeftHand, RightForeArm, RightHand: "
+                              "Rigger's skeleton shows no such part, and a motion's joints for them drive nothing"]
+    assert game.build(full, "full", scene.collection, np.eye(3), mesh=(vertices, triangles)).warnings == []
+
+
 def test_game_armature_weights_and_mirrored_rolls(scene):
     obj, result, report = game_character()
     armature = result.armature

@@ -4,7 +4,7 @@ import time
 
 import numpy as np
 
-from ..core.game import ROOT, game_skeleton
+from ..core.game import ROOT, game_skeleton, missing_humanoid_bones
 from .armature import build_armature
 from .skinning import SkinStage
 
@@ -22,7 +22,10 @@ def build(skeleton, name, collection, frame, mesh=None):
     game = game_skeleton(skeleton, mesh[0])
     armature = build_armature(game.skeleton, name, collection, frame=frame)
     armature.data.bones[ROOT].use_deform = False
-    return Built(armature, game.skeleton)
+    missing = missing_humanoid_bones(game.skeleton.names) if skeleton.body_plan.kind == "humanoid" else []
+    warnings = [f"the humanoid's game rig has no {', '.join(missing)}: Rigger's skeleton shows no such part, and "
+                f"a motion's joints for them drive nothing"] if missing else []
+    return Built(armature, game.skeleton, warnings=warnings)
 
 
 def finish_skin(mesh_obj, armature, report):

@@ -61,6 +61,14 @@ ENDS = (("ForeArm", "Hand", ("hand",), ("hand_tip",), ("finger",)),
         ("Leg", "Foot", ("foot",), ("toe", "toe_tip"), ("toe",)),
         ("Neck", "Head", ("head",), ("head_top",), ("jaw", "ear")))
 END_SHARE = 0.5  # an end bone with nowhere to end goes on along its limb bone for this share of that bone's length
+HUMANOID = ("Hips", "Spine", "Spine1", "Spine2", "Neck", "Head",
+            *(f"{side}{word}" for side in ("Left", "Right")
+              for word in ("Shoulder", "Arm", "ForeArm", "Hand", "UpLeg", "Leg", "Foot")))  # what engines expect
+
+
+def missing_humanoid_bones(names):
+    """The bones of ``HUMANOID`` (a game engine's humanoid, less fingers and toes) that ``names`` lacks."""
+    return [name for name in HUMANOID if name not in names]
 
 
 @dataclass(frozen=True)
