@@ -1,12 +1,15 @@
 """``rig_mesh``: the one call scripts, the CLI and the Blender layer use to turn a mesh into a skeleton."""
 import time
 
+import numpy as np
+
 from .core.bodyplan import recognise
 from .core.mesh import Mesh
 from .core.params import resolve
 from .core.registry import RigMethod, check_method, discover
 from .core.roles import Roles
 from .core.skeleton import Skeleton
+from .core.stages import Placement
 
 _registry = None
 
@@ -23,7 +26,7 @@ def method_registry(*, refresh=False, folder=None):
     return _registry
 
 
-def rig_mesh(vertices, triangles, method="silhouette", **params):
+def rig_mesh(vertices, triangles, method="silhouette", *, axes=None, **params):
     """Rig a triangle mesh and return its :class:`~rigger.core.skeleton.Skeleton`.
 
     Args:
@@ -31,6 +34,11 @@ def rig_mesh(vertices, triangles, method="silhouette", **params):
         triangles: (M, 3) array-like of vertex indices.
         method: a method name from :func:`method_registry`, a :class:`~rigger.core.registry.RigMethod` subclass
             (e.g. one defined in a script) or an instance of one (e.g. with its tuning changed).
+        axes: None, or a 3x3 rotation whose rows are the directions (in the mesh's coordinates) the method takes as
+            its X, Y and Z: the mesh is turned into that frame for the method, and its skeleton and stages turned
+            back; vector parameters (a view direction) are directions in the mesh's coordinates and turn with it.
+            The Blender layer passes a rigged object's own axes, so a character turned about Z rigs as if it stood
+            square to the world.
         **params: the method's parameters by name; values may be strings as typed on a command line.
 
     Raises ValueError for an unknown method (naming the available ones and any that failed to load), unknown or
@@ -43,7 +51,10 @@ def rig_mesh(vertices, triangles, method="silhouette", **params):
     rigging = _method(method)
     values = resolve(rigging.params, params)
     mesh = Mesh(vertices, triangles)
-    skeleton = rigging.rig(mesh, **values)
+    if axes is None:
+        skeleton = rigging.rig(mesh, **values)
+    else:
+        skeleton = _rigged_along(rigging, mesh, _rotation(axes), values)
     if not isinstance(skeleton, Skeleton):
         raise TypeError(f"method {rigging.name!r} returned {type(skeleton).__name__}, not a Skeleton")
     skeleton.params = values
@@ -52,6 +63,35 @@ def rig_mesh(vertices, triangles, method="silhouette", **params):
     skeleton.stages["roles"] = Roles.of(skeleton, skeleton.roles)
     skeleton.timings["body_plan"] = time.perf_counter() - recognised
     skeleton.timings["total"] = time.perf_counter() - start
+    return skeleton
+
+
+def _rotation(axes):
+    """``axes`` as a (3, 3) float64 rotation; ValueError unless its rows are orthonormal and right-handed."""
+    try:
+        rotation = np.array(axes, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"axes must be a 3x3 rotation, got {axes!r}") from None
+    if rotation.shape != (3, 3) or not np.isfinite(rotation).all():
+        raise ValueError(f"axes must be a finite 3x3 rotation, got shape {rotation.shape}")
+    if not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-6) or np.linalg.det(rotation) < 0:
+        raise ValueError("axes must be a rotation: orthonormal rows, right-handed")
+    return rotation
+
+
+def _rigged_along(rigging, mesh, rotation, values):
+    """The skeleton ``rigging`` makes of ``mesh`` turned into the frame whose axes are ``rotation``'s rows, turned
+    back with its stages; vector parameters are turned into the frame first."""
+    kinds = {param.name: param.type for param in rigging.params}
+    turned = {name: tuple(rotation @ np.asarray(value, dtype=np.float64)) if kinds[name] == "vector" else value
+              for name, value in values.items()}
+    inside = rigging.rig(mesh.with_vertices(mesh.vertices @ rotation.T), **turned)
+    if not isinstance(inside, Skeleton):
+        return inside
+    placement = Placement(1.0, rotation)
+    skeleton = Skeleton(inside.names, placement.point(inside.heads), placement.point(inside.tails), inside.parents,
+                        {name: stage.mapped(placement) for name, stage in inside.stages.items()})
+    skeleton.timings = inside.timings
     return skeleton
 
 

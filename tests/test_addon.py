@@ -163,6 +163,24 @@ def test_the_rig_follows_the_objects_transform_and_modifiers(scene):
     assert bpy.context.view_layer.objects.active == armature
 
 
+def test_a_character_turned_off_the_worlds_axes_rigs_as_it_stands_square(scene):
+    """Turned 30° about Z (to face a camera, say), the humanoid shows the world's axes neither its front nor its
+    side; it is rigged along its own axes: the same bones as standing square, turned with it."""
+    obj = build_character("humanoid", subdivisions=0)
+    activate(obj)
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    square = {bone.name: np.array(bone.head_local) for bone in obj.rigger_armature.data.bones}
+    obj.rotation_euler = (0.0, 0.0, np.pi / 6)
+    bpy.context.view_layer.update()
+    activate(obj)
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    turned = {bone.name: np.array(bone.head_local) for bone in obj.rigger_armature.data.bones}
+    assert turned.keys() == square.keys() and any(name.endswith(".L") for name in turned)
+    rotation = np.array(obj.matrix_world)[:3, :3]
+    for name, head in square.items():
+        np.testing.assert_allclose(turned[name], rotation @ head, atol=1e-4)
+
+
 def test_the_rig_keeps_following_the_meshs_parent(scene):
     vehicle = bpy.data.objects.new("Vehicle", None)
     scene.collection.objects.link(vehicle)

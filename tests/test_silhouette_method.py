@@ -605,6 +605,29 @@ def test_auto_view_skips_an_axis_the_mesh_shows_nothing_along():
     assert len(skeleton) >= 1 and skeleton.stages["frame"].direction[0] == 0
 
 
+def test_a_mesh_rigged_along_its_own_axes_gets_its_square_skeleton_turned():
+    """The humanoid turned 30° about Z: seen along the world's axes it shows neither its front nor its side, and the
+    rig is poor; rigged along its own axes (the Blender layer passes an object's), it gets the skeleton it gets
+    standing square, turned with it, its stages too, and a view direction given in its coordinates turns along."""
+    vertices, triangles = load_character("humanoid")
+    turn = np.array([[np.cos(np.pi / 6), -np.sin(np.pi / 6), 0.0], [np.sin(np.pi / 6), np.cos(np.pi / 6), 0.0],
+                     [0.0, 0.0, 1.0]])
+    square = rigger.rig_mesh(vertices, triangles)
+    turned = rigger.rig_mesh(vertices @ turn.T, triangles, axes=turn.T)
+    assert list(turned.names) == list(square.names) and turned.body_plan.kind == "humanoid"
+    np.testing.assert_allclose(turned.heads, square.heads @ turn.T, atol=1e-9)
+    np.testing.assert_allclose(turned.stages["joints"].points, square.stages["joints"].points @ turn.T, atol=1e-9)
+    np.testing.assert_allclose(turned.body_plan.up, turn @ square.body_plan.up, atol=1e-9)
+    along = rigger.rig_mesh(vertices @ turn.T, triangles, axes=turn.T, view="DIRECTION",
+                            view_direction=turn @ [0.0, 1.0, 0.0])
+    np.testing.assert_allclose(along.heads, rigger.rig_mesh(vertices, triangles, view="DIRECTION").heads @ turn.T,
+                               atol=1e-9)
+    for axes, message in ((np.eye(2), "finite 3x3 rotation"), (np.diag([1.0, 1.0, -1.0]), "right-handed"),
+                          (2 * np.eye(3), "orthonormal")):
+        with pytest.raises(ValueError, match=message):
+            rigger.rig_mesh(vertices, triangles, axes=axes)
+
+
 def test_unknown_parameter_is_rejected():
     vertices, triangles = load_character("snake")
     with pytest.raises(ValueError, match="bone_lenght"):

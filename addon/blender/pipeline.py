@@ -60,7 +60,7 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
         vertices, triangles = combined_arrays(meshes)
     clock.lap("read_mesh")
     report(0.1)
-    skeleton = rig_mesh(vertices, triangles, method, **(params or {}))
+    skeleton = rig_mesh(vertices, triangles, method, axes=own_axes(obj), **(params or {}))
     chosen, fell_back = choose_target(target, skeleton.body_plan)
     clock.lap("rig")
     report(0.7)
@@ -87,6 +87,18 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     warnings = [fell_back] if fell_back else []
     return RigResult(armature, meshes, skeleton, chosen, built.bones, replaced, clock.laps, drawn,
                      warnings + built.warnings)
+
+
+def own_axes(obj):
+    """The axes ``rig_mesh`` rigs ``obj`` along: the rotation of its world matrix (rows: its X, Y, Z in the world)
+    when that turns it off the world's axes (a character turned 30° about Z to face a camera), else None: an
+    object square to the world (turned by quarter turns, or not at all) rigs along the world's own, and so does a
+    mirrored one."""
+    left, _, right = np.linalg.svd(np.array(obj.matrix_world, dtype=np.float64)[:3, :3])
+    rotation = left @ right  # the nearest rotation (polar factor): scale and shear left out
+    if np.linalg.det(rotation) < 0 or np.allclose(np.abs(rotation).max(axis=0), 1.0, atol=1e-6):
+        return None
+    return rotation.T
 
 
 @contextlib.contextmanager

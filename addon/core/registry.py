@@ -24,7 +24,7 @@ from .tuning import TuningTable
 METHODS_PACKAGE = __name__.rsplit(".", 2)[0] + ".methods"
 
 # Keyword arguments of rigger.rig_mesh that a parameter name would shadow.
-RESERVED_PARAM_NAMES = frozenset({"vertices", "triangles", "method", "mesh", "self"})
+RESERVED_PARAM_NAMES = frozenset({"vertices", "triangles", "method", "axes", "mesh", "self"})
 
 
 class RigMethod:
