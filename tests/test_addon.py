@@ -215,6 +215,29 @@ def test_rigging_again_replaces_the_previous_rig(scene):
     assert first_groups and len(obj.vertex_groups) == 0 and "rigger_vertex_groups" not in obj
 
 
+def test_rigging_again_carries_the_animation_over_to_the_new_rig(scene):
+    """Keys set on the rig (an Euler turn of one bone), then Rig again with another bone length: the motion goes
+    on, on the new bone of the same name, turning in the same mode, and the report says so."""
+    obj = build_character("humanoid", subdivisions=0)
+    activate(obj)
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    bone = obj.rigger_armature.pose.bones["trunk.01"]
+    bone.rotation_mode = 'XYZ'
+    for frame, angle in ((1, 0.5), (10, 0.0)):
+        bone.rotation_euler = (angle, 0.0, 0.0)
+        bone.keyframe_insert("rotation_euler", frame=frame)
+    motion = obj.rigger_armature.animation_data.action.name
+    activate(obj)
+    scene.rigger.methods.silhouette.bone_length = 0.12
+    result, printed = reports_of(bpy.ops.rigger.rig)
+    assert result == {'FINISHED'} and f"its animation '{motion}' goes on" in printed
+    armature = obj.rigger_armature
+    assert armature.animation_data.action.name == motion and [a.name for a in bpy.data.actions] == [motion]
+    scene.frame_set(1)
+    assert armature.pose.bones["trunk.01"].rotation_mode == 'XYZ'
+    assert armature.pose.bones["trunk.01"].rotation_euler[0] == pytest.approx(0.5)
+
+
 def test_rigging_a_posed_rig_again_fits_the_mesh_at_rest(scene):
     from mathutils import Matrix
     obj = build_character("humanoid", subdivisions=0)
@@ -309,7 +332,8 @@ def test_polls_explain_why_an_operator_cannot_run(scene):
     obj = build_character("snake", subdivisions=0)
     activate(obj)
     assert poll_message(bpy.ops.rigger.rig) is None
-    assert "has no armature yet: rig it first" in poll_message(bpy.ops.rigger.skin)
+    assert "snake's armature was deleted, but still holds the mesh: Rig makes a new one and lets go of the old" \
+        in poll_message(bpy.ops.rigger.skin)
     bpy.ops.object.mode_set(mode='EDIT')
     assert poll_message(bpy.ops.rigger.rig) == "Switch to Object Mode first"
     bpy.ops.object.mode_set(mode='OBJECT')
@@ -350,7 +374,8 @@ def test_skin_refuses_an_armature_the_user_deleted_and_rigging_again_makes_a_new
     activate(obj.rigger_armature)
     assert bpy.ops.object.delete() == {'FINISHED'}  # out of the scene, yet kept alive by the mesh's pointer
     activate(obj)
-    assert "has no armature yet: rig it first" in poll_message(bpy.ops.rigger.skin)
+    assert "snake's armature was deleted, but still holds the mesh: Rig makes a new one and lets go of the old" \
+        in poll_message(bpy.ops.rigger.skin)
     assert bpy.ops.rigger.rig_skin() == {'FINISHED'}
     assert [o for o in bpy.data.objects if o.type == 'ARMATURE'] == [obj.rigger_armature]
     assert obj.parent == obj.rigger_armature and obj.rigger_armature.name in scene.objects

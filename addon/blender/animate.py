@@ -137,11 +137,14 @@ def _soles(armature, names, up):
 
 def bake(armature, rig, motion, name, start):
     """A new action ``name`` on ``armature``: every bone's rotation (quaternion) and the Hips' location, one key per
-    frame from frame ``start``."""
+    frame from frame ``start``. It replaces the armature's action, which goes when nothing else uses it (exporters
+    write the actions they find)."""
     if armature.animation_data is None:
         armature.animation_data_create()
     action = bpy.data.actions.new(name)
-    armature.animation_data.action = action
+    previous, armature.animation_data.action = armature.animation_data.action, action
+    if previous is not None and previous.users == 0:
+        bpy.data.actions.remove(previous)
     frames = start + np.arange(len(motion.rotations), dtype=np.float64)
     channels = [(bone, "rotation_quaternion", motion.rotations[:, k]) for k, bone in enumerate(rig.names)]
     channels.append((rig.names[motion.hips], "location", motion.location))

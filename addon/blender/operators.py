@@ -42,10 +42,12 @@ def skin_targets(context):
     if not meshes:
         return [], None, why
     armature = getattr(meshes[0], ARMATURE_POINTER, None)
-    if armature is not None and context.scene.objects.get(armature.name) != armature:
-        armature = None
-    if armature is None:
+    deleted = armature is not None and context.scene.objects.get(armature.name) != armature
+    if armature is None or deleted:
         armature = next((obj for obj in context.selected_objects if obj.type == 'ARMATURE'), None)
+    if armature is None and deleted:
+        return [], None, (f"{meshes[0].name}'s armature was deleted, but still holds the mesh: Rig makes a new one "
+                          f"and lets go of the old")
     if armature is None:
         return [], None, f"{meshes[0].name} has no armature yet: rig it first (or select an armature with it)"
     return meshes, armature, None
@@ -86,7 +88,8 @@ class _RiggerOperator:
         note_overlays(settings, result.skeleton.stages, result.overlays)
         seconds = sum(result.timings.values())
         names = ", ".join(mesh.name for mesh in meshes)
-        replaced = " (replaced the previous rig)" if result.replaced else ""
+        replaced = "" if not result.replaced else " (replaced the previous rig)" if result.motion is None else \
+            f" (replaced the previous rig; its animation {result.motion!r} goes on, on the bones of the same names)"
         plan = result.skeleton.body_plan
         notes = [*result.warnings, *([] if plan is None else [plan.warning or plan.summary()])]
         warned = result.warnings or plan is not None and plan.warning

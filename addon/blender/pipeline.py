@@ -23,8 +23,8 @@ TARGET_PROPERTY = "rigger_target"  # ... and the output target it was built as
 class RigResult:
     """What :func:`rig_object` made: the armature object, the meshes it was made for, the method's skeleton (with
     its stages and roles), the ``core.targets.Target`` built and the armature's deforming bones as a skeleton in
-    world space (the method's skeleton itself for ``plain``), whether a previous Rigger armature was replaced,
-    seconds per step, the overlay objects by stage name (none unless asked for) and warnings (a target that fell
+    world space (the method's skeleton itself for ``plain``), whether a previous Rigger armature was replaced (and
+    the name of its action, which the new one took over), seconds per step, the overlay objects by stage name (none unless asked for) and warnings (a target that fell
     back, say)."""
 
     armature: bpy.types.Object
@@ -36,6 +36,7 @@ class RigResult:
     timings: dict
     overlays: dict
     warnings: list
+    motion: str = None  # the previous armature's action, carried over to this one
 
 
 def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(), show_overlays=None,
@@ -65,6 +66,7 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     clock.lap("rig")
     report(0.7)
     parent = _rig_parent(obj)
+    motion = _previous_motion(meshes)
     replaced = any([remove_rig(mesh) for mesh in meshes])
     collection = shown_collection(obj, bpy.context.view_layer)
     frame = np.array(obj.matrix_world, dtype=np.float64)[:3, :3]
@@ -73,6 +75,8 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     if parent is not None:  # skinning makes the mesh the armature's child: the rig keeps following what moved it
         armature.parent = parent
         armature.matrix_parent_inverse = parent.matrix_world.inverted_safe()
+    if motion is not None:
+        _take_motion(armature, *motion)
     armature[METHOD_PROPERTY] = method if isinstance(method, str) else method.name
     armature[TARGET_PROPERTY] = chosen.name
     for mesh in meshes:
@@ -86,7 +90,33 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     report(1.0)
     warnings = [fell_back] if fell_back else []
     return RigResult(armature, meshes, skeleton, chosen, built.bones, replaced, clock.laps, drawn,
-                     warnings + built.warnings)
+                     warnings + built.warnings, motion[0].name if motion is not None else None)
+
+
+def _previous_motion(meshes):
+    """(action, its fake-user flag, each pose bone's rotation mode) of the armature Rigger made for ``meshes``
+    before, the action held by a fake user while that armature goes (deleting an armature deletes the actions
+    nothing else uses), or None: a motion made on the old rig carries over to the new one, on the bones of the same
+    names."""
+    armature = next((getattr(mesh, ARMATURE_POINTER) for mesh in meshes if getattr(mesh, ARMATURE_POINTER, None)),
+                    None)
+    action = armature.animation_data.action if armature is not None and armature.animation_data else None
+    if action is None:
+        return None
+    flag, action.use_fake_user = action.use_fake_user, True
+    return action, flag, {bone.name: bone.rotation_mode for bone in armature.pose.bones}
+
+
+def _take_motion(armature, action, fake_user, rotation_modes):
+    """Give ``armature`` the previous armature's ``action`` (in its slot, where actions have slots: Blender 4.4+),
+    its bones turning in the modes the old ones did (the action's curves are for those)."""
+    action.use_fake_user = fake_user
+    for bone in armature.pose.bones:
+        bone.rotation_mode = rotation_modes.get(bone.name, bone.rotation_mode)
+    animation = armature.animation_data_create()
+    animation.action = action
+    if getattr(animation, "action_slot", False) is None and len(getattr(action, "slots", ())):
+        animation.action_slot = action.slots[0]
 
 
 def own_axes(obj):
