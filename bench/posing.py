@@ -141,10 +141,15 @@ def skeleton_measures(rig, artist_skeleton, skeleton, vertices, triangles, size)
     plane = pm.mirror_plane(vertices, triangles, size)
     twins = pm.twin_mismatches(skeleton.names, skeleton.heads, skeleton.tails, plane, size)
     unsided = pm.unsided_off_plane(skeleton.names, skeleton.heads, skeleton.tails, plane, size)
+    bone = {name: k for k, name in enumerate(skeleton.names)}
+    measured = [bone[f"{base}.L"] for base in twins] + [bone[name] for name in unsided]
+    local = pm.local_asymmetry(vertices, pm.mirror_surface(vertices, triangles), plane, skeleton.heads,
+                               skeleton.tails, measured, size)
     return {"limb_recall": recall, "chains": len(outcome), "own_recall": own_recall,
             "missed": [str(names[chain[-1]]) for chain, followed in outcome if not followed],
             "plane": {"axis": "XYZ"[plane.axis], "asymmetry": plane.asymmetry, "two_sided": plane.two_sided()},
-            "twins": twins, "unsided": unsided if plane.two_sided() else None}
+            "twins": twins, "unsided": unsided if plane.two_sided() else None,
+            "mesh_asymmetry": {skeleton.names[k]: value for k, value in local.items()}}
 
 
 def measured(folder, seeds, poses, max_degrees, params):
@@ -193,6 +198,7 @@ def summarise(records, seeds):
     recall = [(r["model"], r["skeleton"]["limb_recall"]) for r in good]
     twins = [(r["model"], name, value) for r in good for name, value in r["skeleton"]["twins"].items()]
     unsided = [(r["model"], name) for r in good for name in (r["skeleton"]["unsided"] or [])]
+    asymmetry = {(r["model"], name): value for r in good for name, value in r["skeleton"]["mesh_asymmetry"].items()}
     summary.update({
         "excess_mean": float(np.mean([value for _, value in excess])),
         "excess_over": [(m, v) for m, v in excess if v > TARGET_EXCESS_MAX],
@@ -200,7 +206,11 @@ def summarise(records, seeds):
         "recall_mean": float(np.mean([value for _, value in recall])),
         "recall_low": sorted(recall, key=lambda pair: pair[1])[:3],
         "twins_over": [(m, n, v) for m, n, v in twins if v > TARGET_TWIN], "twin_pairs": len(twins),
+        "twins_over_mirrored": [(m, n, v) for m, n, v in twins if v > TARGET_TWIN
+                                and asymmetry[(m, f"{n}.L")] <= TARGET_TWIN],
         "unsided": unsided, "two_sided": sum(r["skeleton"]["plane"]["two_sided"] for r in good),
+        "unsided_mirrored": [(m, n) for m, n in unsided if asymmetry[(m, n)] <= TARGET_TWIN],
+        "asymmetry": {f"{m} {n}": v for (m, n), v in asymmetry.items()},
         "rigger_bones": sum(r["bones"]["rigger"] for r in good),
         "excess_vs_recall": float(spearmanr([v for _, v in excess], [v for _, v in recall])[0]),
     })
@@ -233,8 +243,11 @@ def target_rows(summary):
     over_cracks = summary["cracks_over"]
     twins_over = summary["twins_over"]
     unsided = summary["unsided"]
+    asymmetry = summary["asymmetry"]
     twin_text = (f"{len(twins_over)} of {summary['twin_pairs']} pairs above; worst "
                  + ", ".join(f"{m} {n} {v:.3f}" for m, n, v in sorted(twins_over, key=lambda t: -t[2])[:3])
+                 + _where_mirrored(len(summary["twins_over_mirrored"]), len(twins_over),
+                                   [asymmetry[f"{m} {n}.L"] for m, n, _ in twins_over])
                  if twins_over else f"all {summary['twin_pairs']} pairs within")
     unsided_models = sorted({model for model, _ in unsided})
     return [
@@ -255,8 +268,21 @@ def target_rows(summary):
          verdict(not twins_over)],
         ["no unsided off-plane bones on two-sided bodies", "—",
          f"{len(unsided)} of {summary['rigger_bones']} bones on {len(unsided_models)} of {summary['two_sided']} "
-         f"two-sided models" if unsided else "none", verdict(not unsided)],
+         f"two-sided models" + _where_mirrored(len(summary["unsided_mirrored"]), len(unsided),
+                                               [asymmetry[f"{m} {n}"] for m, n in unsided])
+         if unsided else "none", verdict(not unsided)],
     ]
+
+
+def _where_mirrored(mirrored, count, asymmetries):
+    """How many of ``count`` bones measured against a target lie where the mesh itself mirrors within
+    ``TARGET_TWIN`` (``posing_math.local_asymmetry``; the others' part of the mesh does not mirror)."""
+    if mirrored == count:
+        return ""
+    if not mirrored:
+        return (f"; all on parts the mesh itself does not mirror (its asymmetry there "
+                f"{min(asymmetries):.3f}–{max(asymmetries):.3f})")
+    return f"; {count - mirrored} of them on parts the mesh itself does not mirror"
 
 
 def model_rows(records, seeds):
@@ -359,7 +385,10 @@ def report(records, summary, run):
         f"distance from a mirrored vertex to the surface's vertices, edge midpoints and face centres); two-sided "
         f"when that asymmetry is ≤ {pm.MIRROR_SYMMETRIC}. Twin mismatch: per `.L`/`.R` pair, the larger distance "
         f"between a head (tail) and the mirror image of its twin's. Unsided: bones without `.L`/`.R` whose midpoint "
-        f"is more than {pm.OFF_PLANE} off the plane of a two-sided body.",
+        f"is more than {pm.OFF_PLANE} off the plane of a two-sided body. Both targets are judged on every bone; "
+        f"beside them, how many lie on parts the mesh itself does not mirror within {TARGET_TWIN} (the median "
+        f"distance from the mirror images of the vertices nearest the bone to the surface): a figure posed with one "
+        f"arm raised, a tail curled to one side, where no rig can mirror.",
         "", "## Rigs", "",
     ]
     if not summary["models"]:

@@ -448,6 +448,14 @@ class MirrorPlane:
         return self.asymmetry <= tolerance
 
 
+def mirror_surface(vertices, triangles):
+    """A KD-tree of the surface's samples (vertices, edge midpoints and face centres): a mirror image that falls
+    between the vertices of a coarser side still lands on one."""
+    corners = vertices[triangles]
+    return cKDTree(np.concatenate([vertices, corners.mean(axis=1),
+                                   (corners + np.roll(corners, 1, axis=1)).reshape(-1, 3) / 2]))
+
+
 def mirror_plane(vertices, triangles, size):
     """Of the three axis planes, each at the offset the mesh is most symmetric about, the one the mesh is most
     symmetric about.
@@ -458,10 +466,7 @@ def mirror_plane(vertices, triangles, size):
     symmetric body holding a prop to one side is not centred on its box). The plane is chosen by the asymmetry
     relative to the mesh's extent across the plane: a thin body mirrors onto itself front to back whatever its shape.
     """
-    corners = vertices[triangles]
-    surface = np.concatenate([vertices, corners.mean(axis=1), (corners + np.roll(corners, 1, axis=1)).reshape(-1, 3)
-                              / 2])
-    tree = cKDTree(surface)
+    tree = mirror_surface(vertices, triangles)
     low, high = vertices.min(axis=0), vertices.max(axis=0)
     probe = vertices[::max(1, len(vertices) // PLANE_PROBES)]
     planes = []
@@ -488,6 +493,18 @@ def twin_mismatches(names, heads, tails, plane, size):
         j = index[f"{match.group(1)}.R"]
         result[match.group(1)] = float(max(np.linalg.norm(heads[i] - plane.mirrored(heads[j])),
                                            np.linalg.norm(tails[i] - plane.mirrored(tails[j])))) / size
+    return result
+
+
+def local_asymmetry(vertices, surface, plane, heads, tails, bones, size):
+    """{bone: the median distance (fraction of size) from the mirror images of the vertices nearest that bone (of all
+    the ``heads``/``tails`` segments) to the ``surface`` (``mirror_surface``)} for each of ``bones``: whether the mesh
+    itself mirrors there (a figure posed with one arm raised does not, however symmetric the rest of it)."""
+    nearest = segment_distances(vertices, np.asarray(heads), np.asarray(tails)).argmin(axis=1)
+    result = {}
+    for bone in bones:
+        near = vertices[nearest == bone]
+        result[bone] = float(np.median(surface.query(plane.mirrored(near))[0])) / size if len(near) else float("nan")
     return result
 
 
