@@ -24,8 +24,8 @@ class RigResult:
     """What :func:`rig_object` made: the armature object, the meshes it was made for, the method's skeleton (with
     its stages and roles), the ``core.targets.Target`` built and the armature's deforming bones as a skeleton in
     world space (the method's skeleton itself for ``plain``), whether a previous Rigger armature was replaced (and
-    the name of its action, which the new one took over), seconds per step, the overlay objects by stage name (none unless asked for) and warnings (a target that fell
-    back, say)."""
+    the name of its action, which the new one took over), seconds per step, the overlay objects by stage name (none
+    unless asked for) and warnings (a target that fell back, say)."""
 
     armature: bpy.types.Object
     meshes: list
