@@ -281,7 +281,7 @@ def test_several_selected_meshes_are_rigged_together_and_all_skinned(scene):
 
 
 def test_rig_builds_the_overlays_the_panel_toggles_and_clear_removes(scene):
-    from rigger.blender.overlays import COLLECTION_NAME, KIND_KEY
+    from rigger.blender.overlays import COLLECTION_NAME, KIND_KEY, OWNER_KEY
     obj = build_character("humanoid", subdivisions=0)
     activate(obj)
     toggle = scene.rigger.overlays.add()  # a script may set a stage's toggle before its first rig
@@ -307,6 +307,12 @@ def test_rig_builds_the_overlays_the_panel_toggles_and_clear_removes(scene):
     assert bpy.ops.rigger.rig() == {'FINISHED'}  # rigging again keeps the toggles as they are
     made = {o[KIND_KEY]: o for o in bpy.data.collections[COLLECTION_NAME].objects}
     assert made["joints"].hide_get() and not made["cdt"].hide_get() and len(toggles) == 8
+    drawn = len(bpy.data.collections[COLLECTION_NAME].objects)
+    obj.name = "Hero"  # renamed, rigged again: the overlays drawn under the old name go with the old rig
+    activate(obj)
+    assert bpy.ops.rigger.rig() == {'FINISHED'}
+    owners = {o[OWNER_KEY] for o in bpy.data.collections[COLLECTION_NAME].objects}
+    assert owners == {"Hero"} and len(bpy.data.collections[COLLECTION_NAME].objects) == drawn
     assert bpy.ops.rigger.clear_overlays() == {'FINISHED'}
     assert COLLECTION_NAME not in bpy.data.collections
     assert not [o for o in bpy.data.objects if KIND_KEY in o] and len(toggles) == 0

@@ -338,6 +338,7 @@ def test_rigging_again_replaces_the_rig_its_metarig_and_rigifys_widgets(register
     widgets = {collection.name for collection in bpy.data.collections}
     rig_object(obj, "silhouette", target="rigify")
     assert scene_objects() == ["humanoid", "humanoid_rig", "humanoid_rig_metarig"]
+    assert sorted(data.name for data in bpy.data.armatures) == ["humanoid_rig", "humanoid_rig_metarig"]  # no copy
     assert {collection.name for collection in bpy.data.collections} == widgets == {"WGTS_humanoid_rig"}
     assert len(bpy.data.texts) == 1
     rig_object(obj, "silhouette", target="plain")  # and a plain rig leaves nothing of Rigify behind

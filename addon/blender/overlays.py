@@ -61,7 +61,7 @@ def build_overlays(stages, owner, *, scale=None, visible=None):
         raise ValueError(f"scale must be a positive finite line radius, got {scale!r}")
 
     drawings = _drawings(stages)
-    _remove_objects(lambda obj: obj.get(OWNER_KEY) == owner)
+    remove_overlays(owner)
     if not drawings:
         return {}
     radius = float(scale) if scale is not None else _line_radius([drawing for _, drawing in drawings.values()])
@@ -81,6 +81,11 @@ def set_overlay_visible(name, visible):
     for obj in objects:
         _show(obj, bool(visible))
     return len(objects)
+
+
+def remove_overlays(owner):
+    """Remove the overlay objects of rig ``owner`` (the name ``build_overlays`` got)."""
+    _remove_objects(lambda obj: obj.get(OWNER_KEY) == owner)
 
 
 def clear_overlays():

@@ -17,6 +17,7 @@ from .rigify import remove_extras
 
 METHOD_PROPERTY = "rigger_method"  # custom property on the armature: the method that made it
 TARGET_PROPERTY = "rigger_target"  # ... and the output target it was built as
+OVERLAYS_PROPERTY = "rigger_overlays"  # ... and the owner its overlays were drawn for (its mesh's name then)
 
 
 @dataclass
@@ -86,6 +87,7 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     drawn = {}
     if show_overlays is not None:
         drawn = overlays.build_overlays(skeleton.stages, obj.name, visible=show_overlays)
+        armature[OVERLAYS_PROPERTY] = obj.name
         clock.lap("overlays")
     report(1.0)
     warnings = [fell_back] if fell_back else []
@@ -197,8 +199,8 @@ def skin_summary(outcomes):
 
 def remove_rig(obj):
     """Delete the armature Rigger made for ``obj`` earlier (with what its target made beside it: Rigify's metarig
-    and widgets), and unbind every mesh made with it (their Armature modifiers, Rigger's vertex groups, the
-    parenting; meshes keep their place). True when there was one."""
+    and widgets; and its overlays), and unbind every mesh made with it (their Armature modifiers, Rigger's vertex
+    groups, the parenting; meshes keep their place). True when there was one."""
     armature = getattr(obj, ARMATURE_POINTER, None)
     if armature is None:
         return False
@@ -206,5 +208,7 @@ def remove_rig(obj):
         skinning.unbind(mesh, armature)
         setattr(mesh, ARMATURE_POINTER, None)
     remove_extras(armature)
+    if OVERLAYS_PROPERTY in armature:  # drawn for the mesh under the name it had then
+        overlays.remove_overlays(armature[OVERLAYS_PROPERTY])
     delete_armature(armature)
     return True

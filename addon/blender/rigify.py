@@ -195,11 +195,15 @@ def generate(metarig, rig):
     view_layer.objects.active = metarig
     metarig.select_set(True)
     printed = io.StringIO()
+    before = set(bpy.data.armatures)
     try:  # Rigify prints its progress, and a traceback when it fails: the error says what went wrong
         with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(printed):
             result = bpy.ops.pose.rigify_generate()
     except RuntimeError as error:
         raise ValueError(f"Rigify could not generate the rig: {blender_message(error)}") from None
+    finally:  # the copy of the metarig's armature Rigify generates from, left unused
+        for data in [data for data in bpy.data.armatures if data not in before and data.users == 0]:
+            bpy.data.armatures.remove(data)
     if 'FINISHED' not in result:
         raise ValueError(f"Rigify could not generate the rig: {printed.getvalue().strip()[-300:]}")
     _object_mode()
