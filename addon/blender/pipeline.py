@@ -135,18 +135,20 @@ def own_axes(obj):
 
 @contextlib.contextmanager
 def _previous_rigs_at_rest(meshes):
-    """Put the armatures Rigger made for ``meshes`` in their rest position meanwhile: a mesh is rigged as it rests,
-    not as the old rig posed it (rigging again removes the old rig, and the pose with it)."""
-    armatures = {armature.name_full: armature for armature in (getattr(mesh, ARMATURE_POINTER, None)
-                                                               for mesh in meshes) if armature is not None}
-    positions = [(armature.data, armature.data.pose_position) for armature in armatures.values()]
-    for data, _ in positions:
-        data.pose_position = 'REST'
+    """Turn off, meanwhile, the Armature modifiers by which the armatures Rigger made for ``meshes`` deform them: a
+    mesh is rigged as it rests, not as the old rig posed it (rigging again removes the old rig, and the pose with
+    it), and exactly so (an armature at its rest pose still moves vertices by float rounding, and a rig made of
+    those differs from the first where a choice is close)."""
+    armatures = {getattr(mesh, ARMATURE_POINTER, None) for mesh in meshes} - {None}
+    modifiers = [modifier for mesh in meshes for modifier in mesh.modifiers
+                 if modifier.type == 'ARMATURE' and modifier.object in armatures and modifier.show_viewport]
+    for modifier in modifiers:
+        modifier.show_viewport = False
     try:
         yield
     finally:
-        for data, position in positions:
-            data.pose_position = position
+        for modifier in modifiers:
+            modifier.show_viewport = True
 
 
 def _rig_parent(obj):
