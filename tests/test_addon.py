@@ -346,6 +346,18 @@ def test_polls_explain_why_an_operator_cannot_run(scene):
     assert poll_message(bpy.ops.rigger.clear_overlays) == "There are no overlays to clear"
 
 
+def test_a_head_on_two_stubs_is_no_humanoid(scene):
+    """Suzanne, Blender's monkey head: its ears and chin read as two legs under a body that leans 110° from up,
+    below its hips. No plan fits that (a humanoid stands up, a bird's body lies level): the rig stays plain and the
+    report says why."""
+    bpy.ops.mesh.primitive_monkey_add()
+    obj = bpy.context.active_object
+    activate(obj)
+    result, printed = reports_of(bpy.ops.rigger.rig)
+    assert result == {'FINISHED'} and "below its hips: not a body plan Rigger knows" in printed
+    assert obj.rigger_armature["rigger_target"] == "plain"
+
+
 def test_a_mesh_without_faces_is_reported_not_raised(scene):
     mesh = bpy.data.meshes.new("points")
     mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1)], [])

@@ -54,6 +54,8 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
                                    "wing or a fin (a bird's wings 0.2 to 0.35, arms 0.55 or rounder)")
     front_back: float = tuned(0.15, "feet this far apart along the body stand in two rows, front and back")
     upright: float = tuned(45.0, "degrees: a biped whose torso leans less than this from up is a humanoid")
+    overturned: float = tuned(100.0, "degrees: a biped whose body leans more than this from up hangs below its hips: "
+                                     "no plan (a bird's body leans about 90)")
     long_limb: float = tuned(0.2, "limbs at least this long are arms, wings or legs; shorter ones ears, fins or stubs")
     small_body: float = tuned(0.25, "a spine shorter than this is a small body (a bat's, between its wings)")
     many_limbs: int = tuned(6, "this many long limbs off the plane besides the legs are no known plan (an "
@@ -189,6 +191,9 @@ def lay_out(body, tuning=BodyPlanTuning()):
     if len(rows) == 1:
         spine, hips = _biped_spine(body, legs)
         lean = _lean(body, spine, hips)
+        if lean > tuning.overturned:
+            return _other(body, parts, f"{len(legs)} legs under a body leaning {lean:.0f} degrees, below its hips: "
+                                       f"not a body plan Rigger knows", confidence)
         paired = all(limbs[k].twin in legs for k in legs)
         margin = min(1.0, abs(lean - tuning.upright) / tuning.upright)
         chest = _chest(body, spine, hips, legs, lengths, tuning)
