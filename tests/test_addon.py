@@ -338,8 +338,10 @@ def test_polls_explain_why_an_operator_cannot_run(scene):
     obj = build_character("snake", subdivisions=0)
     activate(obj)
     assert poll_message(bpy.ops.rigger.rig) is None
-    assert "snake's armature was deleted, but still holds the mesh: Rig makes a new one and lets go of the old" \
-        in poll_message(bpy.ops.rigger.skin)
+    assert "has no armature yet: rig it first" in poll_message(bpy.ops.rigger.skin)
+    bpy.context.view_layer.objects.active = None  # selected, but not active
+    assert poll_message(bpy.ops.rigger.rig) == "Make one of the selected meshes active (click it)"
+    activate(obj)
     bpy.ops.object.mode_set(mode='EDIT')
     assert poll_message(bpy.ops.rigger.rig) == "Switch to Object Mode first"
     bpy.ops.object.mode_set(mode='OBJECT')

@@ -21,7 +21,8 @@ def rig_targets(context):
     Rigger armature (rigging again); else ([], why not)."""
     obj = context.active_object
     if obj is None:
-        return [], "Select a mesh object"
+        selected = any(other.type == 'MESH' for other in context.selected_objects)
+        return [], "Make one of the selected meshes active (click it)" if selected else "Select a mesh object"
     if obj.type == 'MESH':
         return [obj, *(other for other in context.selected_objects if other.type == 'MESH' and other != obj)], None
     if obj.type == 'ARMATURE':
