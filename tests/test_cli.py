@@ -112,6 +112,24 @@ def test_a_blend_is_rigged_as_its_scene_shows_it(scene, tmp_path):
     assert "OldRig" not in objects
 
 
+def test_a_floor_and_a_mesh_standing_apart_are_left_out_of_the_rig(scene, tmp_path):
+    """A humanoid on a floor plane, a crate standing 3 m away: rigged together, the floor seen from above is the
+    widest silhouette and the rig is lost in it. Both are left out, with a warning each, and saved unrigged."""
+    build_character("humanoid", subdivisions=0)
+    bpy.ops.mesh.primitive_plane_add(size=6.0)
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(3.0, 0.0, 0.25))
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "scene.blend"))
+    result = run("rig", tmp_path / "scene.blend", "-o", tmp_path / "rigged.glb", "--report", tmp_path / "r.json")
+    assert result.returncode == 0, result.stderr
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["body_plan"]["kind"] == "humanoid" and list(report["skinning"]["meshes"]) == ["humanoid"]
+    assert "left out 'Plane' (flat and larger than 'humanoid': a floor or a backdrop): it is saved as it was, " \
+           "unrigged" in report["warnings"]
+    assert "left out 'Cube' (apart from 'humanoid'): it is saved as it was, unrigged" in report["warnings"]
+    assert sorted(mesh["name"] for mesh in glb_document(tmp_path / "rigged.glb")["meshes"]) == \
+        ["Cube", "Plane", "humanoid"]
+
+
 def test_outputs_never_overwrite_the_input_or_each_other(rigged_glb, tmp_path):
     source = tmp_path / "model.glb"
     source.write_bytes((rigged_glb[1] / "humanoid.glb").read_bytes())

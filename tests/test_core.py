@@ -395,3 +395,19 @@ def test_a_blender_operator_error_is_one_clause():
     traceback = "Error: Python: Traceback (most recent call last):\n  File \"x.py\", line 3\nIndexError: list index\n"
     assert blender_message(RuntimeError(traceback)) == "IndexError: list index"
     assert blender_message(RuntimeError("")) == "no reason given"
+
+
+def test_the_character_is_the_main_mesh_and_what_reaches_it_not_a_floor_or_a_mesh_apart():
+    from rigger.core.scene import character_parts
+
+    rng = np.random.default_rng(0)
+    body = rng.uniform([-0.3, -0.2, 0.0], [0.3, 0.2, 1.8], (500, 3))
+    hat = rng.uniform([-0.2, -0.2, 1.8], [0.2, 0.2, 2.0], (50, 3))  # on it
+    sword = rng.uniform([0.35, -0.02, 0.5], [0.45, 0.02, 1.0], (40, 3))  # beside it, within a tenth of its size
+    floor = np.column_stack([rng.uniform(-3, 3, (40, 2)), np.zeros(40)])  # flat, under it, larger
+    card = np.column_stack([rng.uniform(-0.1, 0.1, 40), np.full(40, 0.25), rng.uniform(1.5, 1.7, 40)])  # flat, small
+    friend = body + [3.0, 0.0, 0.0]  # another character, apart
+    kept, left = character_parts([("body", body), ("hat", hat), ("sword", sword), ("floor", floor), ("card", card),
+                                  ("friend", friend)])
+    assert kept == [0, 1, 2, 4]
+    assert left == [(3, "flat and larger than 'body': a floor or a backdrop"), (5, "apart from 'body'")]

@@ -7,9 +7,11 @@ import numpy as np
 
 from ..axes import axes_field, file_axes, to_blender
 from ..core.files import replaced_on_success
+from ..core.scene import character_parts
 from . import overlays, skinning
 from .armature import delete_armature
 from .headless import blender_message, empty_scene
+from .meshdata import evaluated_arrays
 from .pipeline import METHOD_PROPERTY, TARGET_PROPERTY, rig_object, skin_meshes, skin_summary
 from .properties import ARMATURE_POINTER
 
@@ -25,11 +27,12 @@ def rig_file(source, output, method, params, *, target="plain", skin=True, up=No
     ``up`` and ``forward`` are the file axes that become Blender's +Z and +Y (``rigger.axes``: OBJ and FBX only; None
     takes the defaults, up Y and forward -Z for OBJ, the file's own axes for FBX).
 
-    The meshes are those the file's scene shows: importers' hidden helpers (glTF's bone shapes) and excluded
-    collections are left alone. Armatures the file already deformed them with are replaced: unbound, and deleted
-    when they deform nothing else, so the output holds one rig. ValueError when the file cannot be imported, holds
-    no mesh or rigging fails; ``output`` is written only after everything succeeded (through a temporary file
-    renamed into place).
+    The meshes are those the file's scene shows that make the character (``core.scene``: not a floor, nor a mesh
+    standing apart): importers' hidden helpers (glTF's bone shapes) and excluded collections are left alone, and so
+    are the meshes left out, with a warning each (the output keeps them as they were). Armatures the file already
+    deformed them with are replaced: unbound, and deleted when they deform nothing else, so the output holds one
+    rig. ValueError when the file cannot be imported, holds no mesh or rigging fails; ``output`` is written only
+    after everything succeeded (through a temporary file renamed into place).
     """
     source, output = pathlib.Path(source), pathlib.Path(output)
     axes = file_axes(source.suffix, up, forward)
@@ -42,12 +45,14 @@ def rig_file(source, output, method, params, *, target="plain", skin=True, up=No
     if not meshes:
         raise ValueError(f"{source}: the file holds no mesh with faces that its scene shows")
     meshes.sort(key=lambda obj: -len(obj.data.vertices))
-    warnings = release_from_armatures(meshes)
-    result = rig_object(meshes[0], method, params, target=target, parts=meshes[1:])
+    character, left_out = _character(meshes)
+    warnings = [f"left out {mesh.name!r} ({why}): it is saved as it was, unrigged" for mesh, why in left_out]
+    warnings += release_from_armatures(character)
+    result = rig_object(character[0], method, params, target=target, parts=character[1:])
     warnings += ["replaced the armature Rigger made for the file before"] if result.replaced else []
     outcomes = None
     if skin:
-        outcomes, skin_warnings = skin_meshes(meshes, result.armature)
+        outcomes, skin_warnings = skin_meshes(character, result.armature)
         warnings += skin_warnings
     animation = None if animate is None else _animated(result, animate)
     save_scene(output, [*meshes, result.armature])
@@ -57,6 +62,14 @@ def rig_file(source, output, method, params, *, target="plain", skin=True, up=No
         report["warnings"] += [f"no joint of {pathlib.Path(animate).name} drives {', '.join(animation['undriven'])}; "
                                f"they turn with their parents"] if animation["undriven"] else []
     return {"input": str(source), "output": str(output), "asked_target": target, **report}
+
+
+def _character(meshes):
+    """(the ``meshes`` that make the character, [(mesh, why it is left out)]): ``core.scene.character_parts``, the
+    main mesh first."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    kept, left = character_parts([(mesh.name, evaluated_arrays(mesh, depsgraph)[0]) for mesh in meshes])
+    return [meshes[k] for k in kept], [(meshes[k], why) for k, why in left]
 
 
 def _animated(result, bvh):
