@@ -98,8 +98,8 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
 def _previous_motion(meshes):
     """(action, its fake-user flag, each pose bone's rotation mode) of the armature Rigger made for ``meshes``
     before, the action held by a fake user while that armature goes (deleting an armature deletes the actions
-    nothing else uses), or None: a motion made on the old rig carries over to the new one, on the bones of the same
-    names."""
+    nothing else uses; it keeps that user if the new rig fails, so the motion is not lost), or None: a motion made on
+    the old rig carries over to the new one, on the bones of the same names."""
     armature = next((getattr(mesh, ARMATURE_POINTER) for mesh in meshes if getattr(mesh, ARMATURE_POINTER, None)),
                     None)
     action = armature.animation_data.action if armature is not None and armature.animation_data else None
