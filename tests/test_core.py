@@ -362,6 +362,9 @@ def test_a_bvh_file_is_checked_without_blender(tmp_path):
     path = tmp_path / "walk.bvh"
     path.write_text(BVH)
     assert bvh.check(path) == bvh.BvhSummary(("Hips", "Spine"), 9, 2, 0.04)
+    path.write_text(BVH.replace("MOTION\n", "motion\n\n").replace("Frame Time:", "frame time:")
+                    .replace("End Site", "end site"))  # as lenient as Blender's importer
+    assert bvh.check(path) == bvh.BvhSummary(("Hips", "Spine"), 9, 2, 0.04)
 
 
 @pytest.mark.parametrize("text, message", [

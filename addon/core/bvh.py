@@ -33,8 +33,9 @@ def check(path):
     except StopIteration:
         raise BvhError(f"{path}: not a BVH file (no MOTION section)") from None
     joints, channels = _hierarchy(path, " ".join(lines[:motion]).split())
-    header = [line.split() for line in lines[motion + 1:motion + 3]]
-    if len(header) < 2 or header[0][:1] != ["Frames:"] or header[1][:2] != ["Frame", "Time:"]:
+    after = [line.split() for line in lines[motion + 1:] if line.strip()]
+    header = [[word.lower() for word in words] for words in after[:2]]
+    if len(header) < 2 or header[0][:1] != ["frames:"] or header[1][:2] != ["frame", "time:"]:
         raise BvhError(f"{path}: MOTION is not followed by 'Frames:' and 'Frame Time:' lines")
     frames, frame_time = _number(path, header[0][1:], int, "Frames:"), _number(path, header[1][2:], float,
                                                                              "Frame Time:")
@@ -42,11 +43,10 @@ def check(path):
         raise BvhError(f"{path}: the BVH file holds no frames")
     if not frame_time > 0:
         raise BvhError(f"{path}: 'Frame Time:' must be a positive number of seconds, not {frame_time:g}")
-    rows = [line for line in lines[motion + 3:] if line.strip()]
+    rows = after[2:]
     if len(rows) < frames:
         raise BvhError(f"{path}: holds {len(rows)} frame lines of the {frames} it announces (cut short?)")
-    for number, row in enumerate(rows[:frames], start=1):
-        values = row.split()
+    for number, values in enumerate(rows[:frames], start=1):
         if len(values) < channels:
             raise BvhError(f"{path}: frame {number} has {len(values)} values, not the {channels} the HIERARCHY's "
                            f"channels need")
@@ -58,15 +58,16 @@ def check(path):
 
 def _hierarchy(path, tokens):
     """(joint names, channel count) of the HIERARCHY tokens; BvhError when they are no BVH hierarchy."""
-    if tokens[:1] != ["HIERARCHY"] or tokens[1:2] != ["ROOT"]:
+    keywords = [token.upper() for token in tokens]  # joint names keep their case, keywords may have any
+    if keywords[:2] != ["HIERARCHY", "ROOT"]:
         raise BvhError(f"{path}: not a BVH file (it does not begin with HIERARCHY and a ROOT joint)")
     joints, channels, depth, k = [], 0, 0, 1
     while k < len(tokens):
-        word = tokens[k]
+        word = keywords[k]
         if word in ("ROOT", "JOINT") and k + 1 < len(tokens):
             joints.append(tokens[k + 1])
             k += 2
-        elif word == "End" and tokens[k + 1:k + 2] == ["Site"]:
+        elif word == "END" and keywords[k + 1:k + 2] == ["SITE"]:
             k += 2
         elif word == "{":
             depth, k = depth + 1, k + 1
@@ -80,7 +81,7 @@ def _hierarchy(path, tokens):
             count = int(tokens[k + 1])
             channels, k = channels + count, k + 2 + count
         else:
-            raise BvhError(f"{path}: unexpected {word!r} in the HIERARCHY")
+            raise BvhError(f"{path}: unexpected {tokens[k]!r} in the HIERARCHY")
     if depth != 0 or not joints:
         raise BvhError(f"{path}: the HIERARCHY's braces do not balance")
     return joints, channels
