@@ -280,6 +280,21 @@ def test_several_selected_meshes_are_rigged_together_and_all_skinned(scene):
         assert obj.vertex_groups and any(m.type == 'ARMATURE' for m in obj.modifiers)
 
 
+def test_a_floor_and_a_crate_apart_box_selected_with_the_character_stay_out_of_its_rig(scene):
+    body = build_character("humanoid", subdivisions=0)
+    bpy.ops.mesh.primitive_plane_add(size=6.0)
+    floor = bpy.context.active_object
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(3.0, 0.0, 0.25))
+    crate = bpy.context.active_object
+    activate(body, floor, crate)
+    result, printed = reports_of(bpy.ops.rigger.rig_skin)
+    assert result == {'FINISHED'}
+    assert "left out Plane (flat and larger than 'humanoid': a floor or a backdrop)" in printed
+    assert "left out Cube (apart from 'humanoid')" in printed and "humanoid (0.9" in printed
+    assert body.rigger_armature is not None and floor.rigger_armature is None and crate.rigger_armature is None
+    assert not floor.modifiers and not crate.modifiers
+
+
 def test_rig_builds_the_overlays_the_panel_toggles_and_clear_removes(scene):
     from rigger.blender.overlays import COLLECTION_NAME, KIND_KEY, OWNER_KEY
     obj = build_character("humanoid", subdivisions=0)

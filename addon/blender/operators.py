@@ -11,7 +11,7 @@ from mathutils import Vector
 
 from ..api import method_registry
 from . import overlays
-from .pipeline import rig_object, skin_meshes, skin_summary
+from .pipeline import character_meshes, rig_object, skin_meshes, skin_summary
 from .properties import (ARMATURE_POINTER, NO_METHOD, SETTINGS_ATTRIBUTE, note_overlays, overlay_visibility,
                          param_values)
 
@@ -83,7 +83,7 @@ class _RiggerOperator:
     def rig(self, context, progress):
         settings, method = chosen_method(context)
         params = param_values(method, getattr(settings.methods, method.name))
-        meshes, _ = rig_targets(context)
+        meshes, left_out = character_meshes(rig_targets(context)[0])
         result = rig_object(meshes[0], method.name, params, target=settings.target, parts=meshes[1:],
                             show_overlays=overlay_visibility(settings), progress=progress)
         note_overlays(settings, result.skeleton.stages, result.overlays)
@@ -92,8 +92,9 @@ class _RiggerOperator:
         replaced = "" if not result.replaced else " (replaced the previous rig)" if result.motion is None else \
             f" (replaced the previous rig; its animation {result.motion!r} goes on, on the bones of the same names)"
         plan = result.skeleton.body_plan
-        notes = [*result.warnings, *([] if plan is None else [plan.warning or plan.summary()])]
-        warned = result.warnings or plan is not None and plan.warning
+        left = [f"left out {mesh.name} ({why})" for mesh, why in left_out]
+        notes = [*left, *result.warnings, *([] if plan is None else [plan.warning or plan.summary()])]
+        warned = left or result.warnings or plan is not None and plan.warning
         self.report({'WARNING'} if warned else {'INFO'},
                     f"Rigged {names} with {method.label or method.name} as {result.target.label}: "
                     f"{len(result.bones)} bones in {seconds:.2f} s{replaced}" + "".join(f"; {n}" for n in notes))

@@ -7,11 +7,12 @@ import bpy
 import numpy as np
 
 from ..api import rig_mesh
+from ..core.scene import character_parts
 from ..core.targets import check_target, choose_target
 from ..core.timing import StageClock
 from . import overlays, skinning, targets
 from .armature import delete_armature
-from .meshdata import combined_arrays
+from .meshdata import combined_arrays, evaluated_arrays
 from .properties import ARMATURE_POINTER
 from .rigify import remove_extras
 
@@ -119,6 +120,15 @@ def _take_motion(armature, action, fake_user, rotation_modes):
     animation.action = action
     if getattr(animation, "action_slot", False) is None and len(getattr(action, "slots", ())):
         animation.action_slot = action.slots[0]
+
+
+def character_meshes(meshes):
+    """(the ``meshes`` that make the character, [(mesh, why it is left out)]): ``core.scene.character_parts``, the
+    first mesh the main one (a floor or a crate standing apart, box-selected or in a file with the character, stays
+    out of its rig)."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    kept, left = character_parts([(mesh.name, evaluated_arrays(mesh, depsgraph)[0]) for mesh in meshes])
+    return [meshes[k] for k in kept], [(meshes[k], why) for k, why in left]
 
 
 def own_axes(obj):

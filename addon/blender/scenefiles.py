@@ -7,12 +7,10 @@ import numpy as np
 
 from ..axes import axes_field, file_axes, to_blender
 from ..core.files import replaced_on_success
-from ..core.scene import character_parts
 from . import overlays, skinning
 from .armature import delete_armature
 from .headless import blender_message, empty_scene
-from .meshdata import evaluated_arrays
-from .pipeline import METHOD_PROPERTY, TARGET_PROPERTY, rig_object, skin_meshes, skin_summary
+from .pipeline import METHOD_PROPERTY, TARGET_PROPERTY, character_meshes, rig_object, skin_meshes, skin_summary
 from .properties import ARMATURE_POINTER
 
 
@@ -45,7 +43,7 @@ def rig_file(source, output, method, params, *, target="plain", skin=True, up=No
     if not meshes:
         raise ValueError(f"{source}: the file holds no mesh with faces that its scene shows")
     meshes.sort(key=lambda obj: -len(obj.data.vertices))
-    character, left_out = _character(meshes)
+    character, left_out = character_meshes(meshes)
     warnings = [f"left out {mesh.name!r} ({why}): it is saved as it was, unrigged" for mesh, why in left_out]
     warnings += release_from_armatures(character)
     result = rig_object(character[0], method, params, target=target, parts=character[1:])
@@ -62,14 +60,6 @@ def rig_file(source, output, method, params, *, target="plain", skin=True, up=No
         report["warnings"] += [f"no joint of {pathlib.Path(animate).name} drives {', '.join(animation['undriven'])}; "
                                f"they turn with their parents"] if animation["undriven"] else []
     return {"input": str(source), "output": str(output), "asked_target": target, **report}
-
-
-def _character(meshes):
-    """(the ``meshes`` that make the character, [(mesh, why it is left out)]): ``core.scene.character_parts``, the
-    main mesh first."""
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    kept, left = character_parts([(mesh.name, evaluated_arrays(mesh, depsgraph)[0]) for mesh in meshes])
-    return [meshes[k] for k in kept], [(meshes[k], why) for k, why in left]
 
 
 def _animated(result, bvh):
