@@ -384,6 +384,19 @@ def test_ears_of_a_symmetric_quadruped_seen_from_the_side_are_a_mirror_pair(mode
     assert ears, "no bone reaches up to the ears"
 
 
+def test_a_tail_curled_onto_the_back_is_one_chain():
+    """The ShibaInu's tail curls up over its rump and rests its tip on the back: the silhouette has a hole there, and
+    the chordal axis a cycle through the tail. The cycle narrows where the tip touches the back, so it is cut there,
+    and the tail is one chain from the rump round to its tip: no second chain from the back up to the tip (it went
+    off the plane, unsided, and took half the tail's weights)."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_ShibaInu", "Quaternius_ShibaInu.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    tails = [b for b, role in enumerate(skeleton.roles) if role.role == "tail"]
+    starts = [b for b in tails if skeleton.roles[skeleton.parents[b]].role != "tail"]
+    assert len(starts) == 1 and len(tails) >= 4
+    assert not [b for b, role in enumerate(skeleton.roles) if role.role == "other"]
+
+
 def test_a_foxs_ears_hang_from_its_head_on_a_neck():
     """The Fox's side view prunes its neck and head, a stubby branch off its deep chest; the end-on view finds its
     ears starting on the head, far from the chest and 0.8 bone lengths apart. They share one extension, a neck and

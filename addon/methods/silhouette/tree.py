@@ -7,7 +7,7 @@ A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch p
 2. Spur pruning (``prune_spurs``): branches that are bumps or outline noise go, repeatedly, since removing one can
    expose another.
 3. Rooting at the most central branch point, then cutting every cycle (holes in the silhouette) where the two ways
-   around it from the root meet.
+   around it from the root meet, or where two parts touch (``_cut_cycle``).
 """
 from dataclasses import dataclass
 
@@ -333,19 +333,32 @@ def rooted_chains(points, keys, chains, radius, tuning):
         nodes = chains[i] if dist[chains[i][0]] <= dist[chains[i][-1]] else chains[i][::-1]
         chain_of_end[nodes[-1]] = len(ordered)
         ordered.append(Chain(nodes, chain_of_end.get(nodes[0], -1) if nodes[0] != root else -1))
-    # cycles: cut each remaining chain where the ways round from the root meet
+    # cycles: cut each remaining chain where the ways round from the root meet, or at a contact
     for i in range(len(chains)):
         if i in tree:
             continue
-        nodes = chains[i]
-        steps = arc_lengths(points[nodes])
-        from_start = dist[nodes[0]] + steps
-        from_end = dist[nodes[-1]] + (steps[-1] - steps)
-        cut = int(np.clip(np.searchsorted(from_start - from_end, 0.0), 1, len(nodes) - 1))
-        for half in (nodes[:cut], nodes[cut:][::-1]):
+        for half in _cut_cycle(chains[i], points, radius, dist, tuning):
             if len(half) > 1:
                 ordered.append(Chain(half, chain_of_end.get(half[0], -1) if half[0] != root else -1))
     return root, ordered
+
+
+def _cut_cycle(nodes, points, radius, dist, tuning):
+    """The chain ``nodes`` that closes a cycle (a hole in the silhouette), cut into the halves that hang from its
+    two ends (``dist``: each node's distance from the root along the tree): where the ways round from the root meet
+    (an arm whose hand rests on the hip: the arm, and the hip's side up to the hand), or, where the cycle narrows to
+    ``contact`` of its median width, there (two parts touching: a curled tail's tip on the back), keeping the longer
+    half alone (the tail; the shorter is the back's side of the contact, no limb)."""
+    inner = radius[nodes[1:-1]]
+    if len(inner) and inner.min() < tuning.contact * np.median(inner):
+        cut = 1 + int(np.argmin(inner))
+        halves = (nodes[:cut + 1], nodes[cut:][::-1])
+        return [max(halves, key=lambda half: length(points[half]))]
+    steps = arc_lengths(points[nodes])
+    from_start = dist[nodes[0]] + steps
+    from_end = dist[nodes[-1]] + (steps[-1] - steps)
+    cut = int(np.clip(np.searchsorted(from_start - from_end, 0.0), 1, len(nodes) - 1))
+    return [nodes[:cut], nodes[cut:][::-1]]
 
 
 def _root_single_path(chains, keys, radius, tuning):

@@ -39,6 +39,8 @@ class Tuning(JointTuning, MirrorTuning):
     width_nodes: int = tuned(3, "a branch's width is its mean over this many nodes past the base's disc (a neck, "
                                 "not the head it carries)")
     # 5. rooting
+    contact: float = tuned(0.5, "a cycle narrowing to this share of its median width is two parts touching (a "
+                                "curled tail's tip on the back): it is cut there")
     column_ratio: float = tuned(1.25, "a path whose widest node is at most this many times its median width is a "
                                       "column, rooted at its thicker end, not a body")
     end_divisor: int = tuned(4, "which end of a column is thicker is judged on its first and last 1/this of nodes")
