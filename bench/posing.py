@@ -280,8 +280,9 @@ def _where_mirrored(mirrored, count, asymmetries):
     if mirrored == count:
         return ""
     if not mirrored:
-        return (f"; all on parts the mesh itself does not mirror (its asymmetry there "
-                f"{min(asymmetries):.3f}–{max(asymmetries):.3f})")
+        low, high = f"{min(asymmetries):.3f}", f"{max(asymmetries):.3f}"
+        spread = low if low == high else f"{low}–{high}"
+        return f"; all on parts the mesh itself does not mirror (its asymmetry there {spread})"
     return f"; {count - mirrored} of them on parts the mesh itself does not mirror"
 
 
