@@ -1,5 +1,6 @@
 """``rig_mesh``: the one call scripts, the CLI and the Blender layer use to turn a mesh into a skeleton."""
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -51,17 +52,20 @@ def rig_mesh(vertices, triangles, method="silhouette", *, axes=None, **params):
     rigging = _method(method)
     values = resolve(rigging.params, params)
     mesh = Mesh(vertices, triangles)
-    if axes is None:
-        skeleton = rigging.rig(mesh, **values)
-    else:
-        skeleton = _rigged_along(rigging, mesh, _rotation(axes), values)
+    rotation = None if axes is None else _rotation(axes)
+    if rotation is not None:  # the method, and the body plan (Z up preferred: the object's own), in the frame
+        mesh = mesh.with_vertices(mesh.vertices @ rotation.T)
+    skeleton = rigging.rig(mesh, **(values if rotation is None else _turned(rigging, values, rotation)))
     if not isinstance(skeleton, Skeleton):
         raise TypeError(f"method {rigging.name!r} returned {type(skeleton).__name__}, not a Skeleton")
-    skeleton.params = values
     recognised = time.perf_counter()
     skeleton.body_plan, skeleton.roles = recognise(skeleton, mesh, plane=skeleton.stages.get("mirror_plane"))
+    body_plan_seconds = time.perf_counter() - recognised
+    if rotation is not None:
+        skeleton = _turned_back(skeleton, rotation)
+    skeleton.params = values
     skeleton.stages["roles"] = Roles.of(skeleton, skeleton.roles)
-    skeleton.timings["body_plan"] = time.perf_counter() - recognised
+    skeleton.timings["body_plan"] = body_plan_seconds
     skeleton.timings["total"] = time.perf_counter() - start
     return skeleton
 
@@ -72,25 +76,30 @@ def _rotation(axes):
         rotation = np.array(axes, dtype=np.float64)
     except (TypeError, ValueError):
         raise ValueError(f"axes must be a 3x3 rotation, got {axes!r}") from None
-    if rotation.shape != (3, 3) or not np.isfinite(rotation).all():
-        raise ValueError(f"axes must be a finite 3x3 rotation, got shape {rotation.shape}")
+    if rotation.shape != (3, 3):
+        raise ValueError(f"axes must be a 3x3 rotation, got shape {rotation.shape}")
+    if not np.isfinite(rotation).all():
+        raise ValueError("axes must be a 3x3 rotation of finite numbers")
     if not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-6) or np.linalg.det(rotation) < 0:
         raise ValueError("axes must be a rotation: orthonormal rows, right-handed")
     return rotation
 
 
-def _rigged_along(rigging, mesh, rotation, values):
-    """The skeleton ``rigging`` makes of ``mesh`` turned into the frame whose axes are ``rotation``'s rows, turned
-    back with its stages; vector parameters are turned into the frame first."""
+def _turned(rigging, values, rotation):
+    """The parameter ``values`` in the frame whose axes are ``rotation``'s rows: vectors (a view direction) turned."""
     kinds = {param.name: param.type for param in rigging.params}
-    turned = {name: tuple(rotation @ np.asarray(value, dtype=np.float64)) if kinds[name] == "vector" else value
-              for name, value in values.items()}
-    inside = rigging.rig(mesh.with_vertices(mesh.vertices @ rotation.T), **turned)
-    if not isinstance(inside, Skeleton):
-        return inside
+    return {name: tuple(rotation @ np.asarray(value, dtype=np.float64)) if kinds[name] == "vector" else value
+            for name, value in values.items()}
+
+
+def _turned_back(inside, rotation):
+    """The skeleton rigged in the frame whose axes are ``rotation``'s rows, its stages and its plan's up, in the
+    mesh's own coordinates (roles and named joints ride on the bones)."""
     placement = Placement(1.0, rotation)
+    plan = replace(inside.body_plan, up=tuple(placement.vector(np.asarray(inside.body_plan.up))))
     skeleton = Skeleton(inside.names, placement.point(inside.heads), placement.point(inside.tails), inside.parents,
-                        {name: stage.mapped(placement) for name, stage in inside.stages.items()})
+                        {name: stage.mapped(placement) for name, stage in inside.stages.items()}, roles=inside.roles,
+                        body_plan=plan)
     skeleton.timings = inside.timings
     return skeleton
 

@@ -123,8 +123,8 @@ def test_a_floor_and_a_mesh_standing_apart_are_left_out_of_the_rig(scene, tmp_pa
     assert result.returncode == 0, result.stderr
     report = json.loads((tmp_path / "r.json").read_text())
     assert report["body_plan"]["kind"] == "humanoid" and list(report["skinning"]["meshes"]) == ["humanoid"]
-    assert "left out 'Plane' (flat and larger than 'humanoid': a floor or a backdrop): it is saved as it was, " \
-           "unrigged" in report["warnings"]
+    assert "left out 'Plane' (flat and larger than 'humanoid': a floor, a stage or a backdrop): it is saved as it " \
+           "was, unrigged" in report["warnings"]
     assert "left out 'Cube' (apart from 'humanoid'): it is saved as it was, unrigged" in report["warnings"]
     assert sorted(mesh["name"] for mesh in glb_document(tmp_path / "rigged.glb")["meshes"]) == \
         ["Cube", "Plane", "humanoid"]

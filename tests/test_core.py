@@ -365,6 +365,8 @@ def test_a_bvh_file_is_checked_without_blender(tmp_path):
     path.write_text(BVH.replace("MOTION\n", "motion\n\n").replace("Frame Time:", "frame time:")
                     .replace("End Site", "end site"))  # as lenient as Blender's importer
     assert bvh.check(path) == bvh.BvhSummary(("Hips", "Spine"), 9, 2, 0.04)
+    path.write_bytes(b"\xef\xbb\xbf" + BVH.encode())  # a byte order mark before HIERARCHY
+    assert bvh.check(path) == bvh.BvhSummary(("Hips", "Spine"), 9, 2, 0.04)
 
 
 @pytest.mark.parametrize("text, message", [
@@ -398,19 +400,28 @@ def test_a_blender_operator_error_is_one_clause():
     traceback = "Error: Python: Traceback (most recent call last):\n  File \"x.py\", line 3\nIndexError: list index\n"
     assert blender_message(RuntimeError(traceback)) == "IndexError: list index"
     assert blender_message(RuntimeError("")) == "no reason given"
+    with pytest.raises(KeyboardInterrupt):  # Ctrl-C inside an operator is Ctrl-C
+        blender_message(RuntimeError("Error: Python: Traceback ...\nKeyboardInterrupt\nLocation: ops.py:109\n"))
 
 
 def test_the_character_is_the_main_mesh_and_what_reaches_it_not_a_floor_or_a_mesh_apart():
+    """The main mesh is the first that is no slab (a floor with more vertices than the character comes first in a
+    file's order); a hat, a sword and a flat card (an eye) at the body stay; a floor, a 10 cm stage and another
+    character 3 m away go; turning the whole scene about any axis changes nothing."""
     from rigger.core.scene import character_parts
 
     rng = np.random.default_rng(0)
     body = rng.uniform([-0.3, -0.2, 0.0], [0.3, 0.2, 1.8], (500, 3))
     hat = rng.uniform([-0.2, -0.2, 1.8], [0.2, 0.2, 2.0], (50, 3))  # on it
     sword = rng.uniform([0.35, -0.02, 0.5], [0.45, 0.02, 1.0], (40, 3))  # beside it, within a tenth of its size
-    floor = np.column_stack([rng.uniform(-3, 3, (40, 2)), np.zeros(40)])  # flat, under it, larger
+    floor = np.column_stack([rng.uniform(-3, 3, (900, 2)), np.zeros(900)])  # flat, under it, larger, denser
     card = np.column_stack([rng.uniform(-0.1, 0.1, 40), np.full(40, 0.25), rng.uniform(1.5, 1.7, 40)])  # flat, small
+    stage = rng.uniform([-2.0, -2.0, -0.1], [2.0, 2.0, 0.0], (60, 3))  # a slab 10 cm thick
     friend = body + [3.0, 0.0, 0.0]  # another character, apart
-    kept, left = character_parts([("body", body), ("hat", hat), ("sword", sword), ("floor", floor), ("card", card),
-                                  ("friend", friend)])
-    assert kept == [0, 1, 2, 4]
-    assert left == [(3, "flat and larger than 'body': a floor or a backdrop"), (5, "apart from 'body'")]
+    parts = [("floor", floor), ("body", body), ("hat", hat), ("sword", sword), ("card", card), ("stage", stage),
+             ("friend", friend)]
+    slab = "flat and larger than 'body': a floor, a stage or a backdrop"
+    expected = ([1, 2, 3, 4], [(0, slab), (5, slab), (6, "apart from 'body'")])
+    assert character_parts(parts) == expected
+    turn = np.array([[0.6, -0.64, 0.48], [0.8, 0.48, -0.36], [0.0, 0.6, 0.8]])  # a rotation
+    assert character_parts([(name, points @ turn.T) for name, points in parts]) == expected

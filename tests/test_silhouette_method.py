@@ -619,13 +619,25 @@ def test_auto_view_skips_an_axis_the_mesh_shows_nothing_along():
 
 
 def test_a_mesh_rigged_along_its_own_axes_gets_its_square_skeleton_turned():
-    """The humanoid turned 30° about Z: seen along the world's axes it shows neither its front nor its side, and the
-    rig is poor; rigged along its own axes (the Blender layer passes an object's), it gets the skeleton it gets
-    standing square, turned with it, its stages too, and a view direction given in its coordinates turns along."""
+    """The humanoid turned 30° about Z, or tilted 30° about Y: seen along the world's axes it shows neither its front
+    nor its side, and the rig is poor; rigged along its own axes (the Blender layer passes an object's), it gets the
+    skeleton and the body plan it gets standing square, turned with it (its stages and up too), and a view direction
+    given in its coordinates turns along."""
     vertices, triangles = load_character("humanoid")
     turn = np.array([[np.cos(np.pi / 6), -np.sin(np.pi / 6), 0.0], [np.sin(np.pi / 6), np.cos(np.pi / 6), 0.0],
                      [0.0, 0.0, 1.0]])
+    tilt = np.array([[np.cos(np.pi / 6), 0.0, np.sin(np.pi / 6)], [0.0, 1.0, 0.0],
+                     [-np.sin(np.pi / 6), 0.0, np.cos(np.pi / 6)]])
     square = rigger.rig_mesh(vertices, triangles)
+    tilted = rigger.rig_mesh(vertices @ tilt.T, triangles, axes=tilt.T)
+    assert tilted.body_plan.summary() == square.body_plan.summary()
+    np.testing.assert_allclose(tilted.body_plan.up, tilt @ square.body_plan.up, atol=1e-9)
+
+    def bones(skeleton, turn_back):  # as a set: the mesh turned back differs by rounding, the chains' order may too
+        return sorted((role.label, *np.round(head @ turn_back, 6)) for role, head in zip(skeleton.roles,
+                                                                                        skeleton.heads))
+
+    assert bones(tilted, tilt) == bones(square, np.eye(3))
     turned = rigger.rig_mesh(vertices @ turn.T, triangles, axes=turn.T)
     assert list(turned.names) == list(square.names) and turned.body_plan.kind == "humanoid"
     np.testing.assert_allclose(turned.heads, square.heads @ turn.T, atol=1e-9)
@@ -635,8 +647,8 @@ def test_a_mesh_rigged_along_its_own_axes_gets_its_square_skeleton_turned():
                             view_direction=turn @ [0.0, 1.0, 0.0])
     np.testing.assert_allclose(along.heads, rigger.rig_mesh(vertices, triangles, view="DIRECTION").heads @ turn.T,
                                atol=1e-9)
-    for axes, message in ((np.eye(2), "finite 3x3 rotation"), (np.diag([1.0, 1.0, -1.0]), "right-handed"),
-                          (2 * np.eye(3), "orthonormal")):
+    for axes, message in ((np.eye(2), r"3x3 rotation, got shape \(2, 2\)"), (np.full((3, 3), np.nan), "finite"),
+                          (np.diag([1.0, 1.0, -1.0]), "right-handed"), (2 * np.eye(3), "orthonormal")):
         with pytest.raises(ValueError, match=message):
             rigger.rig_mesh(vertices, triangles, axes=axes)
 

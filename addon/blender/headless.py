@@ -31,6 +31,9 @@ def empty_scene():
 
 def blender_message(error):
     """A Blender operator's error (its RuntimeError) as one clause: the last line of its text (an add-on's operator
-    may put its whole traceback there) without the "Error:" prefix bpy puts before it."""
+    may put its whole traceback there) without the "Error:" prefix bpy puts before it. An operator that Ctrl-C
+    stopped reports that as its error: KeyboardInterrupt is raised again instead."""
+    if "KeyboardInterrupt" in str(error):
+        raise KeyboardInterrupt
     lines = str(error).strip().splitlines()
     return (lines[-1] if lines else "no reason given").strip().removeprefix("Error:").strip()

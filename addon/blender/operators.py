@@ -90,7 +90,7 @@ class _RiggerOperator:
         seconds = sum(result.timings.values())
         names = ", ".join(mesh.name for mesh in meshes)
         replaced = "" if not result.replaced else " (replaced the previous rig)" if result.motion is None else \
-            f" (replaced the previous rig; its animation {result.motion!r} goes on, on the bones of the same names)"
+            f" (replaced the previous rig; {result.motion})"
         plan = result.skeleton.body_plan
         left = [f"left out {mesh.name} ({why})" for mesh, why in left_out]
         notes = [*left, *result.warnings, *([] if plan is None else [plan.warning or plan.summary()])]

@@ -1,6 +1,7 @@
 """Rigging a Blender mesh object: evaluated mesh → method → skeleton → armature (+ overlays), shared by the
 operators and the command line so both do exactly the same thing."""
 import contextlib
+import re
 from dataclasses import dataclass
 
 import bpy
@@ -18,6 +19,7 @@ from .rigify import remove_extras
 
 METHOD_PROPERTY = "rigger_method"  # custom property on the armature: the method that made it
 TARGET_PROPERTY = "rigger_target"  # ... and the output target it was built as
+BONE_PATH = re.compile(r'pose\.bones\["(.+?)"\]')  # an animation curve's path to the pose bone it keys
 OVERLAYS_PROPERTY = "rigger_overlays"  # ... and the owner its overlays were drawn for (its mesh's name then)
 
 
@@ -26,7 +28,7 @@ class RigResult:
     """What :func:`rig_object` made: the armature object, the meshes it was made for, the method's skeleton (with
     its stages and roles), the ``core.targets.Target`` built and the armature's deforming bones as a skeleton in
     world space (the method's skeleton itself for ``plain``), whether a previous Rigger armature was replaced (and
-    the name of its action, which the new one took over), seconds per step, the overlay objects by stage name (none
+    what became of its motion, which the new one took over), seconds per step, the overlay objects by stage name (none
     unless asked for) and warnings (a target that fell back, say)."""
 
     armature: bpy.types.Object
@@ -38,7 +40,7 @@ class RigResult:
     timings: dict
     overlays: dict
     warnings: list
-    motion: str = None  # the previous armature's action, carried over to this one
+    motion: str = None  # what became of the previous armature's motion, in words (None: it had none)
 
 
 def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(), show_overlays=None,
@@ -77,8 +79,7 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     if parent is not None:  # skinning makes the mesh the armature's child: the rig keeps following what moved it
         armature.parent = parent
         armature.matrix_parent_inverse = parent.matrix_world.inverted_safe()
-    if motion is not None:
-        _take_motion(armature, *motion)
+    carried = _take_motion(armature, *motion) if motion is not None else None
     armature[METHOD_PROPERTY] = method if isinstance(method, str) else method.name
     armature[TARGET_PROPERTY] = chosen.name
     for mesh in meshes:
@@ -93,52 +94,91 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     report(1.0)
     warnings = [fell_back] if fell_back else []
     return RigResult(armature, meshes, skeleton, chosen, built.bones, replaced, clock.laps, drawn,
-                     warnings + built.warnings, motion[0].name if motion is not None else None)
+                     warnings + built.warnings, carried)
 
 
 def _previous_motion(meshes):
-    """(action, its fake-user flag, each pose bone's rotation mode) of the armature Rigger made for ``meshes``
-    before, the action held by a fake user while that armature goes (deleting an armature deletes the actions
-    nothing else uses; it keeps that user if the new rig fails, so the motion is not lost), or None: a motion made on
-    the old rig carries over to the new one, on the bones of the same names."""
+    """The motion of the armature Rigger made for ``meshes`` before, to carry over to the new one (on the bones of the
+    same names): (its action, its NLA tracks as [(name, [(strip name, start frame, action)])], each action's
+    fake-user flag, each pose bone's rotation mode), or None. The actions are held by a fake user meanwhile (deleting
+    an armature deletes the actions nothing else uses; they keep it if the new rig fails, so no motion is lost)."""
     armature = next((getattr(mesh, ARMATURE_POINTER) for mesh in meshes if getattr(mesh, ARMATURE_POINTER, None)),
                     None)
-    action = armature.animation_data.action if armature is not None and armature.animation_data else None
-    if action is None:
+    animation = armature.animation_data if armature is not None else None
+    if animation is None:
         return None
-    flag, action.use_fake_user = action.use_fake_user, True
-    return action, flag, {bone.name: bone.rotation_mode for bone in armature.pose.bones}
+    tracks = [(track.name, [(strip.name, strip.frame_start, strip.action) for strip in track.strips if strip.action])
+              for track in animation.nla_tracks]
+    actions = ({animation.action} | {action for _, strips in tracks for _, _, action in strips}) - {None}
+    if not actions:
+        return None
+    flags = {action: action.use_fake_user for action in actions}
+    for action in actions:
+        action.use_fake_user = True
+    return animation.action, tracks, flags, {bone.name: bone.rotation_mode for bone in armature.pose.bones}
 
 
-def _take_motion(armature, action, fake_user, rotation_modes):
-    """Give ``armature`` the previous armature's ``action`` (in its slot, where actions have slots: Blender 4.4+),
-    its bones turning in the modes the old ones did (the action's curves are for those)."""
-    action.use_fake_user = fake_user
+def _take_motion(armature, action, tracks, flags, rotation_modes):
+    """Give ``armature`` the previous armature's motion (``_previous_motion``); a few words on it for the report:
+    whether it keys any of the new bones."""
+    for each, flag in flags.items():
+        each.use_fake_user = flag
     for bone in armature.pose.bones:
         bone.rotation_mode = rotation_modes.get(bone.name, bone.rotation_mode)
     animation = armature.animation_data_create()
-    animation.action = action
-    if getattr(animation, "action_slot", False) is None and len(getattr(action, "slots", ())):
-        animation.action_slot = action.slots[0]
+    if action is not None:
+        animation.action = action
+        _slotted(animation, action)
+    for name, strips in tracks:
+        track = animation.nla_tracks.new()
+        track.name = name
+        for strip_name, start, strip_action in strips:
+            _slotted(track.strips.new(strip_name, int(start), strip_action), strip_action)
+    names = ", ".join(repr(each.name) for each in flags)
+    if _keyed_bones(flags) & set(armature.pose.bones.keys()):
+        return f"its animation {names} goes on, on the bones of the same names"
+    return f"its animation {names} is kept, but keys none of the new bones"
+
+
+def _slotted(user, action):
+    """Give ``user`` (animation data or an NLA strip) the action's first slot where it took none (Blender 4.4+)."""
+    if getattr(user, "action_slot", False) is None and len(getattr(action, "slots", ())):
+        user.action_slot = action.slots[0]
+
+
+def _keyed_bones(actions):
+    """The names of the pose bones ``actions`` key (their curves: the action's own before Blender 4.4, its layers'
+    channel bags since)."""
+    curves = []
+    for action in actions:
+        curves += list(getattr(action, "fcurves", ()) or ())
+        for layer in getattr(action, "layers", ()):
+            for strip in layer.strips:
+                for bag in getattr(strip, "channelbags", ()):
+                    curves += list(bag.fcurves)
+    return {match.group(1) for curve in curves if (match := BONE_PATH.match(curve.data_path))}
 
 
 def character_meshes(meshes):
     """(the ``meshes`` that make the character, [(mesh, why it is left out)]): ``core.scene.character_parts``, the
     first mesh the main one (a floor or a crate standing apart, box-selected or in a file with the character, stays
     out of its rig)."""
+    if len(meshes) < 2:
+        return list(meshes), []
     depsgraph = bpy.context.evaluated_depsgraph_get()
     kept, left = character_parts([(mesh.name, evaluated_arrays(mesh, depsgraph)[0]) for mesh in meshes])
     return [meshes[k] for k in kept], [(meshes[k], why) for k, why in left]
 
 
 def own_axes(obj):
-    """The axes ``rig_mesh`` rigs ``obj`` along: the rotation of its world matrix (rows: its X, Y, Z in the world)
-    when that turns it off the world's axes (a character turned 30° about Z to face a camera), else None: an
-    object square to the world (turned by quarter turns, or not at all) rigs along the world's own, and so does a
-    mirrored one."""
+    """The axes ``rig_mesh`` rigs ``obj`` along: its own X, Y, Z in the world (rows; the one a mirroring scale
+    flips is taken back), when they are off the world's axes (a character turned 30° about Z to face a camera), else
+    None: an object square to the world (turned by quarter turns, or not at all) rigs along the world's own."""
     left, _, right = np.linalg.svd(np.array(obj.matrix_world, dtype=np.float64)[:3, :3])
-    rotation = left @ right  # the nearest rotation (polar factor): scale and shear left out
-    if np.linalg.det(rotation) < 0 or np.allclose(np.abs(rotation).max(axis=0), 1.0, atol=1e-6):
+    rotation = left @ right  # the nearest orthogonal matrix (polar factor): scale and shear left out
+    if np.linalg.det(rotation) < 0:
+        rotation[:, 2] = -rotation[:, 2]  # the same three axes, one reversed: a rotation
+    if np.allclose(np.abs(rotation).max(axis=0), 1.0, atol=1e-6):
         return None
     return rotation.T
 

@@ -25,7 +25,7 @@ def check(path):
     or holds fewer frame lines (or fewer numbers on one) than it announces."""
     path = pathlib.Path(path)
     try:
-        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+        lines = path.read_text(encoding="utf-8-sig", errors="replace").splitlines()  # a BOM is no keyword
     except OSError as error:
         raise BvhError(f"{path}: cannot read it: {error.strerror or error}") from None
     try:

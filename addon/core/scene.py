@@ -1,38 +1,56 @@
-"""Which meshes of a file's scene make the character the command line rigs (bpy-free).
+"""Which meshes of a file's scene (or of a selection) make the character Rigger rigs (bpy-free).
 
 A file holds a character, often of several meshes (body, clothes, eyes, a sword in its hand), and sometimes more: a
-floor it stands on, a backdrop, a prop or another character standing apart. Rigged together, a floor plane seen from
-above is the widest silhouette there is and the character's rig is lost in it. The character is the mesh with the
-most vertices and the meshes that reach into the space around it; a mesh apart from that space, or a flat one
-larger than the character (a floor, a backdrop), is left out, unrigged.
+floor or a stage it stands on, a backdrop, a prop or another character standing apart. Rigged together, a floor seen
+from above is the widest silhouette there is and the character's rig is lost in it. The character is its main mesh
+(the first given that is no slab) and the meshes that reach into the space around it; a mesh apart from that space,
+or a slab larger than the character (a floor, a stage, a backdrop), is left out, unrigged.
 """
 import numpy as np
 
-NEAR = 0.1  # a part reaching within this share of the main mesh's size of its bounding box belongs to it
-FLAT = 1e-3  # a mesh thinner than this share of its size, across its flattest direction, is flat
+NEAR = 0.1  # a part reaching within this share of the main mesh's size of its box belongs to it
+SLAB = 0.1  # a mesh thinner than this share of its size, across its flattest direction, is a slab
 
 
 def character_parts(parts):
-    """(indices of the ``parts`` that make the character, [(index, why it is left out)]) for ``parts``, a list of
-    (name, world vertices (N, 3)) with the main mesh first (the one with the most vertices)."""
-    _, main = parts[0]
-    low, high = main.min(axis=0), main.max(axis=0)
-    size = float(np.ptp(main, axis=0).max())
+    """(indices of the ``parts`` that make the character, the main one first; [(index, why it is left out)]) for
+    ``parts``, a list of (name, world vertices (N, 3)), the likeliest main mesh first (the active one, or the one
+    with the most vertices): the main mesh is the first that is no slab. Boxes are taken along the main mesh's own
+    axes (its principal directions), so turning the scene changes nothing. Vertices that are not finite do not count
+    here (rigging reports them)."""
+    parts = [(name, vertices[np.isfinite(vertices).all(axis=1)]) for name, vertices in parts]
+    parts = [(name, vertices if len(vertices) else np.zeros((1, 3))) for name, vertices in parts]
+    slabs = [_thickness(vertices) <= SLAB * _extent(vertices) for _, vertices in parts]
+    main = next((k for k, slab in enumerate(slabs) if not slab), 0)
+    name, vertices = parts[main]
+    axes = _principal_axes(vertices)
+    low, high = (vertices @ axes.T).min(axis=0), (vertices @ axes.T).max(axis=0)
+    size = _extent(vertices)
     reach_low, reach_high = low - NEAR * size, high + NEAR * size
-    kept, left = [0], []
-    for index, (name, vertices) in enumerate(parts[1:], start=1):
-        extent = float(np.ptp(vertices, axis=0).max())
-        if (vertices.max(axis=0) < reach_low).any() or (vertices.min(axis=0) > reach_high).any():
-            left.append((index, f"apart from {parts[0][0]!r}"))
-        elif extent > size and _thickness(vertices) <= FLAT * extent:
-            left.append((index, f"flat and larger than {parts[0][0]!r}: a floor or a backdrop"))
+    kept, left = [main], []
+    for index, (_, points) in enumerate(parts):
+        if index == main:
+            continue
+        along = points @ axes.T
+        if (along.max(axis=0) < reach_low).any() or (along.min(axis=0) > reach_high).any():
+            left.append((index, f"apart from {name!r}"))
+        elif slabs[index] and _extent(points) > size:
+            left.append((index, f"flat and larger than {name!r}: a floor, a stage or a backdrop"))
         else:
             kept.append(index)
     return kept, left
 
 
+def _extent(vertices):
+    return float(np.ptp(vertices, axis=0).max())
+
+
+def _principal_axes(vertices):
+    """(3, 3) rows: the principal directions of ``vertices``, largest spread first."""
+    centred = vertices - vertices.mean(axis=0)
+    return np.linalg.svd(centred[::max(1, len(centred) // 10_000)], full_matrices=False)[2]
+
+
 def _thickness(vertices):
     """The extent of ``vertices`` across their flattest direction."""
-    centred = vertices - vertices.mean(axis=0)
-    flattest = np.linalg.svd(centred[::max(1, len(centred) // 10_000)], full_matrices=False)[2][-1]
-    return float(np.ptp(centred @ flattest))
+    return float(np.ptp((vertices - vertices.mean(axis=0)) @ _principal_axes(vertices)[-1]))
