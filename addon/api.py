@@ -36,10 +36,10 @@ def rig_mesh(vertices, triangles, method="silhouette", *, axes=None, **params):
         method: a method name from :func:`method_registry`, a :class:`~rigger.core.registry.RigMethod` subclass
             (e.g. one defined in a script) or an instance of one (e.g. with its tuning changed).
         axes: None, or a 3x3 rotation whose rows are the directions (in the mesh's coordinates) the method takes as
-            its X, Y and Z: the mesh is turned into that frame for the method, and its skeleton and stages turned
-            back; vector parameters (a view direction) are directions in the mesh's coordinates and turn with it.
-            The Blender layer passes a rigged object's own axes, so a character turned about Z rigs as if it stood
-            square to the world.
+            its X, Y and Z: the mesh is turned into that frame for the method and the body plan (whose preferred up
+            is then the frame's Z), and the skeleton, its stages and the plan's up turned back; vector parameters (a
+            view direction) are directions in the mesh's coordinates and turn with it. The Blender layer passes a
+            rigged object's own axes, so a character turned or tilted rigs as if it stood square to the world.
         **params: the method's parameters by name; values may be strings as typed on a command line.
 
     Raises ValueError for an unknown method (naming the available ones and any that failed to load), unknown or
