@@ -134,7 +134,7 @@ def _take_motion(armature, action, tracks, flags, rotation_modes):
         track.name = name
         for strip_name, start, strip_action in strips:
             _slotted(track.strips.new(strip_name, int(start), strip_action), strip_action)
-    names = ", ".join(repr(each.name) for each in flags)
+    names = ", ".join(sorted(repr(each.name) for each in flags))
     if _keyed_bones(flags) & set(armature.pose.bones.keys()):
         return f"its animation {names} goes on, on the bones of the same names"
     return f"its animation {names} is kept, but keys none of the new bones"
