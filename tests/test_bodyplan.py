@@ -133,6 +133,18 @@ def test_a_head_on_the_midline_whose_tip_turns_aside_is_a_neck_and_head_not_an_a
     assert [role.role for role in head] == ["neck"] * 4 + ["head"] and all(role.side is None for role in head)
 
 
+def test_the_bone_the_ears_hang_from_is_the_head():
+    """The Fox as Blender imports it (Z up): its neck runs to the ear base inside the skull, and a snout bone on from
+    there. The narrowest joint is at the ear base, so the bone carrying the ears was a neck bone and turning "head"
+    moved the muzzle alone. Ears are on the skull: the bone they hang from begins the head (a neck bone stays)."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_Fox", "Quaternius_Fox.obj"))
+    skeleton = rigger.rig_mesh(vertices @ np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]).T, triangles)
+    roles = skeleton.roles
+    ears = [b for b, role in enumerate(roles) if role.role == "ear" and roles[skeleton.parents[b]].role != "ear"]
+    assert len(ears) == 2 and {roles[skeleton.parents[b]].role for b in ears} == {"head"}
+    assert "neck" in {role.role for role in roles}
+
+
 def test_arms_reaching_out_from_where_the_legs_hang_are_arms():
     """woody, a gingerbread figure, has one junction for a torso: its arms leave it where its legs do. Arms that reach
     out level, not down to the ground, are arms there too."""

@@ -287,7 +287,11 @@ def _spine_roles(body, layout, tuning):
     above = count - chest
     if above >= 3:
         thinnest = chest + 1 + int(np.argmin(body.radius[spine[chest + 1:count]]))
-        names += ["neck"] * (thinnest - chest) + ["head"] * (count - thinnest)
+        # the ears are on the skull: a bone they hang from (all but the first above the chest) is the head's
+        ears = [spine.index(body.bases[k]) for k, part in enumerate(layout.parts) if part == "ear"
+                and body.bases[k] in spine]
+        start = min([thinnest] + [at - 1 for at in ears if chest + 1 < at <= count])
+        names += ["neck"] * (start - chest) + ["head"] * (count - start)
     else:
         names += ["neck", "head"][:above]  # one bone into the head pivots at the neck
     return names
