@@ -138,13 +138,13 @@ def skeleton_measures(rig, artist_skeleton, skeleton, vertices, triangles, size)
                                      size)
     own_recall = pm.limb_recall(rig.positions, rig.parents, artist_skeleton.heads, artist_skeleton.tails,
                                 artist_skeleton.parents, size)[0]
-    plane = pm.mirror_plane(vertices, triangles, size)
+    surface = pm.mirror_surface(vertices, triangles)
+    plane = pm.mirror_plane(vertices, triangles, size, surface)
     twins = pm.twin_mismatches(skeleton.names, skeleton.heads, skeleton.tails, plane, size)
     unsided = pm.unsided_off_plane(skeleton.names, skeleton.heads, skeleton.tails, plane, size)
     bone = {name: k for k, name in enumerate(skeleton.names)}
     measured = [bone[f"{base}.L"] for base in twins] + [bone[name] for name in unsided]
-    local = pm.local_asymmetry(vertices, pm.mirror_surface(vertices, triangles), plane, skeleton.heads,
-                               skeleton.tails, measured, size)
+    local = pm.local_asymmetry(vertices, surface, plane, skeleton.heads, skeleton.tails, measured, size)
     return {"limb_recall": recall, "chains": len(outcome), "own_recall": own_recall,
             "missed": [str(names[chain[-1]]) for chain, followed in outcome if not followed],
             "plane": {"axis": "XYZ"[plane.axis], "asymmetry": plane.asymmetry, "two_sided": plane.two_sided()},

@@ -456,7 +456,7 @@ def mirror_surface(vertices, triangles):
                                    (corners + np.roll(corners, 1, axis=1)).reshape(-1, 3) / 2]))
 
 
-def mirror_plane(vertices, triangles, size):
+def mirror_plane(vertices, triangles, size, surface=None):
     """Of the three axis planes, each at the offset the mesh is most symmetric about, the one the mesh is most
     symmetric about.
 
@@ -466,7 +466,7 @@ def mirror_plane(vertices, triangles, size):
     symmetric body holding a prop to one side is not centred on its box). The plane is chosen by the asymmetry
     relative to the mesh's extent across the plane: a thin body mirrors onto itself front to back whatever its shape.
     """
-    tree = mirror_surface(vertices, triangles)
+    tree = mirror_surface(vertices, triangles) if surface is None else surface  # ``mirror_surface``, made once
     low, high = vertices.min(axis=0), vertices.max(axis=0)
     probe = vertices[::max(1, len(vertices) // PLANE_PROBES)]
     planes = []

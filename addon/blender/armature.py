@@ -34,15 +34,21 @@ def delete_armature(obj):
     something else uses them too: an exporter writes the actions it finds, and the file's old motion does not fit
     the new bones."""
     data = obj.data
-    animation = obj.animation_data
-    actions = set() if animation is None else {strip.action for track in animation.nla_tracks
-                                               for strip in track.strips if strip.action} | {animation.action} - {None}
+    actions = actions_of(obj.animation_data)
     bpy.data.objects.remove(obj)
     if data.users == 0:
         bpy.data.armatures.remove(data)
     for action in actions:
         if action.users == 0:
             bpy.data.actions.remove(action)
+
+
+def actions_of(animation):
+    """The actions of ``animation`` (an object's animation data, or None): its own and its NLA strips'."""
+    if animation is None:
+        return set()
+    strips = {strip.action for track in animation.nla_tracks for strip in track.strips}
+    return (strips | {animation.action}) - {None}
 
 
 def _edit_bones(obj, skeleton, frame):

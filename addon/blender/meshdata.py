@@ -9,6 +9,20 @@ def evaluated_arrays(obj, depsgraph=None):
     Modifiers and shape keys are applied and the object's world matrix (parents included) maps the vertices, so the
     skeleton lands where the user sees the mesh. ValueError for anything that is not a mesh object with faces.
     """
+    vertices, triangles = _evaluated(obj, depsgraph, mesh_arrays)
+    if not len(triangles):
+        raise ValueError(f"mesh {obj.name!r} has no faces to rig")
+    return vertices, triangles
+
+
+def evaluated_vertices(obj, depsgraph=None):
+    """The world-space vertices (N, 3) float64 of ``evaluated_arrays``, without triangulating (cheap)."""
+    return _evaluated(obj, depsgraph, lambda mesh: (mesh_vertices(mesh), None))[0]
+
+
+def _evaluated(obj, depsgraph, read):
+    """(world vertices, what else ``read`` gives) of mesh object ``obj`` as evaluated: ``read(mesh)`` gives
+    (vertices in the mesh's space, anything)."""
     if not isinstance(obj, bpy.types.Object):
         raise ValueError(f"expected a mesh object, got {type(obj).__name__}")
     if obj.type != 'MESH':
@@ -16,12 +30,10 @@ def evaluated_arrays(obj, depsgraph=None):
     depsgraph = depsgraph or bpy.context.evaluated_depsgraph_get()
     evaluated = obj.evaluated_get(depsgraph)
     try:
-        vertices, triangles = mesh_arrays(evaluated.to_mesh())
+        vertices, other = read(evaluated.to_mesh())
     finally:
         evaluated.to_mesh_clear()
-    if not len(triangles):
-        raise ValueError(f"mesh {obj.name!r} has no faces to rig")
-    return world_points(vertices, evaluated.matrix_world), triangles
+    return world_points(vertices, evaluated.matrix_world), other
 
 
 def mesh_vertices(mesh):

@@ -12,8 +12,8 @@ from ..core.scene import character_parts
 from ..core.targets import check_target, choose_target
 from ..core.timing import StageClock
 from . import overlays, skinning, targets
-from .armature import delete_armature
-from .meshdata import combined_arrays, evaluated_arrays
+from .armature import actions_of, delete_armature
+from .meshdata import combined_arrays, evaluated_vertices
 from .properties import ARMATURE_POINTER
 from .rigify import remove_extras
 
@@ -61,7 +61,7 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     report = progress or (lambda fraction: None)
     clock = StageClock()
     meshes = [obj, *(part for part in parts if part != obj)]
-    with _previous_rigs_at_rest(meshes):
+    with _without_previous_rigs(meshes):
         vertices, triangles = combined_arrays(meshes)
     clock.lap("read_mesh")
     report(0.1)
@@ -109,7 +109,7 @@ def _previous_motion(meshes):
         return None
     tracks = [(track.name, [(strip.name, strip.frame_start, strip.action) for strip in track.strips if strip.action])
               for track in animation.nla_tracks]
-    actions = ({animation.action} | {action for _, strips in tracks for _, _, action in strips}) - {None}
+    actions = actions_of(animation)
     if not actions:
         return None
     flags = {action: action.use_fake_user for action in actions}
@@ -166,7 +166,7 @@ def character_meshes(meshes):
     if len(meshes) < 2:
         return list(meshes), []
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    kept, left = character_parts([(mesh.name, evaluated_arrays(mesh, depsgraph)[0]) for mesh in meshes])
+    kept, left = character_parts([(mesh.name, evaluated_vertices(mesh, depsgraph)) for mesh in meshes])
     return [meshes[k] for k in kept], [(meshes[k], why) for k, why in left]
 
 
@@ -184,7 +184,7 @@ def own_axes(obj):
 
 
 @contextlib.contextmanager
-def _previous_rigs_at_rest(meshes):
+def _without_previous_rigs(meshes):
     """Turn off, meanwhile, the Armature modifiers by which the armatures Rigger made for ``meshes`` deform them: a
     mesh is rigged as it rests, not as the old rig posed it (rigging again removes the old rig, and the pose with
     it), and exactly so (an armature at its rest pose still moves vertices by float rounding, and a rig made of

@@ -248,8 +248,8 @@ def _round_part_on(ordered, points, radius, blobs, min_reach, round_tip):
     to its tip no farther than its radius and a half, else None: a head whose other branches went, leaving the chain
     running on from it to a corner of its outline."""
     base = ordered[0]
-    steps = np.linalg.norm(np.diff(points[ordered], axis=0), axis=1)
-    beyond = np.r_[np.cumsum(steps[::-1])[::-1], 0.0]  # the chain's length from each node to its tip
+    arc = arc_lengths(points[ordered])
+    beyond = arc[-1] - arc  # the chain's length from each node to its tip
     for k in range(len(ordered) - 2, 0, -1):
         node = ordered[k]
         apart = float(np.linalg.norm(points[node] - points[base]))
