@@ -166,6 +166,7 @@ def test_no_skin_and_fbx_output(humanoid_obj, tmp_path):
     ("bad_target", "invalid choice: 'nope'"),
     ("bad_output", "cannot write"),
     ("unreadable", "Blender could not import it"),
+    ("nan_vertex", "line 3: vertex coordinate 'nan' is not a finite number"),  # Blender would read 0
     ("folder", "is a folder, not a model file"),
     ("refusing_folder", "/proc: cannot write there"),
 ])
@@ -179,6 +180,9 @@ def test_errors_exit_non_zero_with_a_message_and_write_nothing(case, message, hu
         source.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\n")
     elif case == "line":
         source = write_obj(tmp_path / "line.obj", [(0, 0, 0), (1, 1, 1), (2, 2, 2), (3, 3, 3)], [(0, 1, 2), (1, 3, 2)])
+    elif case == "nan_vertex":
+        source = tmp_path / "nan.obj"
+        source.write_text("o Infantry\nv 0 0 0\nv nan 1 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n")
     elif case == "unreadable":
         source = tmp_path / "empty.glb"
         source.write_bytes(b"")

@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from rigger.core import bvh
+from rigger.core import bvh, objfile
 from rigger.core.mesh import Mesh, triangulate_polygons
 from rigger.core.params import Param, resolve
 from rigger.core.skeleton import Skeleton
@@ -389,6 +389,20 @@ def test_a_file_that_is_no_readable_bvh_says_why_in_one_line(tmp_path, text, mes
     with pytest.raises(bvh.BvhError) as error:
         bvh.check(path)
     assert message in str(error.value) and "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize("coordinate", ["nan", "-NaN", "inf", "-Infinity", "1e999", "-1E+400"])
+def test_an_obj_vertex_that_is_no_finite_number_is_named_by_its_line(tmp_path, monkeypatch, coordinate):
+    """Blender's OBJ importer reads these as 0 without a word: a spike to the origin. Lines are counted across the
+    chunks the file is read in."""
+    monkeypatch.setattr(objfile, "CHUNK_BYTES", 7)
+    path = tmp_path / "bad.obj"
+    path.write_text(f"mtllib info.mtl\no Infantry\nv 0 0 0\nv 1e300 1e-400 0\nv 0 {coordinate} 0\nf 1 2 3\n")
+    with pytest.raises(objfile.ObjError) as error:
+        objfile.check(path)
+    assert f"line 5: vertex coordinate {coordinate!r} is not a finite number" in str(error.value)
+    path.write_text("mtllib info.mtl\no Infantry\nusemtl nan\nv 0 0 0\r\nv 1e300 1e-400 0\nvt 0.5 0.5\nf 1 2 1\n")
+    objfile.check(path)  # words elsewhere, a large but finite number and an underflow to 0 are sound
 
 
 def test_a_blender_operator_error_is_one_clause():

@@ -6,6 +6,7 @@ import bpy
 import numpy as np
 
 from ..axes import axes_field, file_axes, to_blender
+from ..core import objfile
 from ..core.files import replaced_on_success
 from . import overlays, skinning
 from .armature import delete_armature
@@ -155,6 +156,7 @@ def _import(source, axes):
     suffix = source.suffix.lower()
     path = str(source)
     if suffix == ".obj":
+        objfile.check(source)  # what the importer would read as 0
         up, forward = axes
         bpy.ops.wm.obj_import(filepath=path, up_axis=_enum(up), forward_axis=_enum(forward))
         return to_blender(up, forward), f"file (the OBJ's v coordinates, read with up {up}, forward {forward})"

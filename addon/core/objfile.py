@@ -1,0 +1,57 @@
+"""What Blender's OBJ importer reads silently wrong: a vertex coordinate that is no finite number ("nan", "inf", an
+exponent past the float range) becomes 0, a spike to the origin that rigs and skins without a warning."""
+import math
+import pathlib
+import re
+
+CHUNK_BYTES = 1 << 24  # read this much at a time (and on to the end of its line): a large file is never held whole
+_WORDS = (b"nan", b"inf")  # in lowered text, with a three-digit exponent: what could spell a non-finite number
+_EXPONENT = re.compile(rb"e\+?\d{3}")  # begins with a literal: searched as fast as bytes.find
+
+
+class ObjError(ValueError):
+    """An OBJ file that Blender would read wrong, or not at all; the message names the file and the line."""
+
+
+def check(path):
+    """ObjError naming the first ``v`` line of the OBJ file at ``path`` whose coordinates are not all finite
+    numbers. Only lines holding "nan", "inf" or a three-digit exponent are parsed, so a sound file costs one pass
+    of a byte search."""
+    path = pathlib.Path(path)
+    try:
+        with open(path, "rb") as file:
+            lines_before = 0
+            while chunk := file.read(CHUNK_BYTES):
+                chunk += file.readline()  # whole lines only
+                _check_chunk(path, chunk, lines_before)
+                lines_before += chunk.count(b"\n")
+    except OSError as error:
+        raise ObjError(f"{path}: cannot read it: {error.strerror or error}") from None
+
+
+def _suspects(lowered):
+    """Where "nan", "inf" or a three-digit exponent occur in ``lowered`` text."""
+    for word in _WORDS:
+        at = lowered.find(word)
+        while at >= 0:
+            yield at
+            at = lowered.find(word, at + 1)
+    yield from (match.start() for match in _EXPONENT.finditer(lowered))
+
+
+def _check_chunk(path, chunk, lines_before):
+    lowered = chunk.lower()
+    for start in sorted({lowered.rfind(b"\n", 0, at) + 1 for at in _suspects(lowered)}):
+        end = lowered.find(b"\n", start)
+        words = chunk[start:len(chunk) if end < 0 else end].split()
+        if words[:1] != [b"v"]:
+            continue
+        for word in words[1:4]:
+            try:
+                finite = math.isfinite(float(word))
+            except ValueError:
+                finite = False
+            if not finite:
+                line = lines_before + chunk.count(b"\n", 0, start) + 1
+                raise ObjError(f"{path}: line {line}: vertex coordinate {word.decode(errors='replace')!r} is not a "
+                               f"finite number (Blender's importer would read it as 0)")
