@@ -9,6 +9,7 @@ from .core.mesh import Mesh
 from .core.params import resolve
 from .core.registry import RigMethod, check_method, discover
 from .core.roles import Roles
+from .core.rooting import pelvis, rerooted
 from .core.skeleton import Skeleton
 from .core.stages import Placement
 
@@ -46,7 +47,8 @@ def rig_mesh(vertices, triangles, method="silhouette", *, axes=None, **params):
     out-of-range parameters, and bad meshes. The skeleton's ``params`` are the resolved values, its ``body_plan``
     and ``roles`` what ``rigger.core.bodyplan.recognise`` makes of it on this mesh (Z up preferred, as in Blender;
     the method's mirror plane when it has one; also drawn as the "roles" stage), and its ``timings["total"]`` the
-    seconds for this whole call.
+    seconds for this whole call. A skeleton whose legs hang from another joint than its root's is rooted there,
+    at the pelvis (``rigger.core.rooting``).
     """
     start = time.perf_counter()
     rigging = _method(method)
@@ -60,6 +62,9 @@ def rig_mesh(vertices, triangles, method="silhouette", *, axes=None, **params):
         raise TypeError(f"method {rigging.name!r} returned {type(skeleton).__name__}, not a Skeleton")
     recognised = time.perf_counter()
     skeleton.body_plan, skeleton.roles = recognise(skeleton, mesh, plane=skeleton.stages.get("mirror_plane"))
+    root = pelvis(skeleton)
+    if root is not None:
+        skeleton = rerooted(skeleton, *root)
     body_plan_seconds = time.perf_counter() - recognised
     if rotation is not None:
         skeleton = _turned_back(skeleton, rotation)

@@ -11,6 +11,7 @@ from conftest import shared_path
 from meshes import box, combine
 from rigdata import load_obj
 from rigger import samples
+from rigger.core import rooting
 from rigger.core.body import read_body
 from rigger.core.bodyplan import KINDS, BodyPlan, recognise
 from rigger.core.mesh import Mesh
@@ -334,6 +335,59 @@ def test_rig_mesh_fills_in_the_plan_the_roles_and_their_labels(rigged):
     assert set(skeleton.body_plan.to_dict()) == {"kind", "confidence", "reason", "parts"}  # no points: frame-free
     moved = skeleton.transformed(np.diag([2.0, 2.0, 2.0, 1.0]))
     assert moved.roles == skeleton.roles and moved.body_plan is skeleton.body_plan
+
+
+def descendants(skeleton, bone):
+    """Every bone below ``bone`` in the hierarchy."""
+    below, todo = set(), [bone]
+    while todo:
+        found = set(skeleton.children(todo.pop())) - below
+        below |= found
+        todo += found
+    return below
+
+
+@pytest.mark.parametrize("name", ["quadruped", "bear"])
+def test_a_body_with_legs_hangs_from_its_pelvis(name):
+    """The silhouette method roots these at the withers (their most central branch point), so turning a spine bone
+    swung the hind legs and the hips hung from the chest. rig_mesh roots them where the hind legs start: the trunk
+    runs from the hips forwards, each bone from its parent's end, and no spine bone carries a leg."""
+    skeleton = rigger.rig_mesh(*load_character(name))
+    (root,) = skeleton.roots
+    assert skeleton.names[root] == "trunk.00" and skeleton.roles[root].label == "hips"
+    legs = [bone for bone, role in enumerate(skeleton.roles) if role.side and role.role == "hips"]
+    assert len(legs) == 2 and all(skeleton.parents[leg] == root for leg in legs)
+    np.testing.assert_allclose(skeleton.heads[legs], skeleton.heads[[root, root]], atol=1e-12)
+    trunk = [bone for bone, role in enumerate(skeleton.roles) if role.role in ("spine", "chest")]
+    assert trunk and all(np.allclose(skeleton.heads[bone], skeleton.tails[skeleton.parents[bone]]) for bone in trunk)
+    leg_bones = set(legs).union(*(descendants(skeleton, leg) for leg in legs))
+    assert not any(descendants(skeleton, bone) & leg_bones for bone in trunk)
+
+
+def test_rerooting_turns_the_bones_between_the_old_root_and_the_new_one():
+    """A trunk rooted at the chest (a, then b down to the hips), legs from its lower end, a neck from its upper end
+    with an ear hanging off it apart from its ends, and a second root: rooted at the hips, a and b turn round and
+    swap names, the legs hang from the new root, the neck from the bone now ending at the chest, the ear and the
+    other root stay; the joints and the plan's named places are where they were. The turned bones trade places
+    and so names: the root is bone 0, trunk.00, as before."""
+    chest, middle, hips, knee_l, knee_r = [0, 0, 2.0], [0, 0, 1.5], [0, 0, 1.0], [0.3, 0, 0.5], [-0.3, 0, 0.5]
+    neck_top, ear_head, ear_tip, rock = [0, 0.2, 2.5], [0.1, 0.2, 2.6], [0.3, 0.2, 2.9], [3.0, 0, 0]
+    heads = [chest, middle, hips, hips, chest, ear_head, rock]
+    tails = [middle, hips, knee_l, knee_r, neck_top, ear_tip, [3.0, 0, 1.0]]
+    names = ("trunk.00", "trunk.01", "limb01.00.L", "limb01.00.R", "limb02.00", "limb03.00", "rock.00")
+    roles = [BoneRole("chest"), BoneRole("hips"), BoneRole("thigh", "L"), BoneRole("thigh", "R"), BoneRole("neck"),
+             BoneRole("other"), BoneRole("other")]
+    skeleton = Skeleton(names, heads, tails, [-1, 0, 1, 1, 0, 4, -1], roles=roles,
+                        body_plan=BodyPlan("humanoid", 1.0, "test", joints={("hips", None, None): ((1, 1.0, 1.0),)}))
+    assert rooting.pelvis(skeleton) == (1, 1)
+    moved = rooting.rerooted(skeleton, 1, 1)
+    assert moved.names == names
+    np.testing.assert_array_equal(moved.heads[:2], [hips, middle])
+    np.testing.assert_array_equal(moved.tails[:2], [middle, chest])
+    assert moved.parents.tolist() == [-1, 0, 0, 0, 1, 4, -1]
+    assert moved.roles == (roles[1], roles[0], *roles[2:]) and rooting.pelvis(moved) is None
+    np.testing.assert_array_equal(np.unique(moved.joints(), axis=0), np.unique(skeleton.joints(), axis=0))
+    np.testing.assert_allclose(named_joints(moved)[("hips", None, None)], hips)
 
 
 def test_labels_read_well():
