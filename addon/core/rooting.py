@@ -37,9 +37,10 @@ def rerooted(skeleton, bone, end):
     Bones meet at joints: a bone's head is its parent's tail or head where it lies within ``SAME_POINT``, else a
     joint of its own hanging from the nearer of them. The bones on the way from the new root joint to the old one
     turn round (head and tail swap) and trade places in the bone order end for end, keeping the names of the places
-    (the new root takes the old one's, ``trunk.00``), parents still first; every bone then hangs from the bone that
-    holds the joint it starts at. Of the bones starting at the new root joint, the one on the way to the old root (else
-    ``bone``) is the root and the others hang from it. Stages, timings and parameters are shared, roles go with
+    (the new root takes the old one's, ``trunk.00``), parents still first. A turned bone, and one that started where
+    its turned parent ended, hangs from the bone now ending there; every other bone keeps its parent. Of the bones
+    starting at the new root joint, the one on the way to the old root (else ``bone``) is the root and the others
+    hang from it. Stages, timings and parameters are shared, roles go with
     their bones (a bone keeps its role whichever way it runs), and the body plan's places on turned bones are
     measured from their new heads."""
     count, parents = len(skeleton), skeleton.parents.tolist()
@@ -82,14 +83,16 @@ def rerooted(skeleton, bone, end):
     way.reverse()
     heads, tails = skeleton.heads.copy(), skeleton.tails.copy()
     heads[turned], tails[turned] = skeleton.tails[turned], skeleton.heads[turned]
-    new_head = {b: tail_node[b] if b in turned else head_node[b] for b in reached}
-    root = old_root if not way else way[0] if new_head[way[0]] == start else bone
+    root = old_root if not way else way[0] if tail_node[way[0]] == start else bone
     new_parents = list(parents)
-    for b in reached:
-        node = new_head[b]
-        while node != start and arriving[node] < 0:  # a joint of its own: up the link
-            node = previous[node]
-        new_parents[b] = -1 if b == root else root if node == start else arriving[node]
+    for b in reached:  # a bone turned, or starting where its turned parent ended, hangs from the bone ending there
+        joint = tail_node[b] if b in turned else head_node[b] if parents[b] in turned else None
+        if b == root:
+            new_parents[b] = -1
+        elif joint == start:
+            new_parents[b] = root
+        elif joint is not None and (b in turned or joint == tail_node[parents[b]]):
+            new_parents[b] = arriving[joint]
     slots = list(range(count))  # the turned bones on the way trade places end for end, the new root's first
     for place, old in zip(sorted(way), way):
         slots[place] = old
