@@ -275,6 +275,18 @@ def test_landmarks_mark_the_ends_of_the_body(rigged):
     assert landmarks(samples.ground_truth_bones("humanoid")) == {}  # not recognised yet
 
 
+@pytest.mark.parametrize("name, within", [("head_with_nose", 0.016), ("four_arms", 0.06)])
+def test_a_humanoid_s_head_begins_where_its_neck_meets_the_skull(name, within):
+    """The mesh is thinnest near the crown of a head as wide as its neck, so the neck's thinnest joint there put the
+    head's start near the top (0.022 and 0.076 of the size off): turning the head left the face behind. A humanoid's
+    head begins in the lower part of the way from the neck's base to the head's top, where the artists put it."""
+    vertices, triangles = load_character(name)
+    truth = samples.ground_truth_bones(name)
+    true_head = truth.heads[truth.names.index("head")]
+    head = named_joints(rigger.rig_mesh(vertices, triangles))[("head", None, None)]
+    assert np.linalg.norm(head - true_head) <= within * np.ptp(vertices, axis=0).max()
+
+
 def test_a_mirror_plane_runs_along_the_body_not_across_it():
     """A lying body's joints in a line pair across any plane cut through them: no mirror plane is fitted there."""
     vertices = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 0.13) for z in (0.0, 0.1 + 0.07 * x)])
@@ -366,12 +378,12 @@ def test_a_body_with_legs_hangs_from_its_pelvis(name):
 
 def test_rerooting_turns_the_bones_between_the_old_root_and_the_new_one():
     """A trunk rooted at the chest (a, then b down to the hips), legs from its lower end, a neck from its upper end
-    with an ear hanging off it apart from its ends, and a second root: rooted at the hips, a and b turn round and
-    swap names, the legs hang from the new root, the neck from the bone now ending at the chest, the ear and the
-    other root stay; the joints and the plan's named places are where they were. The turned bones trade places
-    and so names: the root is bone 0, trunk.00, as before."""
+    with an ear hanging off it near its start (no joint), and a second root: rooted at the hips, a and b turn round
+    and trade places (and so names: the root is bone 0, trunk.00, as before), the legs hang from the new root, the
+    neck from the bone now ending at the chest, the ear from the neck still and the other root stays; the joints
+    and the plan's named places are where they were."""
     chest, middle, hips, knee_l, knee_r = [0, 0, 2.0], [0, 0, 1.5], [0, 0, 1.0], [0.3, 0, 0.5], [-0.3, 0, 0.5]
-    neck_top, ear_head, ear_tip, rock = [0, 0.2, 2.5], [0.1, 0.2, 2.6], [0.3, 0.2, 2.9], [3.0, 0, 0]
+    neck_top, ear_head, ear_tip, rock = [0, 0.2, 2.5], [0.1, 0.05, 2.1], [0.3, 0.2, 2.9], [3.0, 0, 0]
     heads = [chest, middle, hips, hips, chest, ear_head, rock]
     tails = [middle, hips, knee_l, knee_r, neck_top, ear_tip, [3.0, 0, 1.0]]
     names = ("trunk.00", "trunk.01", "limb01.00.L", "limb01.00.R", "limb02.00", "limb03.00", "rock.00")

@@ -120,6 +120,9 @@ class RoleTuning(TuningTable):
     spine_at: float = tuned(0.45, "its spine joint: this share of that height")
     chest_at: float = tuned(0.65, "its chest joint: this share")
     neck_at: float = tuned(0.85, "its neck joint: this share")
+    head_below: float = tuned(0.6, "a humanoid's head begins no farther than this share of the way from the neck's "
+                                   "base to the head's top (the artists' 0.24 to 0.46): above, the mesh is thin for "
+                                   "the crown, not for a neck")
     spine_fall: float = tuned(0.02, "... on its spine up to where it falls this share of the height (a hunched "
                                     "figure's head hanging forward)")
     named_reach: float = tuned(0.75, "a target's joint moves to its named joint only within this share of its "
@@ -286,7 +289,12 @@ def _spine_roles(body, layout, tuning):
     names += (["hips"] + ["spine"] * (torso - 2) + ["chest"]) if torso >= 3 else ["hips", "spine"][:torso]
     above = count - chest
     if above >= 3:
-        thinnest = chest + 1 + int(np.argmin(body.radius[spine[chest + 1:count]]))
+        low = count  # the candidates: chest + 1 .. low - 1
+        if kind == "humanoid":
+            top = arc[-1] + _reach(body, points)
+            low = chest + 2 + int(np.count_nonzero(arc[chest + 2:count] - arc[chest] <= tuning.head_below
+                                                   * (top - arc[chest])))
+        thinnest = chest + 1 + int(np.argmin(body.radius[spine[chest + 1:low]]))
         # the ears are on the skull: a bone they hang from (all but the first above the chest) is the head's
         ears = [spine.index(body.bases[k]) for k, part in enumerate(layout.parts) if part == "ear"
                 and body.bases[k] in spine]
