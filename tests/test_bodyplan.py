@@ -276,6 +276,15 @@ def test_landmarks_mark_the_ends_of_the_body(rigged):
     assert landmarks(samples.ground_truth_bones("humanoid")) == {}  # not recognised yet
 
 
+def test_rerooting_across_a_gap_keeps_one_tree():
+    """A trunk bone hanging off its parent's end with a gap (no joint there) still turns and still hangs from it."""
+    skeleton = Skeleton(("trunk.00", "trunk.01", "leg.L", "leg.R"), [[0, 0, 2.0], [0, 0, 1.45], [0, 0, 1], [0, 0, 1]],
+                        [[0, 0, 1.5], [0, 0, 1.0], [0.3, 0, 0], [-0.3, 0, 0]], [-1, 0, 1, 1])
+    moved = rooting.rerooted(skeleton, 1, 1)
+    assert moved.parents.tolist() == [-1, 0, 0, 0] and moved.roots == (0,)
+    np.testing.assert_array_equal(moved.heads[:2], [[0, 0, 1.0], [0, 0, 1.5]])
+
+
 @pytest.mark.parametrize("name, within", [("head_with_nose", 0.016), ("four_arms", 0.06)])
 def test_a_humanoid_s_head_begins_where_its_neck_meets_the_skull(name, within):
     """The mesh is thinnest near the crown of a head as wide as its neck, so the neck's thinnest joint there put the

@@ -40,9 +40,8 @@ def rerooted(skeleton, bone, end):
     (the new root takes the old one's, ``trunk.00``), parents still first. A turned bone, and one that started where
     its turned parent ended, hangs from the bone now ending there; every other bone keeps its parent. Of the bones
     starting at the new root joint, the one on the way to the old root (else ``bone``) is the root and the others
-    hang from it. Stages, timings and parameters are shared, roles go with
-    their bones (a bone keeps its role whichever way it runs), and the body plan's places on turned bones are
-    measured from their new heads."""
+    hang from it. Stages, timings and parameters are shared, roles go with their bones (a bone keeps its role
+    whichever way it runs), and the body plan's places on turned bones are measured from their new heads."""
     count, parents = len(skeleton), skeleton.parents.tolist()
     tolerance = SAME_POINT * _size(skeleton)
     head_node, tail_node = [0] * count, [0] * count
@@ -73,26 +72,30 @@ def rerooted(skeleton, bone, end):
                 arriving[other], previous[other] = edge, node
                 queue.append(other)
     reached = [b for b in range(count) if head_node[b] in arriving]  # the new root's island
-    turned = [b for b in reached if arriving[head_node[b]] == b]  # reached tail first
     old_root = next(b for b in reached if parents[b] < 0)
-    way, node = [], head_node[old_root]  # the bones from the new root joint to the old one
+    way, node = [], head_node[old_root]  # the bones from the new root joint to the old one: they turn
     while node != start:
         if arriving[node] >= 0:
             way.append(arriving[node])
         node = previous[node]
     way.reverse()
+    turned = set(way)
     heads, tails = skeleton.heads.copy(), skeleton.tails.copy()
-    heads[turned], tails[turned] = skeleton.tails[turned], skeleton.heads[turned]
+    heads[way], tails[way] = skeleton.tails[way], skeleton.heads[way]
     root = old_root if not way else way[0] if tail_node[way[0]] == start else bone
+
+    def holder(node):  # the bone now ending at a joint (up the links of joints of their own), None at the root
+        while node != start and arriving[node] < 0:
+            node = previous[node]
+        return None if node == start else arriving[node]
+
     new_parents = list(parents)
-    for b in reached:  # a bone turned, or starting where its turned parent ended, hangs from the bone ending there
-        joint = tail_node[b] if b in turned else head_node[b] if parents[b] in turned else None
+    for b in reached:  # a turned bone, or one starting where its turned parent ended, hangs from the bone ending there
         if b == root:
             new_parents[b] = -1
-        elif joint == start:
-            new_parents[b] = root
-        elif joint is not None and (b in turned or joint == tail_node[parents[b]]):
-            new_parents[b] = arriving[joint]
+        elif b in turned or (parents[b] in turned and head_node[b] == tail_node[parents[b]]):
+            held = holder(tail_node[b] if b in turned else head_node[b])
+            new_parents[b] = root if held is None else held
     slots = list(range(count))  # the turned bones on the way trade places end for end, the new root's first
     for place, old in zip(sorted(way), way):
         slots[place] = old
@@ -102,8 +105,7 @@ def rerooted(skeleton, bone, end):
     new_of = {old: k for k, old in enumerate(old_of)}
     plan = skeleton.body_plan
     if plan is not None:
-        flipped = set(turned)
-        plan = replace(plan, joints={key: tuple((new_of[b], 1.0 - share if b in flipped else share, weight)
+        plan = replace(plan, joints={key: tuple((new_of[b], 1.0 - share if b in turned else share, weight)
                                                 for b, share, weight in place)
                                      for key, place in plan.joints.items()})
     moved = Skeleton([skeleton.names[place] for place in order], heads[old_of], tails[old_of],
