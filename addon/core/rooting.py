@@ -37,10 +37,10 @@ def rerooted(skeleton, bone, end):
     Bones meet at joints: a bone's head is its parent's tail or head where it lies within ``SAME_POINT``, else a
     joint of its own hanging from the nearer of them. The bones on the way from the new root joint to the old one
     turn round (head and tail swap) and trade places in the bone order end for end, keeping the names of the places
-    (the new root takes the old one's, ``trunk.00``), parents still first. A turned bone, and one that started where
-    its turned parent ended, hangs from the bone now ending there; every other bone keeps its parent. Of the bones
-    starting at the new root joint, the one on the way to the old root (else ``bone``) is the root and the others
-    hang from it. Stages, timings and parameters are shared, roles go with their bones (a bone keeps its role
+    (the new root takes the first one's: ``trunk.00`` when the trunk turns), parents still first. A turned bone, the
+    old root, and a bone that started where its turned parent ended hang from the bone now ending there; every other
+    bone keeps its parent. Of the bones starting at the new root joint, the one on the way to the old root (else
+    ``bone``) is the root and the others hang from it. Stages, timings and parameters are shared, roles go with their bones (a bone keeps its role
     whichever way it runs), and the body plan's places on turned bones are measured from their new heads."""
     count, parents = len(skeleton), skeleton.parents.tolist()
     tolerance = SAME_POINT * _size(skeleton)
@@ -90,10 +90,10 @@ def rerooted(skeleton, bone, end):
         return None if node == start else arriving[node]
 
     new_parents = list(parents)
-    for b in reached:  # a turned bone, or one starting where its turned parent ended, hangs from the bone ending there
+    for b in reached:
         if b == root:
             new_parents[b] = -1
-        elif b in turned or (parents[b] in turned and head_node[b] == tail_node[parents[b]]):
+        elif b in turned or b == old_root or (parents[b] in turned and head_node[b] == tail_node[parents[b]]):
             held = holder(tail_node[b] if b in turned else head_node[b])
             new_parents[b] = root if held is None else held
     slots = list(range(count))  # the turned bones on the way trade places end for end, the new root's first
