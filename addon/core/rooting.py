@@ -40,8 +40,9 @@ def rerooted(skeleton, bone, end):
     (the new root takes the first one's: ``trunk.00`` when the trunk turns), parents still first. A turned bone, the
     old root, and a bone that started where its turned parent ended hang from the bone now ending there; every other
     bone keeps its parent. Of the bones starting at the new root joint, the one on the way to the old root (else
-    ``bone``) is the root and the others hang from it. Stages, timings and parameters are shared, roles go with their bones (a bone keeps its role
-    whichever way it runs), and the body plan's places on turned bones are measured from their new heads."""
+    ``bone``) is the root and the others hang from it. Stages, timings and parameters are shared, roles go with
+    their bones (a bone keeps its role whichever way it runs), and the body plan's places on turned bones are
+    measured from their new heads."""
     count, parents = len(skeleton), skeleton.parents.tolist()
     tolerance = SAME_POINT * _size(skeleton)
     head_node, tail_node = [0] * count, [0] * count
