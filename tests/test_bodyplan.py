@@ -176,6 +176,15 @@ def test_twins_get_twin_roles(rigged, name):
         assert left == right and left
 
 
+def test_a_chain_named_right_is_on_the_right_though_the_body_s_path_runs_through_it():
+    """cheburashka read Y up has no mirror plane within 1%, and the body's longest path runs through its right ear:
+    those bones got no side while their left twins had one."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "cheburashka.obj"))
+    skeleton = rigger.rig_mesh(vertices @ Y_UP.T, triangles)  # as Blender imports it
+    sided = [(name[-1], role.side) for name, role in zip(skeleton.names, skeleton.roles) if name[-2:] in (".L", ".R")]
+    assert {side for side, _ in sided} == {"L", "R"} and all(side == given for side, given in sided)
+
+
 def test_sides_follow_the_bone_names_and_the_mirror_plane(rigged):
     skeleton = rigged["humanoid"]
     for name, role in zip(skeleton.names, skeleton.roles):

@@ -29,7 +29,7 @@ the shoulder joints. :func:`landmarks` gives the ends no role begins at, placed 
 toe tips, finger tips, heels. A place is a weighted sum of points on bones, so named joints and landmarks follow
 the skeleton when it is moved (``Skeleton.transformed``).
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -175,7 +175,14 @@ def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
         for nodes in _paths(limb):
             put(nodes, [part] * (len(nodes) - 1), side)
     _mirror_twin_roles(roles, body, segment_bone)
-    return _filled(roles, skeleton, kind)
+    return _named_sides(_filled(roles, skeleton, kind), skeleton.names)
+
+
+def _named_sides(roles, names):
+    """``roles`` with a side wherever the bone's name has one and its role none: a chain named ``.R`` that the
+    body's path runs through (one ear of a figure without a mirror plane) is on the right like its ``.L`` twin."""
+    return tuple(replace(role, side=name[-1]) if role.side is None and name[-2:] in (".L", ".R") else role
+                 for role, name in zip(roles, names))
 
 
 def _mirror_twin_roles(roles, body, segment_bone):
