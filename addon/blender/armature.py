@@ -68,7 +68,7 @@ def _edit_bones(obj, skeleton, frame):
 
 
 def _add_bones(data, skeleton, frame):
-    size = float(np.ptp(np.concatenate([skeleton.heads, skeleton.tails]), axis=0).max())
+    size = skeleton.extent
     bones = []
     for name, head, tail in zip(skeleton.names, skeleton.heads, skeleton.tails):
         bone = data.edit_bones.new(name)

@@ -24,7 +24,7 @@ def pelvis(skeleton):
     if len(starts) < 2 or len(bases) != 1:
         return None
     base = bases.pop()
-    tolerance = SAME_POINT * _size(skeleton)
+    tolerance = SAME_POINT * skeleton.extent
     for end, points in ((1, skeleton.tails), (0, skeleton.heads)):
         if np.linalg.norm(skeleton.heads[starts] - points[base], axis=1).max() <= tolerance:
             return None if end == 0 and skeleton.parents[base] < 0 else (base, end)
@@ -44,7 +44,7 @@ def rerooted(skeleton, bone, end):
     their bones (a bone keeps its role whichever way it runs), and the body plan's places on turned bones are
     measured from their new heads."""
     count, parents = len(skeleton), skeleton.parents.tolist()
-    tolerance = SAME_POINT * _size(skeleton)
+    tolerance = SAME_POINT * skeleton.extent
     head_node, tail_node = [0] * count, [0] * count
     neighbours = [[] for _ in range(2 * count)]  # node -> (node, bone or -1 for a link)
     for child in _parents_first(parents):
@@ -129,8 +129,3 @@ def _parents_first(parents):
         order.append(bone)
         waiting += children.get(bone, [])
     return order
-
-
-def _size(skeleton):
-    points = np.concatenate([skeleton.heads, skeleton.tails])
-    return float(np.ptp(points, axis=0).max())

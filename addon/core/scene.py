@@ -20,10 +20,11 @@ def character_parts(parts):
     here (rigging reports them)."""
     parts = [(name, vertices[np.isfinite(vertices).all(axis=1)]) for name, vertices in parts]
     parts = [(name, vertices if len(vertices) else np.zeros((1, 3))) for name, vertices in parts]
-    slabs = [_thickness(vertices) <= SLAB * _extent(vertices) for _, vertices in parts]
+    frames = [_principal_axes(vertices) for _, vertices in parts]
+    slabs = [_thickness(vertices, axes) <= SLAB * _extent(vertices) for (_, vertices), axes in zip(parts, frames)]
     main = next((k for k, slab in enumerate(slabs) if not slab), 0)
     name, vertices = parts[main]
-    axes = _principal_axes(vertices)
+    axes = frames[main]
     low, high = (vertices @ axes.T).min(axis=0), (vertices @ axes.T).max(axis=0)
     size = _extent(vertices)
     reach_low, reach_high = low - NEAR * size, high + NEAR * size
@@ -51,6 +52,6 @@ def _principal_axes(vertices):
     return np.linalg.svd(centred[::max(1, len(centred) // 10_000)], full_matrices=False)[2]
 
 
-def _thickness(vertices):
-    """The extent of ``vertices`` across their flattest direction."""
-    return float(np.ptp((vertices - vertices.mean(axis=0)) @ _principal_axes(vertices)[-1]))
+def _thickness(vertices, axes):
+    """The extent of ``vertices`` across their flattest direction (the last of their principal ``axes``)."""
+    return float(np.ptp((vertices - vertices.mean(axis=0)) @ axes[-1]))

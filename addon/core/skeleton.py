@@ -72,6 +72,11 @@ class Skeleton:
         return f"Skeleton({len(self)} bones, roots {[self.names[i] for i in self.roots]})"
 
     @property
+    def extent(self):
+        """The largest extent of the box around the bones' ends."""
+        return float(np.ptp(np.concatenate([self.heads, self.tails]), axis=0).max())
+
+    @property
     def roots(self):
         """Indices of the bones without a parent, in index order."""
         return tuple(int(i) for i in np.flatnonzero(self.parents == -1))
