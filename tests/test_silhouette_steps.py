@@ -9,7 +9,8 @@ from rigger import silhouette
 from rigger.core.arrays import column_bounds
 from rigger.core.graphs import chains_of
 from rigger.core.joints import Cutting, chain_joints, symmetric_joints
-from rigger.core.mirror import Symmetry, mirror_chain_pairs, mirror_completed, mirror_plane, sided_symmetry
+from rigger.core.mirror import (Symmetry, mirror_chain_pairs, mirror_completed, mirror_plane, mirrored,
+                                 sided_symmetry)
 from rigger.core.naming import bone_names
 from rigger.core.polyline import arc_lengths, segment_distances
 from rigger.methods.silhouette import depth
@@ -475,13 +476,39 @@ def test_twins_of_a_body_that_only_roughly_mirrors_meet_halfway():
     of different shapes allow)."""
     bent, other = np.array([[0.0, 0.0, 0.0], [0.13, 0.0, 0.1], [0.4, 0.0, 0.0]]), straight(-0.45)
     own = [chain_joints(line, cutting(4), leaf=True) for line in (bent, other)]
-    result = symmetric_joints(leaves(bent, other), cutting(4), ACROSS_X, mirror=False)
+    result = symmetric_joints(leaves(bent, other), cutting(4), ACROSS_X, exact=False)
     assert len(own[0]) == len(own[1]) == len(result[0]) == len(result[1]) > 2
     for line, joints in zip((bent, other), result):
         np.testing.assert_array_equal(joints[0], line[0])
         assert segment_distances(joints, line[:-1], line[1:]).min(axis=1).max() < 1e-9
     apart = [np.linalg.norm(joints - ACROSS_X.reflect(twin), axis=1)[1:] for joints, twin in (result, own)]
     assert (apart[0] <= apart[1] + 1e-9).all() and apart[0].mean() < 0.8 * apart[1].mean()
+
+
+def test_twins_of_a_body_that_only_roughly_mirrors_mirror_where_they_nearly_do():
+    """Two arms 0.08 thick across a plane the body only roughly mirrors about, the right one traced 0.01 deeper and
+    its hand bent down, and two legs, the right one 0.01 farther out: the joints that nearly mirror after meeting
+    halfway (the arms' shoulder ends, the legs) become exact mirror images across one plane, the middle between
+    them, each within its limb; the bent hand's joints, too far from their twins' images for a mean inside both
+    arms, stay on their own lines."""
+    left = np.array([[0.0, 1.0, 0.0], [0.6, 1.0, 0.0]])
+    right = np.array([[0.0, 1.0, 0.01], [-0.42, 1.0, 0.01], [-0.54, 0.9, 0.01]])
+    legs = [np.array([[0.0, 0.5, 0.0], [0.3, 0.4, 0.0], [0.3, 0.0, 0.0]]),
+            np.array([[0.0, 0.5, 0.0], [-0.31, 0.4, 0.0], [-0.31, 0.0, 0.0]])]
+    lines = (left, right, *legs)
+    chains = [(line, np.full(len(line), 0.04), True) for line in lines]
+    result = symmetric_joints(chains, cutting(), Symmetry((0, 0.0), 0.15, TUNING), exact=False)
+    assert len(result[0]) == len(result[1]) > 3 and len(result[2]) == len(result[3]) > 3
+    middle = (0, (result[2][1, 0] + result[3][1, 0]) / 2)
+    assert -0.005 < middle[1] < 0
+    arms = np.linalg.norm(result[0] - mirrored(result[1], middle), axis=1)
+    assert arms[1] < 1e-12 and arms[-1] > 0.05  # the shoulder's joint mirrors, the hand's does not
+    np.testing.assert_allclose(result[2][1:], mirrored(result[3][1:], middle), atol=1e-12)
+    for k, (line, joints) in enumerate(zip(lines, result)):
+        np.testing.assert_array_equal(joints[0], line[0])
+        off = segment_distances(joints, line[:-1], line[1:]).min(axis=1)
+        mirrors = np.linalg.norm(joints - mirrored(result[k ^ 1], middle), axis=1) < 1e-12
+        assert (off[mirrors] <= 0.04).all() and (off[~mirrors] < 1e-9).all()
 
 
 def test_a_leaf_running_on_along_its_twins_image_takes_that_image():

@@ -3,7 +3,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .mirror import mirror_chain_pairs
+from .mirror import mirror_chain_pairs, mirrored
 from .polyline import arc_lengths, arc_nearest, length, point_at, resampled
 from .tuning import TuningTable, tuned
 
@@ -166,7 +166,7 @@ def _turns(line, tolerance):
     return turns
 
 
-def symmetric_joints(chains, cutting, symmetry, mirror=True):
+def symmetric_joints(chains, cutting, symmetry, exact=True):
     """Joints along each of the (polyline, half-widths or None, is a leaf) ``chains`` (``chain_joints``), each pair
     of mirror twins (``mirror_chain_pairs``) given mirror-image joints where the mesh allows, so every bone has a
     twin in the mirrored place (``.L`` and ``.R``, X-mirror posing).
@@ -177,23 +177,36 @@ def symmetric_joints(chains, cutting, symmetry, mirror=True):
     the joints of one of them: the shorter's when the longer is a leaf (both arms end at the wrist), else the
     longer's when the shorter is a leaf. Twins whose lines differ (a leg stepping forward) keep their own joints but
     get one bone count: the smaller, unless the other's corners or the longest bone need more, then the larger.
-    Each chain keeps its first joint, where it attaches to its parent. Without ``mirror`` (a body that only roughly
-    mirrors about the plane: its twins are no images of each other) twins get one bone count, and their joints meet
-    halfway (``_met_halfway``).
+    Each chain keeps its first joint, where it attaches to its parent.
+
+    Across a plane the body only roughly mirrors about (not ``exact``: a posed or hand-made figure, whose twins are
+    no images of each other) twins get one bone count and their joints meet halfway (``_met_halfway``); those that
+    then nearly mirror each other (``_nearly_mirrored``) move to their mean, mirror images across the plane
+    midway between all such joints (the body's own middle, which a posed figure's box or spine may miss).
     """
     chains = [(line, np.zeros(len(line)) if widths is None else widths, leaf) for line, widths, leaf in chains]
     joints = [chain_joints(line, cutting, widths, leaf) for line, widths, leaf in chains]
     lines = [line for line, _, _ in chains]
+    close = []  # (i, j, which of their joints nearly mirror) across a rough plane
     for i, j in mirror_chain_pairs(lines, symmetry):
-        shared = _shared_joints(chains[i], chains[j], joints[i], joints[j], cutting, symmetry) if mirror else None
+        shared = _shared_joints(chains[i], chains[j], joints[i], joints[j], cutting, symmetry) if exact else None
         if shared is not None:
             joints[i] = np.vstack([joints[i][:1], shared[1:]])
             joints[j] = np.vstack([joints[j][:1], symmetry.reflect(shared)[1:]])
-        else:
-            if len(joints[i]) != len(joints[j]):
-                joints[i], joints[j] = _one_count(chains[i], chains[j], joints[i], joints[j], cutting)
-            if not mirror:
-                joints[i], joints[j] = _met_halfway(lines[i], lines[j], joints[i], joints[j], symmetry)
+            continue
+        if len(joints[i]) != len(joints[j]):
+            joints[i], joints[j] = _one_count(chains[i], chains[j], joints[i], joints[j], cutting)
+        if not exact:
+            joints[i], joints[j] = _met_halfway(lines[i], lines[j], joints[i], joints[j], symmetry)
+            close.append((i, j, _nearly_mirrored(chains[i], chains[j], joints[i], joints[j], symmetry)))
+    if any(near.any() for _, _, near in close):
+        axis = symmetry.plane[0]
+        middle = np.concatenate([(joints[i][near, axis] + joints[j][near, axis]) / 2 for i, j, near in close])
+        plane = (axis, float(middle.mean()))
+        for i, j, near in close:
+            joints[i], joints[j] = joints[i].copy(), joints[j].copy()
+            joints[i][near] = (joints[i][near] + mirrored(joints[j][near], plane)) / 2
+            joints[j][near] = mirrored(joints[i][near], plane)
     return joints
 
 
@@ -238,6 +251,24 @@ def _met_halfway(line, other, joints, other_joints, symmetry):
                  for joint, image in zip(own[1:], symmetry.reflect(twin[1:]))]
         moved.append(np.vstack([own[:1], point_at(points, arc, np.array(along))]))
     return moved[0], moved[1]
+
+
+def _nearly_mirrored(chain, twin, joints, twin_joints, symmetry):
+    """Which k-th joints of twins across a plane the body only roughly mirrors about (one count each, met halfway)
+    nearly mirror each other: within the twin tolerance, and within both limbs' half-widths, so their mean lies in
+    both limbs (a shoulder; not the elbow of an arm raised while its twin hangs). First joints are attached."""
+    gaps = np.linalg.norm(joints - symmetry.reflect(twin_joints), axis=1)
+    reach = np.minimum(_widths_at(chain, joints), _widths_at(twin, twin_joints))
+    close = (gaps <= symmetry.tolerance) & (gaps <= 2 * reach)
+    close[0] = False
+    return close
+
+
+def _widths_at(chain, joints):
+    """The half-width of the (polyline, half-widths, is a leaf) ``chain``'s part where each of ``joints`` lies."""
+    line, widths, _ = chain
+    arc = arc_lengths(line)
+    return np.interp([arc_nearest(line, arc, joint) for joint in joints], arc, widths)
 
 
 def _at_fractions(line, values, fractions):

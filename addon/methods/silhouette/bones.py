@@ -165,7 +165,7 @@ class BoneBuilder:
         if self.symmetry is None:
             joints = iter([chain_joints(line, self.cutting, widths, leaf) for line, widths, leaf in cut])
         else:
-            joints = iter(symmetric_joints(cut, self.cutting, self.symmetry, self.exact))
+            joints = iter(symmetric_joints(cut, self.cutting, self.symmetry, exact=self.exact))
         return [line.copy() if one else next(joints) for (line, _, _), one in zip(chains, across)]
 
     def _add_chain(self, line, joints, up):
