@@ -181,8 +181,9 @@ def symmetric_joints(chains, cutting, symmetry, exact=True):
 
     Across a plane the body only roughly mirrors about (not ``exact``: a posed or hand-made figure, whose twins are
     no images of each other) twins get one bone count and their joints meet halfway (``_met_halfway``); those that
-    then nearly mirror each other (``_nearly_mirrored``) move to their mean, mirror images across the plane
-    midway between all such joints (the body's own middle, which a posed figure's box or spine may miss).
+    then nearly mirror each other (``_nearly_mirrored``) move to their mean, mirror images across one plane: the
+    median of those pairs' midpoints (the body's own middle, which a posed figure's box or spine may miss, and a
+    lopsided ear tip does not pull off).
     """
     chains = [(line, np.zeros(len(line)) if widths is None else widths, leaf) for line, widths, leaf in chains]
     joints = [chain_joints(line, cutting, widths, leaf) for line, widths, leaf in chains]
@@ -202,7 +203,7 @@ def symmetric_joints(chains, cutting, symmetry, exact=True):
     if any(near.any() for _, _, near in close):
         axis = symmetry.plane[0]
         middle = np.concatenate([(joints[i][near, axis] + joints[j][near, axis]) / 2 for i, j, near in close])
-        plane = (axis, float(middle.mean()))
+        plane = (axis, float(np.median(middle)))
         for i, j, near in close:
             joints[i], joints[j] = joints[i].copy(), joints[j].copy()
             joints[i][near] = (joints[i][near] + mirrored(joints[j][near], plane)) / 2
