@@ -159,6 +159,23 @@ def test_arms_reaching_out_from_where_the_legs_hang_are_arms():
         assert {"shoulder", "upper_arm", "forearm", "hand"} <= set(arm), arm
 
 
+@pytest.mark.parametrize("blender", [False, True])
+def test_a_big_headed_figure_s_short_legs_and_arms_are_legs_and_arms_and_its_ears_are_ears(blender):
+    """cheburashka in its file's frame (Y up) and as Blender imports it (Z up): a head as wide as the figure is tall
+    carries two big ears, and its short legs hang from 0.18 of the height. Its legs are legs, under an upright torso
+    (a lying fish's low fins are not), and its arms are the limbs hanging below the head, not the longer ears at the
+    spine's top end."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "cheburashka.obj"))
+    skeleton = rigger.rig_mesh(vertices @ Y_UP.T if blender else vertices, triangles)
+    plan, roles = skeleton.body_plan, skeleton.roles
+    assert plan.kind == "humanoid" and plan.parts == {"legs": 2, "arms": 2, "ears": 2}, plan.reason
+    assert has_sides(roles, "thigh", "upper_arm", "ear") and "head" in {role.role for role in roles}
+    height = {role: max(skeleton.heads[b][2 if blender else 1] for b, r in enumerate(roles) if r.role == role)
+              for role in ("upper_arm", "ear")}
+    assert height["upper_arm"] < height["ear"]
+    assert roles[skeleton.parents.tolist().index(-1)].role == "hips"
+
+
 @pytest.mark.parametrize("name", ["octopus", "tree"])
 def test_an_unknown_plan_keeps_plain_roles_and_says_why(rigged, name):
     for plan, roles in (truth(name), (rigged[name].body_plan, rigged[name].roles)):

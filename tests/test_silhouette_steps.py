@@ -194,6 +194,23 @@ def test_a_round_part_without_a_neck_is_kept():
     assert not head_kept((0.0, 1.1, 0.85), min_reach=1.0)
 
 
+def test_a_chain_running_on_from_a_round_part_to_a_corner_goes_back_to_the_part_however_it_wiggles():
+    """A foot (a blob of radius 0.75, off the chest's disc) whose axis runs on to a corner of the outline 0.95 away
+    (within a radius and a half) but zigzags on the way, 1.5 along: the chain is a bump as a whole, yet the foot
+    keeps its branch, cut back to the foot. A corner 1.2 away is beyond the foot: the whole branch goes."""
+    def kept(corner):
+        foot = (1.6, 0.0, 0.75)
+        zigzag = [(1.6 + x, corner * f, 0.05) for x, f in ((-0.2, 0.25), (0.2, 0.5), (-0.2, 0.75), (0.0, 1.0))]
+        points, radius, chains = chest_with_legs([(1.02, 0.0, 0.7), foot, *zigzag])
+        blobs = np.zeros(len(points), bool)
+        blobs[[0, chains[-1][2], chains[-1][-1]]] = True
+        links = prune_spurs(points, radius, chains, Pruning(1.35, heads=True), blobs=blobs)
+        return chains[-1][2] in links, chains[-1][-1] in links
+
+    assert kept(0.95) == (True, False)
+    assert kept(1.2) == (False, False)
+
+
 def test_blobs_near_the_mirror_line_are_centred_on_it():
     """Hubs within half their radius of the line x = 0 move onto it (halfway to their image); one farther off,
     and every other node, stay; the graph itself is left as it was."""

@@ -159,8 +159,7 @@ def lay_out(body, tuning=BodyPlanTuning()):
     legs = _legs(body, lengths, tuning)
     forward = _forward_axis(body, legs)
     rows = _rows(body, legs, forward, tuning)
-    if len(rows) == 1 and (min(body.height(body.graph.points[body.limbs[k].attach]) for k in legs) < tuning.biped_lift
-                           or len(legs) < 2):
+    if len(rows) == 1 and (len(legs) < 2 or _low_slung(body, legs, tuning)):
         legs, rows = [], []  # fins, stubs or a lone leg: not legs a biped stands on
     long_pairs = _long_pairs(body, lengths, legs, tuning)
     spine_points = body.graph.points[list(body.spine)]
@@ -338,6 +337,13 @@ def _biped_spine(body, legs):
     return spine, hips
 
 
+def _low_slung(body, legs, tuning):
+    """Whether a row of ``legs`` hangs below ``biped_lift`` from a body that does not stand upright over them: a
+    lying fish's fins, where a big-headed figure's short legs under its upright torso are legs."""
+    low = min(body.height(body.graph.points[body.limbs[k].attach]) for k in legs) < tuning.biped_lift
+    return low and _lean(body, *_biped_spine(body, legs)) >= tuning.upright
+
+
 def _upward(body, spine):
     """The spine from its lower end to its upper end."""
     points = body.graph.points
@@ -367,7 +373,7 @@ def _chest(body, spine, hips, legs, lengths, tuning):
             continue
         at = _spine_index(spine, body, k)
         level = (_tip(body, k) - body.graph.points[body.bases[k]]) @ body.up > -tuning.leg_drop * lengths[k]
-        rank = (at > hips or not legs, at == hips and level, lengths[k])
+        rank = (at > hips or not legs, at == hips and level, at < len(spine) - 1, lengths[k])
         if (rank[0] or rank[1]) and (best is None or rank > best[0]):
             best = (rank, at)
     return -1 if best is None else best[1]

@@ -244,17 +244,16 @@ def _round_part(apart, radius, blobs, base, tip, round_tip):
 
 def _round_part_on(ordered, points, radius, blobs, min_reach, round_tip):
     """The index along a leaf chain (``ordered``: base first) of the farthest node before its tip that is a round
-    part (:func:`_round_part`) reaching more than ``min_reach`` beyond the base's disc, the chain running on from it
-    to its tip no farther than its radius and a half, else None: a head whose other branches went, leaving the chain
-    running on from it to a corner of its outline."""
+    part (:func:`_round_part`) reaching more than ``min_reach`` beyond the base's disc, the chain's tip no farther
+    from it than its radius and a half, else None: a head whose other branches went, leaving the chain running on
+    from it to a corner of its outline (however the axis wiggles on the way)."""
     base = ordered[0]
-    arc = arc_lengths(points[ordered])
-    beyond = arc[-1] - arc  # the chain's length from each node to its tip
+    tip = points[ordered[-1]]
     for k in range(len(ordered) - 2, 0, -1):
         node = ordered[k]
         apart = float(np.linalg.norm(points[node] - points[base]))
         if (_round_part(apart, radius, blobs, base, node, round_tip) and apart + radius[node] - radius[base] > min_reach
-                and beyond[k] <= 1.5 * radius[node]):
+                and np.linalg.norm(tip - points[node]) <= 1.5 * radius[node]):
             return k
     return None
 
