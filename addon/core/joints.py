@@ -205,7 +205,6 @@ def symmetric_joints(chains, cutting, symmetry, exact=True):
         middle = np.concatenate([(joints[i][near, axis] + joints[j][near, axis]) / 2 for i, j, near in close])
         plane = (axis, float(np.median(middle)))
         for i, j, near in close:
-            joints[i], joints[j] = joints[i].copy(), joints[j].copy()
             joints[i][near] = (joints[i][near] + mirrored(joints[j][near], plane)) / 2
             joints[j][near] = mirrored(joints[i][near], plane)
     return joints
