@@ -767,6 +767,27 @@ def test_on_a_four_armed_figure_each_arm_keeps_its_hand_and_the_head_hangs_from_
             assert not skeleton.names[parent].endswith((".L", ".R")), skeleton.names[bone]
 
 
+@pytest.mark.parametrize("model", ["gt/rignet_17872/rignet_17872.obj", "gt/magicarticulate_0a59c5ff/"
+                                   "magicarticulate_0a59c5ff.obj"])
+def test_every_limb_keeps_its_bones_read_y_up(model):
+    """Read Y up, as Blender's OBJ importer does by default, the figure's outline is traced turned round from its
+    file's frame. rignet_17872 (a bird) lost a wing there: its body's chain ran straight into one wing but stopped
+    at a shoulder junction on the other side, and the wing was cut back to that stub. magicarticulate (a Z-up file,
+    so lying on its back) lost its head: the head on its narrow neck stuck out just under prune times the neck's
+    width. Every limb tip of the file's own frame has a bone ending within a tenth of the size of it read Y up too
+    (a head's bone may end at the head's centre rather than its crown)."""
+    vertices, triangles = load_obj(shared_path("models", *model.split("/")))
+    turn = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+    size = np.ptp(vertices, axis=0).max()
+    tips = []
+    for frame in (np.eye(3), turn):
+        skeleton = rigger.rig_mesh(vertices @ frame.T, triangles)
+        leaves = [bone for bone in range(len(skeleton)) if not skeleton.children(bone)]
+        tips.append(skeleton.tails[leaves] @ frame)  # back in the file's frame
+    near = np.linalg.norm(tips[0][:, None] - tips[1][None], axis=2).min(axis=1)
+    assert near.max() < 0.1 * size, np.round(tips[0][near >= 0.1 * size] / size, 3)
+
+
 def test_a_cat_s_stubby_front_legs_seen_from_the_side_get_bones():
     """rignet_8338 seen from the side: its front legs are a bump as long as it is thick, but they stand on the ground
     with the hind legs, so they keep a chain (split in depth into the two legs): a bone passes by each front ankle

@@ -211,6 +211,24 @@ def test_a_chain_running_on_from_a_round_part_to_a_corner_goes_back_to_the_part_
     assert kept(1.2) == (False, False)
 
 
+def test_a_head_on_a_narrow_neck_is_a_part_of_its_own():
+    """A chest (radius 1) carrying a head blob of radius 0.62 (under 0.7 of the chest's) just off its disc, whose
+    axis runs on to a corner of the outline: the branch sticks out less than prune times its width, yet the head is
+    1.5 times as wide as the branch, so it keeps its branch, cut back to the head, and keeps it while pruning goes on
+    (the cut-back branch, the head alone, is no wider than its head). A blob of radius 0.5 on a branch 0.9 wide is
+    no head, nor is one whose radius is under ``min_reach`` (a bump on a head): they go."""
+    def head_kept(head, corner, min_reach=0.0):
+        points, radius, chains = chest_with_legs([(1.5, 0.0, head), (1.65, 0.15, corner[0]), (1.78, 0.3, corner[1])])
+        blobs = np.zeros(len(points), bool)
+        blobs[[0, chains[2][1]]] = True
+        links = prune_spurs(points, radius, chains, Pruning(1.35, min_reach, heads=True), blobs=blobs)
+        return chains[2][1] in links, chains[2][-1] in links
+
+    assert head_kept(0.62, (0.35, 0.25)) == (True, False)
+    assert head_kept(0.5, (0.45, 0.4)) == (False, False)
+    assert head_kept(0.62, (0.35, 0.25), min_reach=0.7) == (False, False)
+
+
 def test_blobs_near_the_mirror_line_are_centred_on_it():
     """Hubs within half their radius of the line x = 0 move onto it (halfway to their image); one farther off,
     and every other node, stay; the graph itself is left as it was."""
@@ -548,6 +566,21 @@ def test_a_leaf_running_on_along_its_twins_image_takes_that_image():
     result = symmetric_joints(neither, cutting(), ACROSS_X)
     np.testing.assert_allclose(result[1][-1], into_hand[-1])
     assert len(result[0]) == len(result[1])
+
+
+def test_a_leaf_running_on_past_a_twin_that_goes_on_in_its_children_keeps_its_own_joints_beyond():
+    """A wing traced from the body to its tip on the left, while on the right the body's chain stops at a shoulder
+    junction from which the wing's own chains go on (so it is no leaf): the left wing takes the right stub's image
+    as far as the stub goes, then its own joints to its tip, instead of being cut back to the stub (which left the
+    rest of the wing without a bone)."""
+    stub = np.array([[0.0, 1.0, 0.0], [0.15, 1.0, 0.0]])
+    wing = np.array([[0.0, 1.0, 0.0], [-0.15, 1.0, 0.0], [-0.5, 1.0, 0.0]])
+    result = symmetric_joints([(stub, None, False), (wing, None, True)], cutting(), ACROSS_X)
+    np.testing.assert_array_equal(result[0], chain_joints(stub, cutting()))
+    assert len(result[1]) > len(result[0])
+    np.testing.assert_allclose(result[1][:len(result[0])], mirrored(result[0], (0, 0.0)))
+    np.testing.assert_allclose(result[1][-1], wing[-1])
+    assert np.diff(result[1][:, 0]).max() < 0 and np.linalg.norm(np.diff(result[1], axis=0), axis=1).max() <= 0.1
 
 
 def test_whole_twins_pair_before_partial_ones():

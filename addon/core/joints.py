@@ -192,8 +192,8 @@ def symmetric_joints(chains, cutting, symmetry, exact=True):
     for i, j in mirror_chain_pairs(lines, symmetry):
         shared = _shared_joints(chains[i], chains[j], joints[i], joints[j], cutting, symmetry) if exact else None
         if shared is not None:
-            joints[i] = np.vstack([joints[i][:1], shared[1:]])
-            joints[j] = np.vstack([joints[j][:1], symmetry.reflect(shared)[1:]])
+            joints[i] = np.vstack([joints[i][:1], shared[0][1:]])
+            joints[j] = np.vstack([joints[j][:1], shared[1][1:]])
             continue
         if len(joints[i]) != len(joints[j]):
             joints[i], joints[j] = _one_count(chains[i], chains[j], joints[i], joints[j], cutting)
@@ -211,10 +211,13 @@ def symmetric_joints(chains, cutting, symmetry, exact=True):
 
 
 def _shared_joints(chain, twin, joints, twin_joints, cutting, symmetry):
-    """The joints ``chain`` and its mirror ``twin`` share (on ``chain``'s side), or None when their lines differ.
-    Twins whose tips match share the average of their own ``joints`` and the image of ``twin_joints``, recounted to
-    one count, when their lines have one shape (``Symmetry.same_shape``), else the joints of their mean line; a
-    twin running on past the other's tip shares the joints of the one whose joints both can take."""
+    """The joints of ``chain`` and of its mirror ``twin`` made mirror images where their lines agree, or None when
+    their lines differ. Twins whose tips match share the average of their own ``joints`` and the image of
+    ``twin_joints``, recounted to one count, when their lines have one shape (``Symmetry.same_shape``), else the
+    joints of their mean line; a twin running on past the other's tip shares the joints of the one whose joints both
+    can take. A leaf running on past a twin that goes on in the chains hanging from it (a wing traced from the body
+    on one side, from a shoulder junction on the other) takes the twin's image as far as it goes and its own joints
+    beyond."""
     (line, widths, leaf), (other, other_widths, other_leaf) = chain, twin
     image = symmetry.reflect(other)
     if not symmetry.agree(line, image):
@@ -225,17 +228,38 @@ def _shared_joints(chain, twin, joints, twin_joints, cutting, symmetry):
         if len(joints) != len(twin_joints):
             joints, twin_joints = _one_count(chain, twin, joints, twin_joints, cutting)
         if symmetry.same_shape(line, image):
-            return (joints + symmetry.reflect(twin_joints)) / 2
-        count = max(len(line), len(other))
-        mean = (resampled(line, count) + resampled(image, count)) / 2
-        fractions = np.linspace(0.0, 1.0, count)
-        mean_widths = (_at_fractions(line, widths, fractions) + _at_fractions(other, other_widths, fractions)) / 2
-        return chain_joints(mean, cutting, mean_widths, leaf and other_leaf)
+            shared = (joints + symmetry.reflect(twin_joints)) / 2
+        else:
+            count = max(len(line), len(other))
+            mean = (resampled(line, count) + resampled(image, count)) / 2
+            fractions = np.linspace(0.0, 1.0, count)
+            mean_widths = (_at_fractions(line, widths, fractions) + _at_fractions(other, other_widths, fractions)) / 2
+            shared = chain_joints(mean, cutting, mean_widths, leaf and other_leaf)
+        return shared, symmetry.reflect(shared)
     shorter_leaf, longer_leaf = (other_leaf, leaf) if longer_is_chain else (leaf, other_leaf)
+    if longer_leaf and not shorter_leaf:
+        if longer_is_chain:
+            return _run_on(chain, symmetry.reflect(twin_joints), cutting), twin_joints
+        return joints, _run_on(twin, symmetry.reflect(joints), cutting)
     if shorter_leaf or longer_leaf:
         lead_is_chain = longer_is_chain != longer_leaf  # the shorter leads when the longer can be cut back
-        return joints if lead_is_chain else symmetry.reflect(twin_joints)
+        shared = joints if lead_is_chain else symmetry.reflect(twin_joints)
+        return shared, symmetry.reflect(shared)
     return None
+
+
+def _run_on(chain, image_joints, cutting):
+    """The joints of the leaf ``chain`` ((polyline, half-widths, is a leaf)) that runs on past its shorter twin:
+    ``image_joints`` (the twin's, mirrored) up to where the twin ends, then the chain's own joints on the rest."""
+    line, widths, _ = chain
+    arc = arc_lengths(line)
+    start = arc_nearest(line, arc, image_joints[-1])
+    beyond = arc > start
+    rest = np.vstack([point_at(line, arc, np.array([start])), line[beyond]])
+    rest_widths = np.concatenate([np.interp([start], arc, widths), widths[beyond]])
+    if len(rest) < 2:
+        return image_joints
+    return np.vstack([image_joints, chain_joints(rest, cutting, rest_widths, leaf=True)[1:]])
 
 
 def _met_halfway(line, other, joints, other_joints, symmetry):
