@@ -219,6 +219,8 @@ class BoneBuilder:
         if views:
             cell = min(view.cell for view in views)
             for bone in order[:self.tuning.path_candidates]:
+                if not np.isfinite(distance[bone]):
+                    break  # the bones left are ones it may not hang from (sorted last)
                 count = int(np.clip(np.ceil(distance[bone] / cell), 1, self.tuning.path_samples))
                 path = point + (np.arange(1, count + 1) / (count + 1))[:, None] * (targets[bone] - point)
                 outside = np.zeros(count, bool)
