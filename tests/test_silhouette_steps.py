@@ -211,24 +211,6 @@ def test_a_chain_running_on_from_a_round_part_to_a_corner_goes_back_to_the_part_
     assert kept(1.2) == (False, False)
 
 
-def test_a_head_on_a_narrow_neck_is_a_part_of_its_own():
-    """A chest (radius 1) carrying a head blob of radius 0.62 (under 0.7 of the chest's) just off its disc, whose
-    axis runs on to a corner of the outline: the branch sticks out less than prune times its width, yet the head is
-    1.5 times as wide as the branch, so it keeps its branch, cut back to the head, and keeps it while pruning goes on
-    (the cut-back branch, the head alone, is no wider than its head). A blob of radius 0.5 on a branch 0.9 wide is
-    no head, nor is one whose radius is under ``min_reach`` (a bump on a head): they go."""
-    def head_kept(head, corner, min_reach=0.0):
-        points, radius, chains = chest_with_legs([(1.5, 0.0, head), (1.65, 0.15, corner[0]), (1.78, 0.3, corner[1])])
-        blobs = np.zeros(len(points), bool)
-        blobs[[0, chains[2][1]]] = True
-        links = prune_spurs(points, radius, chains, Pruning(1.35, min_reach, heads=True), blobs=blobs)
-        return chains[2][1] in links, chains[2][-1] in links
-
-    assert head_kept(0.62, (0.35, 0.25)) == (True, False)
-    assert head_kept(0.5, (0.45, 0.4)) == (False, False)
-    assert head_kept(0.62, (0.35, 0.25), min_reach=0.7) == (False, False)
-
-
 def test_blobs_near_the_mirror_line_are_centred_on_it():
     """Hubs within half their radius of the line x = 0 move onto it (halfway to their image); one farther off,
     and every other node, stay; the graph itself is left as it was."""

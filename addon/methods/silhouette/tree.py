@@ -143,7 +143,6 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
     chains = [list(c) for c in chains]
     dropped = []  # with local_pairs, the pairable spurs removed so far (``pairable`` entries below)
     stood = {}  # node -> the sides of the outline its removed spurs stood on (a leg keeps its foot's footing)
-    parts = set()  # the round parts a spur was cut back to: they stay
     while True:
         degree = {}
         for chain in chains:
@@ -163,10 +162,10 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                     outside = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]]
                     width = 2 * float(radius[outside[:tuning.width_nodes]].mean()) if len(outside) else (
                         2 * float(radius[tip]))
-                    bump = beyond <= prune * width and tip not in parts and not (  # the costly test only if needed
-                        blobs is not None and _round_part(apart, radius, blobs, base, tip, width, min_reach, tuning))
+                    bump = beyond <= prune * width and not (  # the round-part test only where it can matter
+                        blobs is not None and _round_part(apart, radius, blobs, base, tip, tuning.round_tip))
                     spur = beyond < max_reach and (beyond <= min_reach or bump)
-                    part = _round_part_on(ordered, points, radius, blobs, min_reach, width, tuning) \
+                    part = _round_part_on(ordered, points, radius, blobs, min_reach, tuning.round_tip) \
                         if spur and pruning.heads and blobs is not None else None
                     if part is not None:
                         heads[i] = ordered[:part + 1].tolist()
@@ -183,7 +182,6 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
         if spurs and pruning.ground is not None:
             spurs = _standing(spurs, pairable, leaves, chains, points, radius, pruning.ground, stood)
         trims = {i: heads[i] for i in spurs if i in heads}  # a head the spur runs on past: only the rest goes
-        parts.update(trim[-1] for trim in trims.values())
         spurs = {i: ends for i, ends in spurs.items() if i not in trims}
         if not spurs and not trims:
             links = links_of(chains)
@@ -238,29 +236,23 @@ def _standing(spurs, pairable, leaves, chains, points, radius, ground, stood):
     return result
 
 
-def _round_part(apart, radius, blobs, base, node, width, min_reach, tuning):
-    """Whether ``node``, ``apart`` from ``base`` on a branch ``width`` wide where it leaves the base, is a blob off
-    the base's disc at least ``round_tip`` as wide as the base, or ``knob`` times as wide as the branch there and
-    ``min_reach`` or more in radius: a part of its own (a head without a neck; a head on a narrow neck, not a bump
-    on a head)."""
-    return bool(blobs[node]) and apart > radius[base] and (
-        radius[node] >= tuning.round_tip * radius[base]
-        or (2 * radius[node] >= tuning.knob * width and radius[node] >= min_reach))
+def _round_part(apart, radius, blobs, base, tip, round_tip):
+    """Whether leaf node ``tip``, ``apart`` from ``base``, is a blob at least ``round_tip`` as wide as the base (a
+    part of its own), lying off the disc of ``base``."""
+    return bool(blobs[tip]) and radius[tip] >= round_tip * radius[base] and apart > radius[base]
 
 
-def _round_part_on(ordered, points, radius, blobs, min_reach, width, tuning):
-    """The index along a leaf chain (``ordered``: base first, ``width`` wide where it leaves the base) of the
-    farthest node before its tip that is a round part (:func:`_round_part`) reaching more than ``min_reach`` beyond
-    the base's disc, the chain's tip no farther from it than its radius and a half, else None: a head whose other
-    branches went, leaving the chain running on from it to a corner of its outline (however the axis wiggles on the
-    way)."""
+def _round_part_on(ordered, points, radius, blobs, min_reach, round_tip):
+    """The index along a leaf chain (``ordered``: base first) of the farthest node before its tip that is a round
+    part (:func:`_round_part`) reaching more than ``min_reach`` beyond the base's disc, the chain's tip no farther
+    from it than its radius and a half, else None: a head whose other branches went, leaving the chain running on
+    from it to a corner of its outline (however the axis wiggles on the way)."""
     base = ordered[0]
     tip = points[ordered[-1]]
     for k in range(len(ordered) - 2, 0, -1):
         node = ordered[k]
         apart = float(np.linalg.norm(points[node] - points[base]))
-        if (_round_part(apart, radius, blobs, base, node, width, min_reach, tuning)
-                and apart + radius[node] - radius[base] > min_reach
+        if (_round_part(apart, radius, blobs, base, node, round_tip) and apart + radius[node] - radius[base] > min_reach
                 and np.linalg.norm(tip - points[node]) <= 1.5 * radius[node]):
             return k
     return None

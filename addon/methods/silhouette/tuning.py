@@ -34,8 +34,6 @@ class Tuning(JointTuning, MirrorTuning):
                                    "times width ratio is at most this")
     round_tip: float = tuned(0.7, "a branch ending in a blob this share of its base's width, off the base's disc, is "
                                   "a part (a head without a neck)")
-    knob: float = tuned(1.25, "... and so is one whose blob is this many times as wide as the branch where it leaves "
-                              "the base (a head on a narrow neck), its radius min_branch bone lengths or more")
     ground_reach: float = tuned(0.03, "a branch tip this close (share of the size) to a side of the outline stands on "
                                       "it, as legs stand on the ground")
     width_nodes: int = tuned(3, "a branch's width is its mean over this many nodes past the base's disc (a neck, "
