@@ -11,7 +11,7 @@ BPY42_STAMP := $(BPY42_VENV)/.installed
 RAY_STAMP := $(VENV)/.ray-installed
 
 .PHONY: test build demo addon bpy42 ray bench bench-quality bench-silhouette bench-skinning bench-posing \
-	bench-bodyplan bench-retarget bench-rigify bench-rig-time bench-batch regress regress-baseline defects clean
+	bench-bodyplan bench-frames bench-retarget bench-rigify bench-rig-time bench-batch regress regress-baseline defects clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -66,6 +66,10 @@ bench-posing: build
 # Body plan of every ../shared model against a hand label, named-joint error of the humanoids: bodyplan.{md,png,json}.
 bench-bodyplan: build
 	$(PY) bench/bodyplan.py
+
+# Every ../shared/models/gt model rigged read in six frames (its own, four turned, Blender's import): frames.{md,png,json}.
+bench-frames: build
+	$(PY) bench/frames.py
 
 # The CMU walk and jump (../shared/anim) on game rigs of the humanoids: feet, knees, elbows, weights, seams.
 bench-retarget: build
