@@ -42,6 +42,22 @@ def run_record(script, argv):
             "commit": described_commit()}
 
 
+def subset_options(parser, name):
+    """Add a benchmark's ``--models`` (run on a subset, for ``picked``) and ``--out`` options (``results_folder``);
+    ``name`` is the benchmark's, for its out/ folder."""
+    parser.add_argument("--models", nargs="+", help="names or substrings of names (commas also separate)")
+    parser.add_argument("--out", type=pathlib.Path,
+                        help=f"results folder (default bench/results, or out/{name} with --models)")
+
+
+def results_folder(args, name):
+    """The folder a run writes to, made: ``--out``, else out/NAME for a run on some ``--models`` (a subset must not
+    overwrite the committed results), else bench/results."""
+    out = args.out or (REPO / "out" / name if args.models else RESULTS_DIR)
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
 def picked(items, wanted, name=lambda item: item):
     """The ``items`` whose ``name`` contains any of the texts of ``wanted`` (a ``--models`` list, commas also
     separating), all of them when ``wanted`` is empty; SystemExit when none does."""

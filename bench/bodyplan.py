@@ -33,7 +33,8 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
 import rigger  # noqa: E402
-from benchkit import REPO, RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit, markdown_table  # noqa: E402
+from benchkit import (SHARED_MODELS, cpu_model, described_commit, markdown_table, picked, results_folder,  # noqa: E402
+                      subset_options)
 from rigger.axes import to_blender  # noqa: E402
 from rigger.core.bodyplan import KINDS, recognise  # noqa: E402
 from rigger.core.mesh import Mesh  # noqa: E402
@@ -485,9 +486,7 @@ def plot(records, path):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--models", nargs="+", help="names or substrings of names (commas also separate)")
-    parser.add_argument("--out", type=pathlib.Path,
-                        help="results folder (default bench/results, or out/bodyplan with --models)")
+    subset_options(parser, "bodyplan")
     args = parser.parse_args(argv)
     if not SHARED_MODELS.is_dir():
         raise SystemExit(f"No models at {SHARED_MODELS}: the body-plan benchmark needs ../shared beside the checkout.")
@@ -495,13 +494,8 @@ def main(argv=None):
     absent = [name for name in names if not model_path(name).exists()]
     if absent:
         raise SystemExit(f"Models missing from {SHARED_MODELS}: {', '.join(absent)}")
-    if args.models:
-        wanted = [text for item in args.models for text in item.split(",") if text]
-        names = [name for name in names if any(text in name for text in wanted)]
-        if not names:
-            raise SystemExit(f"No model name contains any of {wanted}.")
-    out = args.out or (REPO / "out" / "bodyplan" if args.models else RESULTS_DIR)
-    out.mkdir(parents=True, exist_ok=True)
+    names = picked(names, args.models)
+    out = results_folder(args, "bodyplan")
     arguments = " ".join(argv if argv is not None else sys.argv[1:])
     run = {"command": f"python bench/bodyplan.py {arguments}".rstrip(),
            "started": datetime.datetime.now(datetime.timezone.utc), "load": os.getloadavg(), "cpu": cpu_model(),

@@ -25,7 +25,7 @@ import posing_math  # noqa: E402  (bench/ is not a package)
 import quality  # noqa: E402
 import rigdata  # noqa: E402
 import rigger  # noqa: E402
-from benchkit import REPO, RESULTS_DIR, SHARED_MODELS, markdown_table, picked, run_record  # noqa: E402
+from benchkit import SHARED_MODELS, markdown_table, picked, results_folder, run_record, subset_options  # noqa: E402
 from bodyplan import MODELS  # noqa: E402
 from rigger.axes import to_blender  # noqa: E402
 
@@ -113,17 +113,14 @@ def plot(records, path):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--models", nargs="+", help="names or substrings of names (commas also separate)")
-    parser.add_argument("--out", type=pathlib.Path, help="results folder (default bench/results, or out/frames "
-                                                          "with --models)")
+    subset_options(parser, "frames")
     args = parser.parse_args(argv)
     folder = SHARED_MODELS / "gt"
     if not folder.is_dir():
         raise SystemExit(f"No models at {folder}: the frame benchmark needs ../shared beside the checkout.")
     folders = picked(sorted(f for f in folder.iterdir() if f.is_dir() and f.name in MODELS), args.models,
                      name=lambda f: f.name)
-    out = args.out or (REPO / "out" / "frames" if args.models else RESULTS_DIR)
-    out.mkdir(parents=True, exist_ok=True)
+    out = results_folder(args, "frames")
     run = run_record("frames.py", argv)
     started = time.perf_counter()
     records = {}

@@ -34,8 +34,8 @@ from scipy.stats import spearmanr  # noqa: E402
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import posing_math as pm  # noqa: E402  (bench/ is not a package)
 import rigdata  # noqa: E402
-from benchkit import (REPO, RESULTS_DIR, SHARED_MODELS, cpu_model, described_commit, markdown_table,  # noqa: E402
-                      table_cell)
+from benchkit import (SHARED_MODELS, cpu_model, described_commit, markdown_table, picked, results_folder,  # noqa: E402
+                      subset_options, table_cell)
 from quality import principal_stick  # noqa: E402
 from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
 
@@ -528,15 +528,13 @@ def comparison_lines(records, seeds, previous_path):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--models", nargs="+", help="names or substrings of names (commas also separate)")
+    subset_options(parser, "posing")
     parser.add_argument("--seed", type=int, default=0, help="first seed (default 0); the second is seed + 1")
     parser.add_argument("--one-seed", action="store_true", help="only the first seed (no variability figures)")
     parser.add_argument("--poses", type=int, default=POSES, help=f"poses per seed (default {POSES})")
     parser.add_argument("--max-angle", type=float, default=MAX_DEGREES,
                         help=f"largest turn of a joint, degrees (default {MAX_DEGREES:g})")
     parser.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
-    parser.add_argument("--out", type=pathlib.Path,
-                        help="results folder (default bench/results, or out/posing with --models)")
     parser.add_argument("--compare", type=pathlib.Path, help="a previous run's posing.json to compare against")
     parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
                         help="a parameter of Rigger's method, e.g. --set bone_length=0.08 (repeatable)")
@@ -546,13 +544,9 @@ def main(argv=None):
         raise SystemExit(f"No models at {MODELS_DIR}: the posing benchmark needs ../shared beside the checkout.")
     if args.poses < 1 or args.jobs < 1:
         raise SystemExit("--poses and --jobs must be at least 1.")
-    folders = sorted(path for path in MODELS_DIR.iterdir() if path.is_dir())
-    if args.models:
-        wanted = [text for item in args.models for text in item.split(",") if text]
-        folders = [path for path in folders if any(text in path.name for text in wanted)]
-        if not folders:
-            raise SystemExit(f"No model name contains any of {wanted}.")
-    out = args.out or (REPO / "out" / "posing" if args.models else RESULTS_DIR)
+    folders = picked(sorted(path for path in MODELS_DIR.iterdir() if path.is_dir()), args.models,
+                     lambda path: path.name)
+    out = results_folder(args, "posing")
     seeds = [args.seed] if args.one_seed else [args.seed, args.seed + 1]
     temporary_user_folder()
     run = {"command": "python bench/posing.py" + (" " + " ".join(argv if argv is not None else sys.argv[1:])).rstrip(),
@@ -572,7 +566,6 @@ def main(argv=None):
     run["seconds"] = time.perf_counter() - started
     run["load_after"] = os.getloadavg()
     summary = summarise(records, seeds)
-    out.mkdir(parents=True, exist_ok=True)
     (out / "posing.md").write_text(report(records, summary, run), encoding="utf-8")
     (out / "posing.json").write_text(json.dumps(
         {"run": {**run, "started": run["started"].isoformat(), "machine": cpu_model(), "commit": described_commit()},

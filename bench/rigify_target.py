@@ -35,8 +35,8 @@ import time
 import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from benchkit import (REPO, RESULTS_DIR, SHARED_MODELS, markdown_table, picked, run_record,  # noqa: E402
-                      table_cell)
+from benchkit import (SHARED_MODELS, markdown_table, picked, results_folder, run_record,  # noqa: E402
+                      subset_options, table_cell)
 from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
 
 IK_REACH = 0.3  # share of a limb's reach its IK control moves towards the limb's root
@@ -363,9 +363,7 @@ def plot(records, path):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--models", nargs="+", help="names or substrings of names (commas also separate)")
-    parser.add_argument("--out", type=pathlib.Path, help="results folder (default bench/results, or out/rigify with "
-                                                         "--models)")
+    subset_options(parser, "rigify")
     args = parser.parse_args(argv)
     if not SHARED_MODELS.is_dir():
         raise SystemExit(f"No models at {SHARED_MODELS}: the Rigify benchmark needs ../shared beside the checkout.")
@@ -375,8 +373,7 @@ def main(argv=None):
 
     rigger.register()  # the pipeline keeps its armature pointer in the add-on's properties
     names = picked(model_names(), args.models, lambda item: item[1])
-    out = args.out or (REPO / "out" / "rigify" if args.models else RESULTS_DIR)
-    out.mkdir(parents=True, exist_ok=True)
+    out = results_folder(args, "rigify")
     run = run_record("rigify_target.py", argv)
     started = time.perf_counter()
     records = []
