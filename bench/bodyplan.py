@@ -157,11 +157,17 @@ def load(name):
         vertices, triangles, rig = rigdata.load_ground_truth(path)
     else:
         (vertices, triangles), rig = rigdata.load_obj(path), None
-    up = MODELS[name][1]
-    turn = to_blender(up, "Y" if up == "Z" else "-Z")  # Blender's OBJ importer's defaults for that up
+    turn = blender_turn(name)
     if rig is not None:
         rig = rigdata.Rig(rig.names, rig.positions @ turn.T, rig.parents, rig.root, rig.skin)
     return vertices @ turn.T, triangles.astype(np.int32), rig, turn
+
+
+def blender_turn(name):
+    """The rotation from model ``name``'s file frame to Blender's world, as its OBJ importer reads the file with the
+    defaults for the file's up (``MODELS``): forward -Z for Y up, Y for Z up."""
+    up = MODELS[name][1]
+    return to_blender(up, "Y" if up == "Z" else "-Z")
 
 
 def measure(name):

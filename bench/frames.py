@@ -26,8 +26,7 @@ import quality  # noqa: E402
 import rigdata  # noqa: E402
 import rigger  # noqa: E402
 from benchkit import SHARED_MODELS, markdown_table, picked, results_folder, run_record, subset_options  # noqa: E402
-from bodyplan import MODELS  # noqa: E402
-from rigger.axes import to_blender  # noqa: E402
+from bodyplan import MODELS, blender_turn  # noqa: E402
 
 # name -> the rotation whose rows are the directions (in the file's coordinates) the method takes as X, Y and Z
 TURNS = {"file": np.eye(3),
@@ -40,8 +39,7 @@ BLENDER = "Blender"  # the frame Blender's OBJ importer reads the file in
 
 def frames_of(name):
     """{frame name: rotation} for model ``name``: ``TURNS`` and Blender's import."""
-    up = MODELS[name][1]
-    return {**TURNS, BLENDER: to_blender(up, "Y" if up == "Z" else "-Z")}
+    return {**TURNS, BLENDER: blender_turn(name)}
 
 
 def measure(folder):
@@ -52,8 +50,7 @@ def measure(folder):
     result = {}
     for frame, turn in frames_of(folder.name).items():
         skeleton = rigger.rig_mesh(truth.vertices, truth.triangles.astype(np.int32), axes=turn)
-        bones = rigdata.Bones.of(skeleton).mapped(truth.normalisation)
-        scores = rigdata.skeleton_distances(bones.joints(), bones.samples(), truth.joints, truth.samples)
+        _, scores = quality.scored(truth, rigdata.Bones.of(skeleton))
         recall, _ = posing_math.limb_recall(rig.positions, rig.parents, skeleton.heads, skeleton.tails,
                                             skeleton.parents, size)
         result[frame] = (float(scores["cd_j2j"]), float(recall), len(skeleton))

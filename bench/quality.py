@@ -9,6 +9,7 @@ makes) to show how the joint counts move against the artists'.
 """
 import argparse
 import datetime
+import functools
 import json
 import os
 import pathlib
@@ -150,7 +151,18 @@ class GroundTruth:
         self.joints = self.bones.joints()  # the same joint-set rule as for predictions: RigNet's root_dup_* collapse
         self.samples = self.bones.samples()
         self.length = self.bones.total_length()
-        self.inside = rigdata.inside_fraction(self.samples, self.unit_vertices, self.triangles)
+
+    @functools.cached_property
+    def inside(self):
+        """The share of the artist's bone samples inside the mesh (costly: worked out when asked)."""
+        return rigdata.inside_fraction(self.samples, self.unit_vertices, self.triangles)
+
+
+def scored(truth, bones):
+    """(``bones`` in ``truth``'s normalised frame, their distances to the artist's: ``rigdata.skeleton_distances``)."""
+    unit_bones = bones.mapped(truth.normalisation)
+    return unit_bones, rigdata.skeleton_distances(unit_bones.joints(), unit_bones.samples(), truth.joints,
+                                                  truth.samples)
 
 
 def evaluate(truth, method, params, timeout, inside=True):
@@ -163,14 +175,14 @@ def evaluate(truth, method, params, timeout, inside=True):
         record["seconds"] = time.perf_counter() - started
         record["stages"] = {name: float(value) for name, value in stage_seconds.items()}
         record["tree_problem"] = rigdata.tree_problem(bones)
-        unit_bones = bones.mapped(truth.normalisation)
-        joints, samples = unit_bones.joints(), unit_bones.samples()
-        record.update(rigdata.skeleton_distances(joints, samples, truth.joints, truth.samples))
+        unit_bones, distances = scored(truth, bones)
+        record.update(distances)
+        joints = unit_bones.joints()
         record["joints"] = len(joints)
         record["joint_ratio"] = len(joints) / len(truth.joints)
         record["length_ratio"] = unit_bones.total_length() / truth.length
         if inside:
-            record["inside"] = rigdata.inside_fraction(samples, truth.unit_vertices, truth.triangles)
+            record["inside"] = rigdata.inside_fraction(unit_bones.samples(), truth.unit_vertices, truth.triangles)
         record["unit_bones"] = unit_bones
     except Exception as error:  # a method failing on one model must not stop the benchmark
         record["error"] = f"{type(error).__name__}: {error}".strip()

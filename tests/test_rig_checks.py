@@ -127,7 +127,7 @@ def test_a_missing_limb_is_not_followed_and_a_near_one_is():
     joint.name.endswith(".L") for joint in samples.character_joints(name))])
 def test_true_skeletons_of_mirrored_characters_pass_their_own_checks(name):
     truth = samples.ground_truth_bones(name)
-    size = float(np.ptp(np.concatenate([truth.heads, truth.tails]), axis=0).max())
+    size = truth.extent
     assert set(rc.twin_mismatches(truth, size).values()) == {0.0}
     assert rc.unsided_off_plane(truth, size) == []
     left, right = rc.side_counts(truth)
@@ -137,6 +137,6 @@ def test_true_skeletons_of_mirrored_characters_pass_their_own_checks(name):
 
 def test_the_near_symmetric_human_s_true_twins_miss_by_a_few_percent():
     truth = samples.ground_truth_bones("humanoid_handmade")
-    size = float(np.ptp(np.concatenate([truth.heads, truth.tails]), axis=0).max())
+    size = truth.extent
     worst = max(rc.twin_mismatches(truth, size).values())
     assert 0.01 < worst < 0.1
