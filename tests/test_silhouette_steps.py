@@ -732,6 +732,31 @@ def test_a_stubby_leg_standing_on_the_ground_with_the_others_is_a_leg():
     assert not kept([(x, y + 0.5, r) for x, y, r in stubby])
 
 
+def test_stubby_legs_off_two_bases_standing_on_the_ground_are_legs_together():
+    """A body seen from the side (rump and chest, radius 1, at x = ±2) with a thin tail and neck, and under each a
+    leg as long as it is thick standing on the ground (y = -3.2): every leg is a bump under prune and none of the
+    kept leaves stands there, but the two legs stand there together, so both stay. Two such stubs off one base (a
+    forked fin) do not: a pair off one base is judged by the pairing rules."""
+    def kept_legs(legs_at):
+        nodes = [(-2.0, 0.0, 1.0), (2.0, 0.0, 1.0), (0.0, 0.0, 1.0)]  # rump, chest, the belly between
+        chains = [[0, 2, 1]]
+        for base, direction in ((0, -1.0), (1, 1.0)):  # a thin tail and a thin neck, off the ground
+            chains.append([base] + list(range(len(nodes), len(nodes) + 6)))
+            nodes += [(direction * (2.0 + 0.5 * k), 0.5 * k, 0.2) for k in range(1, 7)]
+        feet = []
+        for base, x in legs_at:
+            chains.append([base] + list(range(len(nodes), len(nodes) + 3)))
+            nodes += [(x, -0.8, 1.4), (x, -1.4, 1.4), (x, -1.8, 1.4)]  # its foot reaches y = -3.2
+            feet.append(len(nodes) - 1)
+        points = np.array(nodes)
+        links = prune_spurs(points[:, :2], points[:, 2], chains,
+                            Pruning(1.35, pair_prune=0.74, ground=((-9.0, -3.2), (9.0, 9.0), 0.1)))
+        return [foot in links for foot in feet]
+
+    assert kept_legs([(0, -2.0), (1, 2.0)]) == [True, True]
+    assert kept_legs([(0, -3.5), (0, -0.5)]) == [False, False]
+
+
 def test_a_straight_leg_gets_its_knee_where_it_narrows():
     """A straight leg 0.4 long cut into four bones of 0.1: evenly, its joints would fall at 0.1, 0.2 and 0.3; its
     width narrows to 0.6 of the thigh's and calf's at 0.23 (the knee), where a joint goes instead."""

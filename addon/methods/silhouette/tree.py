@@ -180,7 +180,8 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
         if spurs and pruning.mirror is not None:
             spurs = _unmirrored(spurs, pairable, leaves, points, radius, pruning.mirror)
         if spurs and pruning.ground is not None:
-            spurs = _standing(spurs, pairable, leaves, chains, points, radius, pruning.ground, stood)
+            spurs = _standing(spurs, pairable, leaves, chains, points, radius, pruning.ground, stood,
+                              spurs_stand=pruning.mirror is None)
         trims = {i: heads[i] for i in spurs if i in heads}  # a head the spur runs on past: only the rest goes
         spurs = {i: ends for i, ends in spurs.items() if i not in trims}
         if not spurs and not trims:
@@ -211,12 +212,14 @@ def _sides(node, points, radius, ground):
             if touches}
 
 
-def _standing(spurs, pairable, leaves, chains, points, radius, ground, stood):
+def _standing(spurs, pairable, leaves, chains, points, radius, ground, stood, spurs_stand=True):
     """The ``spurs`` (chain -> (base, tip)) without the ``pairable`` ones that stand on a side of the view's outline
     (``ground``: its low and high corner and a tolerance), with a node or through spurs already removed from one
     (``stood``: a leg whose foot's corners went), that a kept leaf stands on too, their tips farther apart than
     either is wide: legs reach the ground together, however stubby (a foot's toe beside its own leg's foot is no
-    leg)."""
+    leg). With ``spurs_stand`` (a view with no mirror in it), a pairable spur off another base standing there counts
+    as a kept leaf: every leg of a cartoon cow seen from the side is stubby. Spurs off one base (a forked tail fin),
+    and twins across a mirror, pair by the pairing rules alone."""
     def sides(chain, base):
         nodes = [node for node in chains[chain] if node != base]
         return set().union(*(_sides(node, points, radius, ground) | stood.get(node, set()) for node in nodes))
@@ -224,13 +227,15 @@ def _standing(spurs, pairable, leaves, chains, points, radius, ground, stood):
     def tip(chain, base):
         return chains[chain][-1] if chains[chain][0] == base else chains[chain][0]
 
-    standing = [(sides(i, base), tip(i, base)) for i, base, _ in leaves if i not in spurs]
+    standing = [(sides(j, other_base), tip(j, other_base), other_base, j in spurs) for j, other_base, _ in leaves
+                if spurs_stand or j not in spurs]
     result = {}
     for i, (base, end) in spurs.items():
         width = pairable[i][3] if i in pairable else None
         stands = width is not None and any(
-            sides(i, base) & on and np.linalg.norm(points[end] - points[other]) > max(width, 2 * radius[other])
-            for on, other in standing)
+            sides(i, base) & on and not (spur and other_base == base)
+            and np.linalg.norm(points[end] - points[other]) > max(width, 2 * radius[other])
+            for on, other, other_base, spur in standing)
         if not stands:
             result[i] = base, end
     return result
