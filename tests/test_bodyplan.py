@@ -312,15 +312,18 @@ def test_rerooting_across_a_gap_keeps_one_tree():
 
 
 def test_rerooting_a_root_off_the_way_hangs_it_from_the_new_tree():
-    """Rooted at a neck bone with the spine hanging from its head (spot, as its file has it): the spine turns, and
-    the neck, not on the way, hangs from the bone now ending where it starts: one root, at the hips."""
-    skeleton = Skeleton(("trunk.00", "limb01.00", "limb01.01", "leg.L", "leg.R"),
-                        [[0, 0, 2.0], [0, 0, 2.0], [0, 0, 1.5], [0, 0, 1], [0, 0, 1]],
-                        [[0, 0.5, 2.5], [0, 0, 1.5], [0, 0, 1.0], [0.3, 0, 0], [-0.3, 0, 0]], [-1, 0, 1, 2, 2])
+    """Rooted at a neck bone with the spine and the front legs hanging from its head (spot, as its file has it):
+    the spine turns, and the neck, not on the way, hangs from the bone now ending where it starts: one root, at the
+    hips. So do the front legs: hanging from the neck, turning the head swung them."""
+    skeleton = Skeleton(("trunk.00", "limb01.00", "limb01.01", "leg.L", "leg.R", "arm.L", "arm.R"),
+                        [[0, 0, 2.0], [0, 0, 2.0], [0, 0, 1.5], [0, 0, 1], [0, 0, 1], [0, 0, 2.0], [0, 0, 2.0]],
+                        [[0, 0.5, 2.5], [0, 0, 1.5], [0, 0, 1.0], [0.3, 0, 0], [-0.3, 0, 0], [0.3, 0, 1.0],
+                         [-0.3, 0, 1.0]], [-1, 0, 1, 2, 2, 0, 0])
     moved = rooting.rerooted(skeleton, 2, 1)
     assert moved.roots == (0,) and moved.names[:3] == ("limb01.00", "limb01.01", "trunk.00")
     np.testing.assert_array_equal(moved.heads[:3], [[0, 0, 1.0], [0, 0, 1.5], [0, 0, 2.0]])
-    assert moved.parents.tolist() == [-1, 0, 1, 0, 0]  # the neck from the spine's end, the legs from the root
+    # the neck and the front legs from the spine's end, the legs from the root
+    assert moved.parents.tolist() == [-1, 0, 1, 0, 0, 1, 1]
 
 
 @pytest.mark.parametrize("name, within", [("head_with_nose", 0.016), ("four_arms", 0.06)])

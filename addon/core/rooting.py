@@ -38,8 +38,8 @@ def rerooted(skeleton, bone, end):
     joint of its own hanging from the nearer of them. The bones on the way from the new root joint to the old one
     turn round (head and tail swap) and trade places in the bone order end for end, keeping the names of the places
     (the new root takes the first one's: ``trunk.00`` when the trunk turns), parents still first. A turned bone, the
-    old root, and a bone that started where its turned parent ended hang from the bone now ending there; every other
-    bone keeps its parent. Of the bones starting at the new root joint, the one on the way to the old root (else
+    old root, a bone that started where its turned parent ended and one that started where the old root did (a
+    front leg beside the neck) hang from the bone now ending there; every other bone keeps its parent. Of the bones starting at the new root joint, the one on the way to the old root (else
     ``bone``) is the root and the others hang from it. Stages, timings and parameters are shared, roles go with
     their bones (a bone keeps its role whichever way it runs), and the body plan's places on turned bones are
     measured from their new heads."""
@@ -94,7 +94,8 @@ def rerooted(skeleton, bone, end):
     for b in reached:
         if b == root:
             new_parents[b] = -1
-        elif b in turned or b == old_root or (parents[b] in turned and head_node[b] == tail_node[parents[b]]):
+        elif b in turned or b == old_root or (parents[b] in turned and head_node[b] == tail_node[parents[b]]) or (
+                parents[b] == old_root and head_node[b] == head_node[old_root]):
             held = holder(tail_node[b] if b in turned else head_node[b])
             new_parents[b] = root if held is None else held
     slots = list(range(count))  # the turned bones on the way trade places end for end, the new root's first
