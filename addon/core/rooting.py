@@ -39,8 +39,9 @@ def rerooted(skeleton, bone, end):
     turn round (head and tail swap) and trade places in the bone order end for end, keeping the names of the places
     (the new root takes the first one's: ``trunk.00`` when the trunk turns), parents still first. A turned bone, the
     old root, a bone that started where its turned parent ended and one that started where the old root did (a
-    front leg beside the neck) hang from the bone now ending there; every other bone keeps its parent. Of the bones starting at the new root joint, the one on the way to the old root (else
-    ``bone``) is the root and the others hang from it. Stages, timings and parameters are shared, roles go with
+    front leg beside the neck) hang from the bone now ending there; every other bone keeps its parent. Of the bones
+    starting at the new root joint, the one on the way to the old root (else ``bone``) is the root and the others
+    hang from it. Stages, timings and parameters are shared, roles go with
     their bones (a bone keeps its role whichever way it runs), and the body plan's places on turned bones are
     measured from their new heads."""
     count, parents = len(skeleton), skeleton.parents.tolist()
