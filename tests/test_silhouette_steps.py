@@ -757,6 +757,21 @@ def test_stubby_legs_off_two_bases_standing_on_the_ground_are_legs_together():
     assert kept_legs([(0, -3.5), (0, -0.5)]) == [False, False]
 
 
+def test_an_axis_jumping_from_a_disc_into_a_corner_is_no_limb():
+    """A body's disc (radius 1) with a long arm each way, and an axis branch jumping from the disc straight to a
+    node by the outline's bottom edge (y = -2.1) whose half-width (0.1) is the corner's: by its nodes it sticks out
+    ten widths, a limb. Where it leaves the disc the body is 2.2 wide (the outline is 1.1 away): a bump, pruned."""
+    points = np.array([(0.0, 0.0), (-2.0, 0.0), (-3.0, 0.0), (-4.0, 0.0), (2.0, 0.0), (3.0, 0.0), (4.0, 0.0),
+                       (0.0, -2.0), (0.0, -2.05)])
+    radius = np.array([1.0, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.1, 0.0])
+    chains = [[0, 1, 2, 3], [0, 4, 5, 6], [0, 7, 8]]
+    corners = np.array([(-5.0, -2.1), (5.0, -2.1), (5.0, 0.9), (-5.0, 0.9)])
+    outline = (corners, np.roll(corners, -1, axis=0))
+    assert 8 in prune_spurs(points, radius, chains, Pruning(1.35))
+    assert 8 not in prune_spurs(points, radius, chains, Pruning(1.35, outline=outline))
+    assert 3 in prune_spurs(points, radius, chains, Pruning(1.35, outline=outline))
+
+
 def test_a_straight_leg_gets_its_knee_where_it_narrows():
     """A straight leg 0.4 long cut into four bones of 0.1: evenly, its joints would fall at 0.1, 0.2 and 0.3; its
     width narrows to 0.6 of the thigh's and calf's at 0.23 (the knee), where a joint goes instead."""

@@ -29,3 +29,8 @@ def outline_segments(loops, spacing):
         segments.append(offset + np.stack([np.arange(count), (np.arange(count) + 1) % count], axis=1))
         offset += count
     return np.concatenate(points), np.concatenate(segments)
+
+
+def loop_edges(loops):
+    """Every edge of the loops as (starts, ends), each (K, 2): for distances to the outline."""
+    return np.concatenate(loops), np.concatenate([np.roll(loop, -1, axis=0) for loop in loops])

@@ -6,6 +6,7 @@ import numpy as np
 
 from ...core.joints import Cutting
 from ...core.mirror import Symmetry, mirror_plane
+from .outline import loop_edges
 from .tree import Pruning
 from .views import reflection_in_view
 
@@ -49,4 +50,4 @@ class Rules:
                        max_reach=self.tuning.keep_reach * self.size,
                        pair_prune=self.tuning.pair_prune * self.params.prune,
                        mirror=reflection_in_view(sil, self.plane, self.tuning), local_pairs=self.plane is None,
-                       ground=ground, heads=heads, tuning=self.tuning)
+                       ground=ground, heads=heads, outline=loop_edges(sil.loops), tuning=self.tuning)

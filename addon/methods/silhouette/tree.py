@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...core.graphs import chains_of, links_of, neighbour_lists, shortest_paths
-from ...core.polyline import arc_lengths, length
+from ...core.polyline import arc_lengths, length, segment_distances
 from .tuning import Tuning
 
 
@@ -71,6 +71,8 @@ class Pruning:
             kept leaf stands on too stays (``_standing``); None: no such rule.
         heads: a spur running on past a round part (``_round_part_on``) goes only beyond it (the primary view's
             heads; the hidden views look for limbs, and a remnant there is no limb).
+        outline: the view's outline edges (starts, ends), for a branch's width where its axis jumps off the base's
+            disc (``_jump_width``); None: widths from the nodes alone.
         tuning: the method's tuning (``round_tip``, ``local_pair``, ``width_nodes``).
     """
 
@@ -82,6 +84,7 @@ class Pruning:
     local_pairs: bool = False
     ground: tuple = None
     heads: bool = False
+    outline: tuple = None
     tuning: Tuning = Tuning()
 
 
@@ -162,6 +165,8 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                     outside = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]]
                     width = 2 * float(radius[outside[:tuning.width_nodes]].mean()) if len(outside) else (
                         2 * float(radius[tip]))
+                    if len(outside) and pruning.outline is not None:
+                        width = max(width, _jump_width(ordered, points, radius, pruning.outline))
                     bump = beyond <= prune * width and not (  # the round-part test only where it can matter
                         blobs is not None and _round_part(apart, radius, blobs, base, tip, tuning.round_tip))
                     spur = beyond < max_reach and (beyond <= min_reach or bump)
@@ -200,6 +205,22 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
         if not kept:
             return np.zeros((0, 2), dtype=np.int64)
         _, chains = chains_of(sorted({n for c in kept for n in c}), links_of(kept))
+
+
+def _jump_width(ordered, points, radius, outline):
+    """The width where a leaf chain (``ordered``: base first) leaves its base's disc when its axis jumps there, its
+    first node outside lying farther beyond the disc's edge than that node is wide: twice the distance from where
+    the jump crosses the edge to the ``outline`` (segment starts and ends). Such a jump crosses a fan of triangles
+    into a concave corner of the outline, where the nodes' widths are the corner's, not the part's; 0 otherwise."""
+    base = points[ordered[0]]
+    apart = np.linalg.norm(points[ordered] - base, axis=1)
+    k = int(np.argmax(apart > radius[ordered[0]]))
+    if apart[k] - radius[ordered[0]] <= 2 * radius[ordered[k]]:
+        return 0.0
+    before = points[ordered[k - 1]]
+    share = (radius[ordered[0]] - apart[k - 1]) / max(apart[k] - apart[k - 1], 1e-12)
+    edge = before + np.clip(share, 0.0, 1.0) * (points[ordered[k]] - before)
+    return 2 * float(segment_distances(edge[None], *outline).min())
 
 
 def _sides(node, points, radius, ground):
