@@ -41,9 +41,8 @@ def rerooted(skeleton, bone, end):
     old root, a bone that started where its turned parent ended and one that started where the old root did (a
     front leg beside the neck) hang from the bone now ending there; every other bone keeps its parent. Of the bones
     starting at the new root joint, the one on the way to the old root (else ``bone``) is the root and the others
-    hang from it. Stages, timings and parameters are shared, roles go with
-    their bones (a bone keeps its role whichever way it runs), and the body plan's places on turned bones are
-    measured from their new heads."""
+    hang from it. Stages, timings and parameters are shared, roles go with their bones (a bone keeps its role
+    whichever way it runs), and the body plan's places on turned bones are measured from their new heads."""
     count, parents = len(skeleton), skeleton.parents.tolist()
     tolerance = SAME_POINT * skeleton.extent
     head_node, tail_node = [0] * count, [0] * count

@@ -254,9 +254,9 @@ def _standing(spurs, pairable, leaves, chains, points, radius, ground, stood, sp
     for i, (base, end) in spurs.items():
         width = pairable[i][3] if i in pairable else None
         stands = width is not None and any(
-            sides(i, base) & on and not (spur and other_base == base)
+            sides(i, base) & on and not (is_spur and other_base == base)
             and np.linalg.norm(points[end] - points[other]) > max(width, 2 * radius[other])
-            for on, other, other_base, spur in standing)
+            for on, other, other_base, is_spur in standing)
         if not stands:
             result[i] = base, end
     return result
