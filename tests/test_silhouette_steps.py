@@ -15,6 +15,7 @@ from rigger.core.naming import bone_names
 from rigger.core.polyline import arc_lengths, segment_distances
 from rigger.methods.silhouette import depth
 from rigger.methods.silhouette.chordal import ChordalAxis
+from rigger.methods.silhouette.outline import loop_edges
 from rigger.methods.silhouette.tree import Chain, Pruning, prune_spurs, rooted_chains
 from rigger.methods.silhouette.tuning import Tuning
 from rigger.methods.silhouette.views import reflection_in_view
@@ -737,24 +738,29 @@ def test_stubby_legs_off_two_bases_standing_on_the_ground_are_legs_together():
     leg as long as it is thick standing on the ground (y = -3.2): every leg is a bump under prune and none of the
     kept leaves stands there, but the two legs stand there together, so both stay. Two such stubs off one base (a
     forked fin) do not: a pair off one base is judged by the pairing rules."""
-    def kept_legs(legs_at):
+    def kept_legs(legs_at, mirror=None):
         nodes = [(-2.0, 0.0, 1.0), (2.0, 0.0, 1.0), (0.0, 0.0, 1.0)]  # rump, chest, the belly between
         chains = [[0, 2, 1]]
         for base, direction in ((0, -1.0), (1, 1.0)):  # a thin tail and a thin neck, off the ground
             chains.append([base] + list(range(len(nodes), len(nodes) + 6)))
             nodes += [(direction * (2.0 + 0.5 * k), 0.5 * k, 0.2) for k in range(1, 7)]
         feet = []
-        for base, x in legs_at:
+        for base, x, r, foot in legs_at:
             chains.append([base] + list(range(len(nodes), len(nodes) + 3)))
-            nodes += [(x, -0.8, 1.4), (x, -1.4, 1.4), (x, -1.8, 1.4)]  # its foot reaches y = -3.2
+            low = -3.2 + foot  # the foot's disc reaches the ground, y = -3.2
+            nodes += [(x, -0.8, r), (x, 0.5 * (low - 0.8), r), (x, low, foot)]
             feet.append(len(nodes) - 1)
         points = np.array(nodes)
         links = prune_spurs(points[:, :2], points[:, 2], chains,
-                            Pruning(1.35, pair_prune=0.74, ground=((-9.0, -3.2), (9.0, 9.0), 0.1)))
+                            Pruning(1.35, pair_prune=0.74, ground=((-9.0, -3.2), (9.0, 9.0), 0.1), mirror=mirror))
         return [foot in links for foot in feet]
 
-    assert kept_legs([(0, -2.0), (1, 2.0)]) == [True, True]
-    assert kept_legs([(0, -3.5), (0, -0.5)]) == [False, False]
+    assert kept_legs([(0, -2.0, 1.4, 1.4), (1, 2.0, 1.4, 1.4)]) == [True, True]
+    # feet 2.8 apart, legs 2.2 and 3.0 wide: too close for the wider, so for both
+    assert kept_legs([(0, -1.4, 1.4, 0.8), (1, 1.4, 2.2, 0.8)]) == [False, False]
+    assert kept_legs([(0, -3.5, 1.4, 1.4), (0, -0.5, 1.4, 1.4)]) == [False, False]
+    # across a mirror in the view, twin spurs pair by the mirror rules alone (here: off two bases, none)
+    assert kept_legs([(0, -2.0, 1.4, 1.4), (1, 2.0, 1.4, 1.4)], mirror=lambda p: p * [-1.0, 1.0]) == [False, False]
 
 
 def test_an_axis_jumping_from_a_disc_into_a_corner_is_no_limb():
@@ -765,8 +771,7 @@ def test_an_axis_jumping_from_a_disc_into_a_corner_is_no_limb():
                        (0.0, -2.0), (0.0, -2.05)])
     radius = np.array([1.0, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.1, 0.0])
     chains = [[0, 1, 2, 3], [0, 4, 5, 6], [0, 7, 8]]
-    corners = np.array([(-5.0, -2.1), (5.0, -2.1), (5.0, 0.9), (-5.0, 0.9)])
-    outline = (corners, np.roll(corners, -1, axis=0))
+    outline = loop_edges([np.array([(-5.0, -2.1), (5.0, -2.1), (5.0, 1.2), (-5.0, 1.2)])])
     assert 8 in prune_spurs(points, radius, chains, Pruning(1.35))
     assert 8 not in prune_spurs(points, radius, chains, Pruning(1.35, outline=outline))
     assert 3 in prune_spurs(points, radius, chains, Pruning(1.35, outline=outline))

@@ -6,7 +6,7 @@ import numpy as np
 
 from ...core.joints import Cutting
 from ...core.mirror import Symmetry, mirror_plane
-from .outline import loop_edges
+from .outline import loop_edges, without_small_holes
 from .tree import Pruning
 from .views import reflection_in_view
 
@@ -44,10 +44,11 @@ class Rules:
     def pruning(self, sil, prune, heads=False):
         """Spur pruning in view ``sil`` at ``prune`` times a branch's width: the primary view's is the ``prune``
         parameter and keeps ``heads`` (``Pruning.heads``), the perpendicular views' ``hidden_prune`` of it."""
-        outline = np.concatenate(sil.loops)
-        ground = (outline.min(axis=0), outline.max(axis=0), self.tuning.ground_reach * self.size)
+        corners = np.concatenate(sil.loops)
+        ground = (corners.min(axis=0), corners.max(axis=0), self.tuning.ground_reach * self.size)
+        triangulated = without_small_holes(sil.loops, self.params.min_hole)  # the loops the axis was made from
         return Pruning(prune, min_reach=self.params.min_branch * self.unit,
                        max_reach=self.tuning.keep_reach * self.size,
                        pair_prune=self.tuning.pair_prune * self.params.prune,
                        mirror=reflection_in_view(sil, self.plane, self.tuning), local_pairs=self.plane is None,
-                       ground=ground, heads=heads, outline=loop_edges(sil.loops), tuning=self.tuning)
+                       ground=ground, heads=heads, outline=loop_edges(triangulated), tuning=self.tuning)

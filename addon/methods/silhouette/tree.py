@@ -68,7 +68,7 @@ class Pruning:
         mirror: a function reflecting (P, 2) points of the view across the mesh's mirror plane, or None.
         local_pairs: without a mirror plane, pair spurs alike in size (``_local_pairs``).
         ground: (low (2,), high (2,), tolerance) of the view's outline: a stubby spur standing on a side of it that a
-            kept leaf stands on too stays (``_standing``); None: no such rule.
+            kept leaf (or another stubby spur) stands on too stays (``_standing``); None: no such rule.
         heads: a spur running on past a round part (``_round_part_on``) goes only beyond it (the primary view's
             heads; the hidden views look for limbs, and a remnant there is no limb).
         outline: the view's outline edges (starts, ends), for a branch's width where its axis jumps off the base's
@@ -129,7 +129,9 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
     the surviving links.
 
     A limb is long for its width where it leaves the base (a leg, a finger, a tail, a neck with its head) while
-    outline noise and bumps (an ear on a round head, a belly) are not, whatever their size, up to ``max_reach``.
+    outline noise and bumps (an ear on a round head, a belly) are not, whatever their size, up to ``max_reach``;
+    with an ``outline``, an axis jumping off the base's disc into a corner is as wide there as the outline says
+    (``_jump_width``).
     With ``blobs``, a (n,) mask of the nodes that stand for a round part (junctions, which swallow the axis within
     their disc), a spur reaching ``min_reach`` and ending in one whose centre lies off the base's disc and whose
     width is at least ``round_tip`` times the base's is kept: a gingerbread man's head sits on its shoulders without
@@ -138,8 +140,8 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
     that mirror each other stay: a pair is a limb where a lone bump of that size is not (a dog's ears; outline noise
     is not symmetric). With ``pair_prune`` and ``local_pairs`` instead, two such spurs off one base that stick out
     about as far and are about as wide stay (``_local_pairs``). With ``pair_prune`` and a ``ground``, such a spur
-    stays when its tip stands where a kept leaf stands (``_standing``): a cat's stubby front legs beside its hind
-    legs, seen from the side.
+    stays when its tip stands where a kept leaf stands, or in a view with no mirror another such spur off another
+    base (``_standing``): a cat's stubby front legs beside its hind legs, a cartoon cow's four, seen from the side.
     """
     prune, min_reach, max_reach, pair_prune = pruning.prune, pruning.min_reach, pruning.max_reach, pruning.pair_prune
     tuning = pruning.tuning
@@ -165,7 +167,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                     outside = ordered[np.linalg.norm(points[ordered] - points[base], axis=1) > radius[base]]
                     width = 2 * float(radius[outside[:tuning.width_nodes]].mean()) if len(outside) else (
                         2 * float(radius[tip]))
-                    if len(outside) and pruning.outline is not None:
+                    if pruning.outline is not None:
                         width = max(width, _jump_width(ordered, points, radius, pruning.outline))
                     bump = beyond <= prune * width and not (  # the round-part test only where it can matter
                         blobs is not None and _round_part(apart, radius, blobs, base, tip, tuning.round_tip))
@@ -211,15 +213,16 @@ def _jump_width(ordered, points, radius, outline):
     """The width where a leaf chain (``ordered``: base first) leaves its base's disc when its axis jumps there, its
     first node outside lying farther beyond the disc's edge than that node is wide: twice the distance from where
     the jump crosses the edge to the ``outline`` (segment starts and ends). Such a jump crosses a fan of triangles
-    into a concave corner of the outline, where the nodes' widths are the corner's, not the part's; 0 otherwise."""
+    into a concave corner of the outline, where the nodes' widths are the corner's, not the part's; 0 otherwise
+    (and for a chain with no node outside the disc)."""
     base = points[ordered[0]]
     apart = np.linalg.norm(points[ordered] - base, axis=1)
-    k = int(np.argmax(apart > radius[ordered[0]]))
+    k = int(np.argmax(apart > radius[ordered[0]]))  # the first node outside; 0 (the base) when there is none
     if apart[k] - radius[ordered[0]] <= 2 * radius[ordered[k]]:
         return 0.0
-    before = points[ordered[k - 1]]
-    share = (radius[ordered[0]] - apart[k - 1]) / max(apart[k] - apart[k - 1], 1e-12)
-    edge = before + np.clip(share, 0.0, 1.0) * (points[ordered[k]] - before)
+    before = points[ordered[k - 1]]  # inside the disc: apart[k - 1] <= radius < apart[k]
+    share = (radius[ordered[0]] - apart[k - 1]) / (apart[k] - apart[k - 1])
+    edge = before + share * (points[ordered[k]] - before)
     return 2 * float(segment_distances(edge[None], *outline).min())
 
 
@@ -248,15 +251,17 @@ def _standing(spurs, pairable, leaves, chains, points, radius, ground, stood, sp
     def tip(chain, base):
         return chains[chain][-1] if chains[chain][0] == base else chains[chain][0]
 
-    standing = [(sides(j, other_base), tip(j, other_base), other_base, j in spurs) for j, other_base, _ in leaves
-                if spurs_stand or j not in spurs]
+    # (sides, tip, base, how wide it is if a spur) of the leaves another spur may stand beside
+    standing = [(sides(j, other_base), tip(j, other_base), other_base, pairable[j][3] if j in spurs else None)
+                for j, other_base, _ in leaves if spurs_stand or j not in spurs]
     result = {}
     for i, (base, end) in spurs.items():
         width = pairable[i][3] if i in pairable else None
         stands = width is not None and any(
-            sides(i, base) & on and not (is_spur and other_base == base)
-            and np.linalg.norm(points[end] - points[other]) > max(width, 2 * radius[other])
-            for on, other, other_base, is_spur in standing)
+            sides(i, base) & on and not (other_width is not None and other_base == base)
+            and np.linalg.norm(points[end] - points[other]) > max(width, 2 * radius[other], *(
+                () if other_width is None else (other_width, 2 * radius[end])))  # two spurs: both stay or go
+            for on, other, other_base, other_width in standing)
         if not stands:
             result[i] = base, end
     return result
