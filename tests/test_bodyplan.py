@@ -204,6 +204,22 @@ def test_a_chain_named_right_is_on_the_right_though_the_body_s_path_runs_through
     assert {side for side, _ in sided} == {"L", "R"} and all(side == given for side, given in sided)
 
 
+@pytest.mark.parametrize("path, turn, head_towards", [
+    (("models", "nogt", "alligator.obj"), Y_UP, [-1.0, 0.0, 0.0]),
+    (("models", "gt", "rignet_11814", "rignet_11814.obj"), np.eye(3), [0.0, 0.0, 1.0])])
+def test_a_fish_s_head_is_its_wide_end(path, turn, head_towards):
+    """The alligator as Blender imports it (a flat side profile, thick at its head at -X, tapering to its tail) and
+    rignet_11814 (a fish whose head, at +Z, has an open mouth): their joints lie near the surface at the head end,
+    whose mesh radius looked thinner, so the head was taken for the tail. The head is the end the mesh is wider
+    across."""
+    vertices, triangles = load_obj(shared_path(*path))
+    skeleton = rigger.rig_mesh(vertices @ turn.T, triangles)
+    assert skeleton.body_plan.kind == "fish"
+    ends = {role: np.mean([skeleton.tails[b] for b, given in enumerate(skeleton.roles) if given.role == role], axis=0)
+            for role in ("head", "tail")}
+    assert (ends["head"] - ends["tail"]) @ head_towards > 0
+
+
 def test_sides_follow_the_bone_names_and_the_mirror_plane(rigged):
     skeleton = rigged["humanoid"]
     for name, role in zip(skeleton.names, skeleton.roles):

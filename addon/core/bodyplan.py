@@ -28,7 +28,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .body import AXES, BodyTuning, read_body
-from .polyline import arc_lengths, length
+from .polyline import arc_lengths, length, nearest_on_segments
 from .roles import RoleTuning, assign_roles, joint_places
 from .stages import MirrorPlane
 from .tuning import tuned
@@ -237,9 +237,10 @@ def _legless(body, parts, front, lengths, long_pairs, spine_length, forward, con
     longest = max(lengths, default=0.0)
     if spine_length >= tuning.fish_body * size and rise >= tuning.lying and 180 - rise >= tuning.lying \
             and longest < tuning.fin_share * spine_length and body.high - body.low <= tuning.low_body * spine_length:
-        spine = _thick_end_last(body, spine, tuning)
-        thickness = _end_thickness(body, spine, tuning)
+        thickness = _end_thickness(body, _thick_end_last(body, spine, tuning), tuning)
         tapers = thickness[1] >= tuning.taper * max(thickness[0], 1e-300)
+        spread = _end_spread(body, spine, tuning)
+        spine = spine if spread[1] >= spread[0] else spine[::-1]
         curves = spine_length >= tuning.curve * float(np.linalg.norm(ends[1] - ends[0]))
         if len(body.limbs) or tapers or curves:
             for k in range(len(parts)):
@@ -412,6 +413,29 @@ def _end_thickness(body, spine, tuning):
     first = radius[arc <= arc[-1] * tuning.end_part]
     last = radius[arc >= arc[-1] * (1 - tuning.end_part)]
     return float(first.mean()), float(last.mean())
+
+
+def _end_spread(body, spine, tuning):
+    """How wide the mesh is across the spine over its first and last ``end_part``: the spreads (standard deviations)
+    across the spine's end-to-end direction of the sampled vertices nearest there, the two added. A fish's head is
+    wider than its tail, fins and all, where the mesh radius at joints misleads: joints in an open mouth, or on a
+    flat profile, lie near the surface."""
+    points = body.graph.points[list(spine)]
+    arc = arc_lengths(points)
+    direction = points[-1] - points[0]
+    if len(spine) < 2 or not np.linalg.norm(direction) > 0:
+        return 0.0, 0.0
+    direction /= np.linalg.norm(direction)
+    starts, ends = points[:-1], points[1:]
+    nearest = nearest_on_segments(body.vertices, starts, ends)
+    link = np.argmin(np.linalg.norm(body.vertices[:, None] - nearest, axis=2), axis=1)
+    at = arc[link] + np.linalg.norm(nearest[np.arange(len(link)), link] - starts[link], axis=1)
+    spreads = []
+    for part in (at <= arc[-1] * tuning.end_part, at >= arc[-1] * (1 - tuning.end_part)):
+        across = body.vertices[part] - body.vertices[part].mean(axis=0) if part.sum() > 1 else np.zeros((1, 3))
+        across -= np.outer(across @ direction, direction)
+        spreads.append(float(np.sqrt(np.maximum(np.linalg.eigvalsh(across.T @ across / len(across)), 0.0)).sum()))
+    return tuple(spreads)
 
 
 def _thick_end_last(body, spine, tuning):
