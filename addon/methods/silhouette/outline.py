@@ -1,4 +1,4 @@
-"""Outline preparation: a silhouette's loops as the triangulation's input."""
+"""Outline preparation: a silhouette's loops as the triangulation's input, and as edges for distances to it."""
 import numpy as np
 
 from ...core.arrays import concatenated_ranges
