@@ -8,9 +8,12 @@ by Rigger (the product), a 3-joint stick with nearest-bone weights (the floor). 
 recall, mirror twins and unsided bones of Rigger's skeleton. Writes posing.md, posing.png and posing.json.
 
     .venv/bin/python bench/posing.py [--models NAME ...] [--seed S] [--one-seed] [--jobs N] [--compare OLD.json]
+                                     [--blender-frame]
 
-A full run writes to bench/results; a run on ``--models`` writes to out/posing unless ``--out`` says otherwise, so
-the committed results stay whole. ``--compare bench/results/posing.json`` prints each model's change against a run.
+A full run writes to bench/results; a run on ``--models`` writes to out/posing, and one with ``--blender-frame``
+(Rigger rigs each file as Blender's OBJ importer reads it, turned, and its skeleton is turned back to be measured:
+what a user gets) to out/posing-blender, unless ``--out`` says otherwise, so the committed results stay whole.
+``--compare bench/results/posing.json`` prints each model's change against a run.
 """
 import os
 
@@ -34,8 +37,9 @@ from scipy.stats import spearmanr  # noqa: E402
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import posing_math as pm  # noqa: E402  (bench/ is not a package)
 import rigdata  # noqa: E402
-from benchkit import (SHARED_MODELS, cpu_model, described_commit, markdown_table, picked, results_folder,  # noqa: E402
-                      subset_options, table_cell)
+from benchkit import (REPO, SHARED_MODELS, cpu_model, described_commit, markdown_table, picked,  # noqa: E402
+                      results_folder, subset_options, table_cell)
+from bodyplan import blender_turn  # noqa: E402
 from quality import principal_stick  # noqa: E402
 from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
 
@@ -50,9 +54,9 @@ TARGET_EXCESS_MEAN, TARGET_EXCESS_MAX, TARGET_CRACK, TARGET_RECALL, TARGET_TWIN 
 ISSUE_NOW = {"artist": 0.0, "artist_skin": 0.0053, "rigger": 0.0081, "stick": 0.0495}
 
 
-def measure(folder, seeds, poses=POSES, max_degrees=MAX_DEGREES, params=None):
-    """Every measurement of one model (Rigger rigging it with the method parameters ``params``, default none);
-    failures of one rig or one step become text in the record."""
+def measure(folder, seeds, poses=POSES, max_degrees=MAX_DEGREES, params=None, blender_frame=False):
+    """Every measurement of one model (Rigger rigging it with the method parameters ``params``, default none, in
+    Blender's frame when ``blender_frame``); failures of one rig or one step become text in the record."""
     started = time.perf_counter()
     vertices, triangles, rig = rigdata.load_ground_truth(folder)
     rig = rig.attached()  # posed as one tree: feet the artist drives by IK follow the leg
@@ -66,7 +70,8 @@ def measure(folder, seeds, poses=POSES, max_degrees=MAX_DEGREES, params=None):
         import rigger
 
         rig_started = time.perf_counter()
-        skeletons["rigger"] = rigger.rig_mesh(vertices, triangles.astype(np.int32), **(params or {}))
+        axes = blender_turn(folder.name) if blender_frame else None
+        skeletons["rigger"] = rigger.rig_mesh(vertices, triangles.astype(np.int32), axes=axes, **(params or {}))
         record["rig_seconds"] = time.perf_counter() - rig_started
     except Exception as error:  # the product failing on one model is a result, not a crash
         record["errors"]["rigger"] = f"rig_mesh: {type(error).__name__}: {error}"
@@ -152,11 +157,11 @@ def skeleton_measures(rig, artist_skeleton, skeleton, vertices, triangles, size)
             "mesh_asymmetry": {skeleton.names[k]: value for k, value in local.items()}}
 
 
-def measured(folder, seeds, poses, max_degrees, params):
+def measured(folder, seeds, poses, max_degrees, params, blender_frame):
     """``measure`` for a worker process: never raises, so one model cannot stop the run."""
     temporary_user_folder()
     try:
-        return measure(folder, seeds, poses, max_degrees, params)
+        return measure(folder, seeds, poses, max_degrees, params, blender_frame)
     except Exception as error:
         return {"model": folder.name, "failed": f"{type(error).__name__}: {error}",
                 "traceback": traceback.format_exc(limit=-4)}
@@ -371,7 +376,9 @@ def report(records, summary, run):
         "checks the fit.",
         "- Rigs: " + "; ".join(f"**{kind}** = {label}" for kind, label in RIGS.items()) + ". Rigger's skinning is "
         "`rigger.blender.skinning.skin` on the mesh as the OBJ has it (UV-seam duplicates kept); Rigger's skeleton "
-        "is `rigger.rig_mesh` with the defaults. The stick is the quality benchmark's (principal axis, jointed at "
+        "is `rigger.rig_mesh` with the defaults" + (", on each file as Blender's OBJ importer reads it (the mesh "
+        "turned for the method, the skeleton turned back: `--blender-frame`)" if run["blender_frame"] else "")
+        + ". The stick is the quality benchmark's (principal axis, jointed at "
         "its middle).",
         "- Error: distance from each fitted vertex to its target; mean and 95th percentile over all vertices and "
         "poses. Normal angle: angle between fitted and target face normals, mean over faces (non-degenerate at "
@@ -538,7 +545,11 @@ def main(argv=None):
     parser.add_argument("--compare", type=pathlib.Path, help="a previous run's posing.json to compare against")
     parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
                         help="a parameter of Rigger's method, e.g. --set bone_length=0.08 (repeatable)")
+    parser.add_argument("--blender-frame", action="store_true",
+                        help="Rigger rigs each file as Blender's OBJ importer reads it (default out/posing-blender)")
     args = parser.parse_args(argv)
+    if args.blender_frame and not args.out:
+        args.out = REPO / "out" / "posing-blender"
     params = dict(setting.split("=", 1) for setting in args.settings)
     if not MODELS_DIR.is_dir():
         raise SystemExit(f"No models at {MODELS_DIR}: the posing benchmark needs ../shared beside the checkout.")
@@ -551,13 +562,15 @@ def main(argv=None):
     temporary_user_folder()
     run = {"command": "python bench/posing.py" + (" " + " ".join(argv if argv is not None else sys.argv[1:])).rstrip(),
            "started": datetime.datetime.now(datetime.timezone.utc), "load": os.getloadavg(), "seeds": seeds,
-           "poses": args.poses, "max_degrees": args.max_angle, "jobs": args.jobs, "filtered": bool(args.models)}
+           "poses": args.poses, "max_degrees": args.max_angle, "jobs": args.jobs, "filtered": bool(args.models),
+           "blender_frame": args.blender_frame}
     started = time.perf_counter()
     records = []
     context = multiprocessing.get_context("spawn")  # bpy in each worker of its own, never forked
     with concurrent.futures.ProcessPoolExecutor(args.jobs, mp_context=context) as pool:
         largest_first = sorted(folders, key=obj_size, reverse=True)  # the long pole starts first
-        futures = [pool.submit(measured, folder, seeds, args.poses, args.max_angle, params) for folder in largest_first]
+        futures = [pool.submit(measured, folder, seeds, args.poses, args.max_angle, params, args.blender_frame)
+                   for folder in largest_first]
         for future in concurrent.futures.as_completed(futures):
             record = future.result()
             records.append(record)
