@@ -456,15 +456,15 @@ def bone_builder(bone_length, plane=None):
     return BoneBuilder(Cutting(np.radians(40), bone_length, 0, TUNING), symmetry, TUNING)
 
 
-def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0):
-    """A box body (x in -0.5..0.5) with one bone down its middle, optionally a box hand hanging beside it across a
-    gap, and ``feet`` (polylines) added as hidden limbs seen from the front; returns the builder and how many bones
-    the body (and hand) got."""
+def _body_with_feet(feet, hand=False, plane=None, bone_length=1.0, lean=0.0):
+    """A box body (x in -0.5..0.5) with one bone down its middle (its ends ``lean`` off x = 0 each way), optionally
+    a box hand hanging beside it across a gap, and ``feet`` (polylines) added as hidden limbs seen from the front;
+    returns the builder and how many bones the body (and hand) got."""
     parts = [box((-0.5, 0, 0), (0.5, 3, 1))] + ([box((0.8, 0, 0), (1.1, 2, 1))] if hand else [])
     vertices, triangles = combine(*parts)
     sil = rigger.silhouette.trace(vertices, triangles, "Z")
     builder = bone_builder(bone_length, plane)
-    body = np.array([[0.0, 2.8, 0.5], [0.0, 1.5, 0.5]])
+    body = np.array([[-lean, 2.8, 0.5], [lean, 1.5, 0.5]])
     chains = [(body, -1, np.full(2, 0.4))]
     if hand:
         chains.append((np.array([[0.95, 2.0, 0.5], [0.95, 0.2, 0.5]]), 0, np.full(2, 0.1)))
@@ -542,6 +542,19 @@ def test_mirror_image_hidden_limbs_get_mirror_image_bones():
         assert parents[sides[".L"][0]] == parents[sides[".R"][0]] == first - 1
         for points in (heads, tails):
             np.testing.assert_allclose(points[sides[".R"]], points[sides[".L"]] * [-1, 1, 1], atol=1e-12)
+
+
+def test_mirror_image_hidden_limbs_meeting_a_body_bone_off_the_plane_start_as_mirror_images():
+    """Two mirrored feet extended back to a body bone that ends 0.02 off the mirror plane: both meet it at that end,
+    so their first joints were one point, off the plane, and no mirror images (rignet_1347's legs as Blender imports
+    it, 0.0057 of its size apart). Twins meeting one bone within the twin tolerance start at mirror images."""
+    left = np.array([[0.4, 0.3, 0.5], [0.4, 0.1, 0.9]])
+    builder, first = _body_with_feet([left, left * [-1, 1, 1]], plane=(0, 0.0), lean=0.02)
+    names = builder.names()
+    heads, _, parents = builder.arrays()
+    starts = {side: next(b for b in range(first, len(heads)) if names[b].endswith(side)) for side in (".L", ".R")}
+    assert parents[starts[".L"]] == parents[starts[".R"]] == first - 1
+    np.testing.assert_allclose(heads[starts[".R"]], heads[starts[".L"]] * [-1, 1, 1], atol=1e-12)
 
 
 @pytest.mark.parametrize("start", [0.0, 0.35])

@@ -113,6 +113,8 @@ class BoneBuilder:
                 meets_of[len(chains)] = meets
             chains.append((line, widths, True))
             ups.append(up)
+        if self.symmetry is not None:
+            self._twin_meets(meets_of, ups, [line for line, _, _ in chains])
         ends = {}  # limb number -> the bridge chain it hangs from
         for members in self._sharing(meets_of, ups, [line[0] for line, _, _ in chains]):
             meets = np.mean([meets_of[k] for k in members], axis=0)
@@ -133,6 +135,16 @@ class BoneBuilder:
             up = last_bone[ends[c]] if c in ends else ups[c]
             added = self._add_chain(line, along, up)
             last_bone[c] = added[-1] if added else up
+
+    def _twin_meets(self, meets, ups, lines):
+        """Make the points where mirror twin limbs to extend meet their bone (``meets``, limb number -> point; the
+        limbs' ``ups`` and ``lines``) mirror images, their mean, when both meet one bone within the twin tolerance of
+        each other's image: twins' extensions start at their first joints, which the twins' joints do not move."""
+        for i, j in mirror_chain_pairs(lines, self.symmetry):
+            if i in meets and j in meets and ups[i] == ups[j] and (
+                    np.linalg.norm(meets[i] - self.symmetry.reflect(meets[j])) <= self.symmetry.tolerance):
+                meets[i] = (meets[i] + self.symmetry.reflect(meets[j])) / 2
+                meets[j] = self.symmetry.reflect(meets[i])
 
     def _sharing(self, meets, ups, starts):
         """The limbs to extend (the keys of ``meets``, where each meets its bone) in groups that share one
