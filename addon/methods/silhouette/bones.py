@@ -139,7 +139,8 @@ class BoneBuilder:
     def _twin_meets(self, meets, ups, lines):
         """Make the points where mirror twin limbs to extend meet their bone (``meets``, limb number -> point; the
         limbs' ``ups`` and ``lines``) mirror images, their mean, when both meet one bone within the twin tolerance of
-        each other's image: twins' extensions start at their first joints, which the twins' joints do not move."""
+        each other's image: an extension starts where its limb meets the bone, and twins keep their first joints
+        (``symmetric_joints``), so unlike meeting points would never mirror."""
         for i, j in mirror_chain_pairs(lines, self.symmetry):
             if i in meets and j in meets and ups[i] == ups[j] and (
                     np.linalg.norm(meets[i] - self.symmetry.reflect(meets[j])) <= self.symmetry.tolerance):
