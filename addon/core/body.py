@@ -693,10 +693,16 @@ def _flatness(limb, graph, vertices, segments, nearest, middle):
     around = vertices[np.isin(nearest, own)]
     if len(around) < 4:
         return 1.0
-    across = around - around.mean(axis=0)
-    across -= np.outer(across @ direction, direction)
-    spreads = np.sqrt(np.maximum(np.linalg.eigvalsh(across.T @ across / len(around)), 0.0))  # ascending; first ~ 0
+    spreads = spreads_across(around, direction)  # ascending; the first ~ 0
     return float(spreads[1] / spreads[2]) if spreads[2] > 0 else 1.0
+
+
+def spreads_across(points, direction):
+    """The standard deviations of ``points`` (P, 3) across the unit ``direction``, ascending (the first ~ 0, along
+    it): how thick and how wide they spread around that axis."""
+    across = points - points.mean(axis=0)
+    across -= np.outer(across @ direction, direction)
+    return np.sqrt(np.maximum(np.linalg.eigvalsh(across.T @ across / len(points)), 0.0))
 
 
 def _nearest_links(graph, vertices):

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .body import AXES, BodyTuning, read_body
+from .body import AXES, BodyTuning, read_body, spreads_across
 from .polyline import arc_lengths, length, nearest_on_segments
 from .roles import RoleTuning, assign_roles, joint_places
 from .stages import MirrorPlane
@@ -237,8 +237,8 @@ def _legless(body, parts, front, lengths, long_pairs, spine_length, forward, con
     longest = max(lengths, default=0.0)
     if spine_length >= tuning.fish_body * size and rise >= tuning.lying and 180 - rise >= tuning.lying \
             and longest < tuning.fin_share * spine_length and body.high - body.low <= tuning.low_body * spine_length:
-        thickness = _end_thickness(body, _thick_end_last(body, spine, tuning), tuning)
-        tapers = thickness[1] >= tuning.taper * max(thickness[0], 1e-300)
+        thin, thick = sorted(_end_thickness(body, spine, tuning))
+        tapers = thick >= tuning.taper * max(thin, 1e-300)
         spread = _end_spread(body, spine, tuning)
         spine = spine if spread[1] >= spread[0] else spine[::-1]
         curves = spine_length >= tuning.curve * float(np.linalg.norm(ends[1] - ends[0]))
@@ -432,15 +432,8 @@ def _end_spread(body, spine, tuning):
     at = arc[link] + np.linalg.norm(nearest[np.arange(len(link)), link] - starts[link], axis=1)
     spreads = []
     for part in (at <= arc[-1] * tuning.end_part, at >= arc[-1] * (1 - tuning.end_part)):
-        across = body.vertices[part] - body.vertices[part].mean(axis=0) if part.sum() > 1 else np.zeros((1, 3))
-        across -= np.outer(across @ direction, direction)
-        spreads.append(float(np.sqrt(np.maximum(np.linalg.eigvalsh(across.T @ across / len(across)), 0.0)).sum()))
+        spreads.append(float(spreads_across(body.vertices[part], direction).sum()) if part.sum() > 1 else 0.0)
     return tuple(spreads)
-
-
-def _thick_end_last(body, spine, tuning):
-    thickness = _end_thickness(body, spine, tuning)
-    return spine if thickness[1] >= thickness[0] else spine[::-1]
 
 
 # Parts and the result.
