@@ -220,6 +220,22 @@ def test_a_fish_s_head_is_its_wide_end(path, turn, head_towards):
     assert (ends["head"] - ends["tail"]) @ head_towards > 0
 
 
+@pytest.mark.parametrize("turn, head_towards", [(Y_UP, [0.0, -1.0, 0.0]), (np.eye(3), [0.0, 0.0, 1.0])])
+def test_a_quadruped_s_head_is_its_higher_end_though_its_neck_is_thin(turn, head_towards):
+    """rignet_15446, a crocodile with a big head: its spine ends in the thin neck at the head end and in the wide rump
+    at the other. Read as Blender imports it, its head end was taken for the tail, its front legs for the hind ones:
+    the higher end, the head's, lost to the thicker one."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_15446", "rignet_15446.obj"))
+    skeleton = rigger.rig_mesh(vertices @ turn.T, triangles)
+    assert skeleton.body_plan.kind == "quadruped"
+    ends = {role: np.mean([skeleton.tails[b] for b, given in enumerate(skeleton.roles) if given.role in roles],
+                          axis=0) for role, roles in (("head", ("head",)), ("tail", ("tail",)),
+                                                      ("front", ("upper_arm", "forearm", "hand")),
+                                                      ("hind", ("thigh", "shin", "foot")))}
+    assert (ends["head"] - ends["tail"]) @ head_towards > 0
+    assert (ends["front"] - ends["hind"]) @ head_towards > 0
+
+
 def test_sides_follow_the_bone_names_and_the_mirror_plane(rigged):
     skeleton = rigged["humanoid"]
     for name, role in zip(skeleton.names, skeleton.roles):

@@ -382,7 +382,7 @@ def _chest(body, spine, hips, legs, lengths, tuning):
 
 def _quadruped_spine(body, rows, legs, lengths, tuning):
     """(spine joints from the tail end to the head end, hips index, chest index): the head end has the ears, is the
-    higher and the thicker; the hind legs hang nearer the tail end."""
+    higher and the thicker (``_head_score``); the hind legs hang nearer the tail end."""
     spine = list(body.spine)
     spine = spine if _head_score(body, spine[::-1], legs, lengths, tuning) <= \
         _head_score(body, spine, legs, lengths, tuning) else spine[::-1]
@@ -392,13 +392,15 @@ def _quadruped_spine(body, rows, legs, lengths, tuning):
 
 
 def _head_score(body, spine, legs, lengths, tuning):
-    """How much the last end of ``spine`` looks like a head: limbs (not legs) hanging near it, higher, thicker."""
+    """How much the last end of ``spine`` looks like a head: limbs (not legs) hanging near it, higher, thicker. Height
+    outweighs thickness, which only decides between ends as high: the spine may end in a thin neck before a big head
+    (a crocodile's) while the rump is wide."""
     points = body.graph.points
     arc = arc_lengths(points[spine])
     near = arc >= arc[-1] * (1 - tuning.end_part)
-    score = 2 * sum(1 for k in range(len(body.limbs)) if k not in legs and lengths[k] >= tuning.min_limb * body.size
+    score = 4 * sum(1 for k in range(len(body.limbs)) if k not in legs and lengths[k] >= tuning.min_limb * body.size
                     and body.bases[k] in spine and near[spine.index(body.bases[k])])
-    score += body.height(points[spine[-1]]) > body.height(points[spine[0]])
+    score += 2 * (body.height(points[spine[-1]]) > body.height(points[spine[0]]))
     thickness = _end_thickness(body, spine, tuning)
     return score + (thickness[1] > thickness[0])
 
