@@ -82,6 +82,22 @@ def test_a_quadruped_follows_the_same_scheme_from_its_hips():
     assert bones.parents[bones.names.index("Tail1")] == bones.names.index("Hips")
 
 
+@pytest.mark.parametrize("turn", [np.eye(3), np.diag([-1.0, 1.0, -1.0])])
+def test_left_bones_are_on_the_character_s_left_whichever_way_it_faces(turn):
+    """spot, a cartoon cow, faces -Z in its file, and turned about Y it faces +Z. Bone names put .L on +X, Blender's
+    convention for a character facing the front view; facing away, the cow had its Left bones on its right, so a
+    walk's left leg moved its right one."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "spot.obj"))
+    vertices = vertices @ turn.T
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    middle = {name: 0.5 * (head + tail) for name, head, tail in zip(bones.names, bones.heads, bones.tails)}
+    up = np.asarray(skeleton.body_plan.up)
+    left = np.cross(up, middle["Neck"] - middle["Hips"])  # the neck's end is its front
+    for word in ("Arm", "UpLeg"):
+        assert (middle[f"Left{word}"] - middle[f"Right{word}"]) @ left > 0
+
+
 def test_a_plan_the_game_target_cannot_fill_falls_back_to_plain_saying_why():
     vertices, triangles = load_character("octopus")
     plan = rigger.rig_mesh(vertices, triangles).body_plan

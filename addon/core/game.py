@@ -12,8 +12,10 @@ The naming scheme (one for every body plan; the README says the same for users):
 - Every other role is one bone per chain of that role, Rigger's bones of the chain merged into it, named with
   Mixamo's word for the role: ``Neck``, ``Head``, ``Jaw``, ``Shoulder``, ``Arm`` (upper arm), ``ForeArm``, ``Hand``,
   ``UpLeg`` (thigh), ``Leg`` (shin), ``Foot``, ``ToeBase``; sided ones get ``Left`` / ``Right`` before the word
-  (``LeftForeArm``). A quadruped's front legs have the roles, so the names, of arms and its hind legs those of legs.
-  A leg's ``hips`` bones (from the body's middle to the hip joint) are the pelvis: they merge into ``Hips``.
+  (``LeftForeArm``), by the character's own side (``core.facing``: a character facing +Y has its ``.L`` bones on its
+  right, and its ``Left`` bones on its left). A quadruped's front legs have the roles, so the names, of arms and its
+  hind legs those of legs. A leg's ``hips`` bones (from the body's middle to the hip joint) are the pelvis: they
+  merge into ``Hips``.
 - A humanoid's forearm (shin, neck) that ends without a hand (foot, head) gets one: ``_completed_ends``.
 - Fingers: ``LeftHandThumb1``..``3``, ``Index``, ``Middle``, ``Ring``, ``Pinky``, at most three bones each (Rigger's
   bones merged at the joints nearest the thirds); a finger without a digit is ``LeftHandFinger1``..``3``.
@@ -33,10 +35,11 @@ game bone that holds the joint it starts from, else the nearest joint on its way
 or from twins, and twins (``Left…`` and ``Right…`` bones that mirror each other within ``TWIN_TOLERANCE`` of the size)
 get exactly mirrored points across the mirror plane.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .facing import facing
 from .polyline import arc_lengths, arc_nearest, point_at, segment_distances
 from .roles import BoneRole, landmarks, named_joints, within_reach
 from .skeleton import Skeleton
@@ -117,8 +120,19 @@ def game_skeleton(skeleton, vertices):
     tails = np.vstack([foot + ROOT_LENGTH * size * up, tails])
     parents = [-1] + [parent + 1 for parent in parents]
     roles = [BoneRole("root"), *roles]
+    if facing(skeleton).swapped:
+        names, roles = _own_sides(names, roles)
     game = Skeleton(names, heads, tails, parents, roles=roles, body_plan=skeleton.body_plan)
     return GameSkeleton(game, tuple(owner + 1 for owner in bones.owners(len(skeleton))))
+
+
+def _own_sides(names, roles):
+    """``names`` and ``roles`` with left and right swapped, for a skeleton whose ``.L`` bones lie on the character's
+    right."""
+    words = {"Left": "Right", "Right": "Left"}
+    names = [next((words[word] + name[len(word):] for word in words if name.startswith(word)), name) for name in names]
+    roles = [replace(role, side={"L": "R", "R": "L"}.get(role.side, role.side)) for role in roles]
+    return names, roles
 
 
 def _key(role):

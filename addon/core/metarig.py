@@ -12,12 +12,10 @@ serpents get none (Rigify's shark fits a shark, and a body plan cannot tell it f
 
 How the bones are placed, in order:
 
-- The character's frame: up is the body plan's; the front is, for an animal, from the torso's middle to the head;
-  for a humanoid, across the line from its ``.R`` limbs to its ``.L`` ones, the way its feet point (from the ankle to
-  the toe tip; without feet, as Blender has it: ``.L`` is the character's left); left = up x front. Rigify expects
-  Z up and the front at -Y in the armature's own space, so the metarig gets this frame as its rotation and its bones
-  are placed in it. A skeleton whose ``.L`` limbs lie on the character's right has its sides swapped: Rigify's ``.L``
-  bones go on the character's left.
+- The character's frame (``core.facing``): up is the body plan's, the front and left as that module finds them from
+  the roles. Rigify expects Z up and the front at -Y in the armature's own space, so the metarig gets this frame as
+  its rotation and its bones are placed in it. A skeleton whose ``.L`` limbs lie on the character's right has its
+  sides swapped: Rigify's ``.L`` bones go on the character's left.
 - Chains: each :class:`Chain` of a metarig is a run of its bones with the roles each takes. The skeleton's bones of
   those roles (of that side; fingers of that digit) form a path, ordered from the body outwards; where the path has
   branches or pieces, the longest piece (on the chain's side, the one farthest out on it) is taken.
@@ -53,12 +51,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .facing import TORSO, facing
 from .polyline import arc_lengths, arc_nearest, point_at
 from .roles import CHAINS, BoneRole, mesh_reach, named_joints, within_reach
 from .tuning import TuningTable, tuned
 
 FORWARD, BACKWARD = 1, -1  # the way a limb's first joint bends (a knee, an elbow)
-TORSO = ("hips", "spine", "chest")
 HELPERS = (("pelvis.{s}", "hips"), ("breast.{s}", "chest"))  # Rigify's deforming helpers and their roles
 DIGIT_BONES = {"thumb": "thumb", "index": "f_index", "middle": "f_middle", "ring": "f_ring", "pinky": "f_pinky"}
 
@@ -349,19 +347,10 @@ class _Body:
         self.head_node, self.tail_node = self.node[:count], self.node[count:]
         self.points = np.zeros((self.node.max() + 1, 3))
         self.points[self.node] = ends
-        self.up = np.asarray(skeleton.body_plan.up, dtype=np.float64)
-        self.up /= np.linalg.norm(self.up)
-        torso = self.bones_of(TORSO, None) or list(range(count))
-        self.centre = self.points[np.concatenate([self.head_node[torso], self.tail_node[torso]])].mean(axis=0)
-        front = self._front()
-        left = np.cross(self.up, front)
-        left /= np.linalg.norm(left)
-        front = np.cross(left, self.up)
-        self.frame = np.column_stack([left, -front, self.up])
-        self.side_map = {"L": "L", "R": "R", None: None}
-        named = [bone for bone, role in enumerate(self.roles) if role.side == "L"]
-        if named and (self.middle(named) - self.centre) @ left < 0:
-            self.side_map = {"L": "R", "R": "L", None: None}
+        faced = facing(skeleton, self.points, self.head_node, self.tail_node)
+        self.up, self.centre = faced.up, faced.centre
+        self.frame = np.column_stack([faced.left, -faced.front, faced.up])
+        self.side_map = {"L": faced.side("L"), "R": faced.side("R"), None: None}
 
     def local(self, points):
         """World points in the metarig's frame."""
@@ -374,49 +363,6 @@ class _Body:
         """The bones whose role is in ``roles``, of skeleton side ``side`` (and finger ``digit``)."""
         return [bone for bone, role in enumerate(self.roles) if role.role in roles and role.side == side
                 and (digit is None or role.digit == digit)]
-
-    def _front(self):
-        """The character's front, across up: for an animal from the torso's middle to its head (else its neck,
-        else from its tail to the torso's middle, else from its hips to its chest); for a humanoid across the line
-        from its ``.R`` limbs to its ``.L`` ones, the way its feet point (else the front of a figure whose ``.L``
-        side is its left, Blender's convention), else where its feet point; else Blender's -Y."""
-        candidates = []
-        if self.skeleton.body_plan.kind != "humanoid":
-            for ahead, behind in ((("head",), None), (("neck",), None), (None, ("tail",)), (("chest",), ("hips",))):
-                front_bones, back_bones = (self.bones_of(roles, None) if roles else None for roles in (ahead, behind))
-                if front_bones != [] and back_bones != []:
-                    candidates.append((self.middle(front_bones) if front_bones else self.centre) -
-                                      (self.middle(back_bones) if back_bones else self.centre))
-        feet = self._feet()
-        limbs = ("upper_arm", "forearm", "hand", "thigh", "shin", "foot")
-        lefts, rights = (self.bones_of(limbs, side) for side in ("L", "R"))
-        if lefts and rights:
-            across = self._across(np.cross(self.middle(lefts) - self.middle(rights), self.up))
-            if across is not None:
-                candidates.append(-across if feet and feet[0] @ across < 0 else across)
-        for direction in candidates + feet + [np.array([0.0, -1.0, 0.0]), np.array([0.0, 0.0, 1.0])]:
-            across = self._across(direction)
-            if across is not None:
-                return across
-        raise ValueError("cannot tell the character's front")  # unreachable: -Y and +Z are never both along up
-
-    def _across(self, direction):
-        """``direction`` across up, as a unit vector (None when it runs along up)."""
-        across = direction - (direction @ self.up) * self.up
-        norm = np.linalg.norm(across)
-        return across / norm if norm > 1e-6 * np.linalg.norm(direction) else None
-
-    def _feet(self):
-        """From each ankle to its toe tip, of the legs that have feet."""
-        directions = []
-        for side in ("L", "R"):
-            feet, legs = self.bones_of(("foot", "toe"), side), self.bones_of(("shin", "thigh"), side)
-            if feet and legs:
-                ends = self.points[np.unique(np.concatenate([self.head_node[feet], self.tail_node[feet]]))]
-                leg_ends = self.points[np.concatenate([self.head_node[legs], self.tail_node[legs]])]
-                ankle = ends[np.argmin([np.linalg.norm(leg_ends - end, axis=1).min() for end in ends])]
-                directions.append(ends[np.argmax(np.linalg.norm(ends - ankle, axis=1))] - ankle)
-        return [np.sum(directions, axis=0)] if directions else []
 
     def path(self, bones, order, side):
         """Points (K, 3) of the longest path through ``bones`` and the bone of each step, from the body outwards:

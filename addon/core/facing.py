@@ -1,0 +1,106 @@
+"""Which way a character faces, from its skeleton's roles: its front and its left across the body plan's up, and
+whether the skeleton's ``.L`` bones lie on its left. Bone names follow Blender's convention, ``.L`` on +X (the left of a
+character facing -Y); a character facing +Y has them on its right, and names that mean the character's own side
+(Rigify's, Mixamo's) must swap them."""
+from dataclasses import dataclass
+
+import numpy as np
+
+TORSO = ("hips", "spine", "chest")
+LIMBS = ("upper_arm", "forearm", "hand", "thigh", "shin", "foot")
+
+
+@dataclass(frozen=True, eq=False)
+class Facing:
+    """Unit vectors ``up``, ``front`` and ``left`` (= up x front) of a character, the middle of its torso
+    (``centre``), and ``swapped``: its skeleton's ``.L`` bones lie on its right."""
+
+    up: np.ndarray
+    front: np.ndarray
+    left: np.ndarray
+    centre: np.ndarray
+    swapped: bool
+
+    def side(self, side):
+        """The character's own side ("L", "R" or None) of a skeleton side."""
+        return {"L": "R", "R": "L"}.get(side) if self.swapped else side
+
+
+def facing(skeleton, points=None, head_node=None, tail_node=None):
+    """The :class:`Facing` of ``skeleton`` (with roles and a body plan). ``points`` and each bone's ``head_node`` and
+    ``tail_node`` in them may give its joints with nearby bone ends merged (default: the bones' own ends).
+
+    The front: for an animal, from the torso's middle to its head (else its neck, else from its tail to the torso's
+    middle, else from its hips to its chest); for a humanoid, across the line from its ``.R`` limbs to its ``.L`` ones,
+    the way its feet point (else the front of a figure whose ``.L`` side is its left, Blender's convention), else where
+    its feet point; else Blender's -Y."""
+    count = len(skeleton)
+    if points is None:
+        points = np.concatenate([skeleton.heads, skeleton.tails])
+        head_node, tail_node = np.arange(count), np.arange(count, 2 * count)
+    reading = _Reading(skeleton, np.asarray(points, dtype=np.float64), np.asarray(head_node), np.asarray(tail_node))
+    front = reading.front()
+    left = np.cross(reading.up, front)
+    left /= np.linalg.norm(left)
+    front = np.cross(left, reading.up)
+    named = [bone for bone, role in enumerate(skeleton.roles) if role.side == "L"]
+    swapped = bool(named) and (reading.middle(named) - reading.centre) @ left < 0
+    return Facing(reading.up, front, left, reading.centre, swapped)
+
+
+class _Reading:
+    """The skeleton's bones by role and side, its up and its torso's middle, for :func:`facing`."""
+
+    def __init__(self, skeleton, points, head_node, tail_node):
+        self.skeleton, self.roles = skeleton, skeleton.roles
+        self.points, self.head_node, self.tail_node = points, head_node, tail_node
+        self.up = np.asarray(skeleton.body_plan.up, dtype=np.float64)
+        self.up /= np.linalg.norm(self.up)
+        torso = self.bones_of(TORSO, None) or list(range(len(skeleton)))
+        self.centre = points[np.concatenate([head_node[torso], tail_node[torso]])].mean(axis=0)
+
+    def bones_of(self, roles, side):
+        """The bones whose role is in ``roles``, of skeleton side ``side``."""
+        return [bone for bone, role in enumerate(self.roles) if role.role in roles and role.side == side]
+
+    def middle(self, bones):
+        return 0.5 * (self.skeleton.heads[bones] + self.skeleton.tails[bones]).mean(axis=0)
+
+    def front(self):
+        """The character's front across up (the rules in :func:`facing`'s docstring)."""
+        candidates = []
+        if self.skeleton.body_plan.kind != "humanoid":
+            for ahead, behind in ((("head",), None), (("neck",), None), (None, ("tail",)), (("chest",), ("hips",))):
+                front_bones, back_bones = (self.bones_of(roles, None) if roles else None for roles in (ahead, behind))
+                if front_bones != [] and back_bones != []:
+                    candidates.append((self.middle(front_bones) if front_bones else self.centre) -
+                                      (self.middle(back_bones) if back_bones else self.centre))
+        feet = self._feet()
+        lefts, rights = (self.bones_of(LIMBS, side) for side in ("L", "R"))
+        if lefts and rights:
+            across = self._across(np.cross(self.middle(lefts) - self.middle(rights), self.up))
+            if across is not None:
+                candidates.append(-across if feet and feet[0] @ across < 0 else across)
+        for direction in candidates + feet + [np.array([0.0, -1.0, 0.0]), np.array([0.0, 0.0, 1.0])]:
+            across = self._across(direction)
+            if across is not None:
+                return across
+        raise ValueError("cannot tell the character's front")  # unreachable: -Y and +Z are never both along up
+
+    def _across(self, direction):
+        """``direction`` across up, as a unit vector (None when it runs along up)."""
+        across = direction - (direction @ self.up) * self.up
+        norm = np.linalg.norm(across)
+        return across / norm if norm > 1e-6 * np.linalg.norm(direction) else None
+
+    def _feet(self):
+        """From each ankle to its toe tip, of the legs that have feet."""
+        directions = []
+        for side in ("L", "R"):
+            feet, legs = self.bones_of(("foot", "toe"), side), self.bones_of(("shin", "thigh"), side)
+            if feet and legs:
+                ends = self.points[np.unique(np.concatenate([self.head_node[feet], self.tail_node[feet]]))]
+                leg_ends = self.points[np.concatenate([self.head_node[legs], self.tail_node[legs]])]
+                ankle = ends[np.argmin([np.linalg.norm(leg_ends - end, axis=1).min() for end in ends])]
+                directions.append(ends[np.argmax(np.linalg.norm(ends - ankle, axis=1))] - ankle)
+        return [np.sum(directions, axis=0)] if directions else []
