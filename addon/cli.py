@@ -201,7 +201,8 @@ def _run_rig(args):
     print(f"rigged {source} → {output}: {len(report['bones'])} bones, {report['skinning']['summary']}")
     if report.get("animation"):
         animation = report["animation"]
-        print(f"animated with {animation['bvh']}: {animation['frames']} frames at {animation['fps']:g} fps")
+        skipped = " (its first frame, a reference pose, left out)" if animation.get("skipped_frames") else ""
+        print(f"animated with {animation['bvh']}: {animation['frames']} frames at {animation['fps']:g} fps{skipped}")
     for warning in report["warnings"]:
         print(f"warning: {warning}", file=sys.stderr)
     return 0

@@ -7,7 +7,7 @@ from characters import load_character
 from conftest import shared_path
 from rigdata import load_obj
 from rigger.core.game import game_skeleton
-from rigger.core.retarget import RetargetError, aliases, map_joints, normalised, sole_points
+from rigger.core.retarget import Clip, RetargetError, aliases, captured, map_joints, normalised, sole_points
 from rigger.core.roles import landmarks, named_joints
 from rigger.core.targets import choose_target
 
@@ -124,6 +124,21 @@ def test_cmu_and_mixamo_joints_map_onto_the_game_names():
     assert {name: mixamo[j].split(":")[1] for name, j in mapping.driven.items() if name.startswith("Spine")} == \
         {"Spine": "Spine", "Spine1": "Spine1", "Spine2": "Spine2"}
     assert normalised("mixamorig1_Left_Hand") == "lefthand" and "lthigh" in aliases("LeftUpLeg")
+
+
+def test_a_clip_s_first_frame_is_left_out_when_it_is_a_reference_pose():
+    """CMU's BVH files start with a reference pose, every joint at rest, before the captured motion: a walk baked
+    from frame 1 flashed a T-pose at every loop. A clip that starts moving is kept whole."""
+    frames = 20
+    poses = np.tile(np.eye(4), (frames, 3, 1, 1))
+    poses[:, :, 1, 3] = np.linspace(0.0, 0.2, frames)[:, None]  # walking 1 cm a frame
+    poses[:, 2, 2, 3] = -0.5  # the hand hangs below the shoulder
+    clip = Clip(("Hips", "Arm", "Hand"), np.array([-1, 0, 1]), np.tile(np.eye(4), (3, 1, 1)), poses, 120.0)
+    assert captured(clip) == (clip, 0)
+    reference = poses.copy()
+    reference[0, 2, 2, 3] = 0.0  # the arm held out
+    kept, skipped = captured(Clip(clip.names, clip.parents, clip.rest, reference, clip.fps))
+    assert skipped == 1 and np.array_equal(kept.poses, poses[1:])
 
 
 def test_a_motion_that_cannot_drive_the_legs_names_the_bones_and_joints():

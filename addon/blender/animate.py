@@ -17,9 +17,10 @@ CARRIED = 0.5  # a skin vertex rides rigidly enough on the bone that carries mor
 def animate(armature, path):
     """Retarget the BVH file ``path`` onto game ``armature`` (built by the ``game`` target, with its ``root`` on the
     ground) and bake it as the armature's action, one key per frame from the scene's first frame; the scene's frame
-    rate and range become the clip's. Returns a report (the action, frames, fps, the scale, which game bones no
-    joint drives and which joints drove nothing). ValueError (``core.retarget.RetargetError`` for a motion that
-    cannot drive the armature) when it cannot; the imported BVH armature is removed in any case."""
+    rate and range become the clip's. Returns a report (the action, frames, fps, the frames left out at the start
+    as a reference pose, the scale, which game bones no joint drives and which joints drove nothing). ValueError
+    (``core.retarget.RetargetError`` for a motion that cannot drive the armature) when it cannot; the imported BVH
+    armature is removed in any case."""
     path = pathlib.Path(path)
     if not path.is_file():
         raise ValueError(f"{path}: no such BVH file")
@@ -34,7 +35,8 @@ def animate(armature, path):
     action = bake(armature, rig, motion, f"{armature.name}|{path.stem}", scene.frame_start)
     scene.frame_end = scene.frame_start + len(motion.rotations) - 1
     return {"bvh": str(path), "action": action.name, "frames": len(motion.rotations), "fps": clip.fps,
-            "scale": motion.scale, "undriven": motion.mapping.undriven, "unused_joints": motion.mapping.unused}
+            "skipped_frames": motion.skipped, "scale": motion.scale, "undriven": motion.mapping.undriven,
+            "unused_joints": motion.mapping.unused}
 
 
 def read_clip(path, armature):

@@ -10,6 +10,9 @@ the hips, a leg (UpLeg, Leg, Foot) or an arm (Arm, ForeArm) of the game skeleton
 
 Retargeting, frame by frame (all in the game armature's space):
 
+- A first frame the joints jump out of, by more than ``REFERENCE_JUMP`` times the clip's median step from frame to
+  frame, is a reference pose, not motion (CMU's files start with one, every joint at rest): it is left out
+  (:func:`captured`), so a looping clip does not flash it.
 - The mocap is turned about its up so that its left (from the right hip to the left one) and up meet the
   character's (``Clip.up``: Blender's BVH importer reads files Y up, into +Z).
 - Limb bones (shoulders, arms, legs, hands, fingers) take their joint's rotation since its rest, after a fixed swing
@@ -30,10 +33,11 @@ Retargeting, frame by frame (all in the game armature's space):
   until it does. Feet planted in the mocap are planted in the character whatever the legs' proportions.
 """
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+REFERENCE_JUMP = 10.0  # a first frame the joints leave by this many times the clip's median step is no motion
 SIDES = (("Left", ("left", "l")), ("Right", ("right", "r")))
 SIDED_WORDS = {  # a game bone's word: aliases of the word, best first (sides are added around them)
     "Shoulder": ("shoulder", "collar", "clavicle"),
@@ -191,7 +195,8 @@ class Rig:
 class Motion:
     """Baked keys: per frame and bone, the pose rotation (``rotations`` (F, B, 4) quaternions w, x, y, z, relative to
     the rest pose, as ``pose_bone.rotation_quaternion``), the Hips' pose ``location`` (F, 3) and the ``scale`` the
-    mocap's lengths were taken at, with the :class:`Mapping`."""
+    mocap's lengths were taken at, with the :class:`Mapping`; ``skipped``: the clip's frames left out at its start (a
+    reference pose)."""
 
     rotations: np.ndarray
     location: np.ndarray
@@ -199,10 +204,23 @@ class Motion:
     fps: float
     scale: float
     mapping: Mapping
+    skipped: int = 0
+
+
+def captured(clip):
+    """``clip`` without a first frame that is a reference pose (the module docstring) and how many frames that left
+    out (0 or 1)."""
+    if len(clip.poses) < 3:
+        return clip, 0
+    steps = np.linalg.norm(np.diff(clip.poses[:, :, :3, 3], axis=0), axis=2).max(axis=1)
+    if steps[0] > REFERENCE_JUMP * np.median(steps[1:]):
+        return replace(clip, poses=clip.poses[1:]), 1
+    return clip, 0
 
 
 def retarget(clip, rig, mapping=None):
     """The :class:`Motion` of ``clip`` on ``rig`` (see the module docstring)."""
+    clip, skipped = captured(clip)
     mapping = mapping or map_joints(clip.names, clip.parents, rig.names)
     index = {name: k for k, name in enumerate(rig.names)}
     legs = [f"{side}{word}" for side in ("Left", "Right") for word in ("UpLeg", "Leg")]
@@ -250,7 +268,7 @@ def retarget(clip, rig, mapping=None):
         local = np.einsum("ba,fcb,fcd,de->fae", rest_rot[bone], parent_world, world[:, bone], rest_rot[bone])
         rotations[:, bone] = _continuous(_quaternions(local))
     location = (hips_at - heads[hips]) @ rest_rot[hips]  # into the Hips' rest frame
-    return Motion(rotations, location, hips, clip.fps, scale, mapping)
+    return Motion(rotations, location, hips, clip.fps, scale, mapping, skipped)
 
 
 def posed_points(rig, world, hips_at):
