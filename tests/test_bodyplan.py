@@ -236,6 +236,21 @@ def test_a_quadruped_s_head_is_its_higher_end_though_its_neck_is_thin(turn, head
     assert (ends["front"] - ends["hind"]) @ head_towards > 0
 
 
+def test_twins_named_joints_mirror_where_the_mesh_mirrors_only_nearly():
+    """homer read as Blender imports it: its arms are mirror twins, but the mesh is a little thicker at one shoulder,
+    so the shoulder joint was found one joint farther out on that arm than on the other. Its game skeleton's
+    RightShoulder came out less than half as long as its LeftShoulder."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "homer.obj"))
+    skeleton = rigger.rig_mesh(vertices @ Y_UP.T, triangles)
+    plane, size = skeleton.stages["mirror_plane"], float(np.ptp(vertices, axis=0).max())
+    joints = named_joints(skeleton)
+    twins = [(joints[(role, "L", digit)], joints[(role, "R", digit)]) for role, side, digit in joints
+             if side == "L" and (role, "R", digit) in joints]
+    assert len(twins) >= 6
+    for left, right in twins:
+        assert np.linalg.norm(plane.reflect(left[None])[0] - right) <= 0.005 * size
+
+
 def test_sides_follow_the_bone_names_and_the_mirror_plane(rigged):
     skeleton = rigged["humanoid"]
     for name, role in zip(skeleton.names, skeleton.roles):

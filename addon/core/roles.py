@@ -30,6 +30,7 @@ toe tips, finger tips, heels. A place is a weighted sum of points on bones, so n
 the skeleton when it is moved (``Skeleton.transformed``).
 """
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -167,11 +168,11 @@ def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
     for k, limb in enumerate(body.limbs):
         side = _limb_side(skeleton, graph, limb, left)
         part = layout.parts[k]
-        points = _twin_points(body, limb)
+        path = _twin_path(body, limb)
         if part == "leg":
-            _leg(body, limb, points, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
+            _leg(body, limb, path.points, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
         elif part == "arm":
-            _arm(body, limb, points, tuning, lambda nodes, names: put(nodes, names, side))
+            _arm(body, limb, path, tuning, lambda nodes, names: put(nodes, names, side))
         for nodes in _paths(limb):
             put(nodes, [part] * (len(nodes) - 1), side)
     _mirror_twin_roles(roles, body, segment_bone)
@@ -239,14 +240,26 @@ def _filled(roles, skeleton, kind):
     return tuple(roles)
 
 
-def _twin_points(body, limb):
-    """The joints along ``limb``'s main path, averaged with its twin's mirror image when both have as many: twins
-    get their roles cut at the same joints."""
-    points = body.graph.points[list(limb.main)]
+class _TwinPath(NamedTuple):
+    """A limb's main path read for its roles and joints: the joints' ``points``, the mesh's ``radius`` at them and its
+    ``reach`` beyond the last (:func:`_reach`)."""
+
+    points: np.ndarray
+    radius: np.ndarray
+    reach: float
+
+
+def _twin_path(body, limb):
+    """The :class:`_TwinPath` of ``limb``, averaged with its twin's mirror image when both have as many joints: twins
+    get their roles cut, and their joints placed, alike though the mesh mirrors only nearly."""
+    nodes = list(limb.main)
+    points, radius = body.graph.points[nodes], body.radius[nodes]
     twin = body.limbs[limb.twin] if limb.twin >= 0 else None
-    if twin is not None and len(twin.main) == len(limb.main) and body.plane is not None:
-        points = 0.5 * (points + body.plane.reflect(body.graph.points[list(twin.main)]))
-    return points
+    if twin is None or len(twin.main) != len(nodes) or body.plane is None:
+        return _TwinPath(points, radius, _reach(body, points))
+    points = 0.5 * (points + body.plane.reflect(body.graph.points[list(twin.main)]))
+    radius = 0.5 * (radius + body.radius[list(twin.main)])
+    return _TwinPath(points, radius, 0.5 * (_reach(body, points) + _reach(body, body.plane.reflect(points))))
 
 
 def _paths(limb):
@@ -359,17 +372,17 @@ def _segments(names, cuts):
     return roles
 
 
-def _arm(body, limb, points, tuning, put):
+def _arm(body, limb, path, tuning, put):
     """Roles along an arm: shoulder up to the shoulder joint (where the arm leaves the torso, :func:`_shoulder`),
     then upper_arm, forearm and hand by where each bone's middle lies, at ``elbow_at`` and ``wrist_at`` of the way
     from that joint to the end of the arm's reach (the mesh beyond its last joint included: an artist's arm may end
     at the wrist), the elbow at a bend near its share; the fingers beyond the hand."""
-    nodes = list(limb.main)
+    nodes, points = list(limb.main), path.points
     last = len(nodes) - 1
     arc = arc_lengths(points)
-    total = arc[-1] + _reach(body, points)
+    total = arc[-1] + path.reach
     middle = 0.5 * (arc[1:] + arc[:-1])
-    shoulder = _shoulder(body, nodes, arc, total, tuning)
+    shoulder = _shoulder(path.radius, arc, total, tuning)
     rest = total - arc[min(shoulder, last)]  # from the shoulder joint on
     elbow, wrist = (int(np.searchsorted(middle, arc[min(shoulder, last)] + share * rest))
                     for share in (tuning.elbow_at, tuning.wrist_at))
@@ -377,7 +390,7 @@ def _arm(body, limb, points, tuning, put):
                  bends_only=True)
     elbow = elbow if bent is None else bent
     branches = _paths(limb)[1:]
-    forks = sorted({_fork(path, nodes) for path in branches})
+    forks = sorted({_fork(branch, nodes) for branch in branches})
     fingers_from = forks[0] if forks else last
     wrist = min(wrist, fingers_from) if fingers_from > elbow else wrist
     fingers_from = max(fingers_from, wrist)
@@ -392,12 +405,12 @@ def _arm(body, limb, points, tuning, put):
         put(finger, [("finger", digit)] * (len(finger) - 1))
 
 
-def _shoulder(body, nodes, arc, total, tuning):
-    """Index of an arm's shoulder joint: its first joint where the mesh is about as thin as along the arm
-    (``shoulder_thickness`` times the median half-thickness of its joints between ``arm_from`` and ``arm_to`` of
-    its reach): the arm has left the torso there. Else the joint where the bones pass ``shoulder_at`` of the reach."""
+def _shoulder(radius, arc, total, tuning):
+    """Index of an arm's shoulder joint (of the joints with mesh half-thickness ``radius`` at arc lengths ``arc``,
+    reaching ``total``): its first joint where the mesh is about as thin as along the arm (``shoulder_thickness``
+    times the median half-thickness of its joints between ``arm_from`` and ``arm_to`` of its reach): the arm has
+    left the torso there. Else the joint where the bones pass ``shoulder_at`` of the reach."""
     middle = 0.5 * (arc[1:] + arc[:-1])
-    radius = body.radius[nodes]
     share = arc / max(total, 1e-300)
     along = radius[(share >= tuning.arm_from) & (share <= tuning.arm_to)]
     if len(along):
@@ -634,10 +647,10 @@ def joint_places(skeleton, body, layout, tuning=RoleTuning()):
         if part not in ("leg", "arm") or len(limb.main) < 2:
             continue
         side = _limb_side(skeleton, graph, limb, left)
-        points = _twin_points(body, limb)
-        arc = arc_lengths(points)
-        found = _leg_places(body, points, arc, layout.front[k], tuning) if part == "leg" else \
-            _arm_places(body, limb, points, arc, tuning)
+        path = _twin_path(body, limb)
+        arc = arc_lengths(path.points)
+        found = _leg_places(body, path, arc, layout.front[k], tuning) if part == "leg" else \
+            _arm_places(body, limb, path, arc, tuning)
         for role, spots in found.items():
             places[(role, side, None)] = _on_bones(graph, ends, list(limb.main), arc, spots)
     spine = list(layout.spine)
@@ -726,20 +739,21 @@ def _down_to(heights, arc, level):
     return float(arc[i - 1] + (arc[i] - arc[i - 1]) * (heights[i - 1] - level) / max(drop, 1e-300))
 
 
-def _leg_places(body, points, arc, front, tuning):
+def _leg_places(body, path, arc, front, tuning):
     """{role: spots} along a leg's path: the ankle where it comes down to ``ankle_height``, the hip joint at
     ``hip_rise`` of the height from the ankle to where the leg hangs, on the line of the thigh when that stands
     within ``thigh_lean`` of up (the path from the knee halfway up to the hip, carried on up: the path may reach the
     hip slanting in from the body's middle; a bent hind leg's thigh line leads elsewhere), the
     knee at ``knee_at`` of the way between (a bend near there winning), the toe at ``toe_at`` of the way from the
     ankle to the tip."""
+    points = path.points
     heights = body.height(points)
     ankle = _down_to(heights, arc, tuning.ankle_height)
     ankle_height = float(np.interp(ankle, arc, heights))
     hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
     hip = _down_to(heights, arc, hip_height)
     knee = _bent(points, arc, hip, hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
-    tip = arc[-1] + _reach(body, points)
+    tip = arc[-1] + path.reach
     toe = ankle + tuning.toe_at * (tip - ankle)
     thigh = 0.5 * (hip + knee)
     line = _along(points, arc, thigh) - _along(points, arc, knee)
@@ -782,18 +796,18 @@ def _heel(body, points, arc, knee, ankle, tip, tuning):
     return ((knee, float(weights[0])), (ankle, float(weights[1])), (tip, float(1.0 - weights.sum())))
 
 
-def _arm_places(body, limb, points, arc, tuning):
+def _arm_places(body, limb, path, arc, tuning):
     """{role: spots} along an arm's path: the collarbone's start ``clavicle_at`` of the way to the shoulder joint,
     the shoulder joint as :func:`_shoulder` finds it, the elbow and the wrist
     at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the reach (a bend near the elbow winning;
     the wrist no farther than where the fingers fork)."""
-    nodes = list(limb.main)
-    total = arc[-1] + _reach(body, points)
-    shoulder = float(arc[min(_shoulder(body, nodes, arc, total, tuning), len(nodes) - 1)])
+    nodes, points = list(limb.main), path.points
+    total = arc[-1] + path.reach
+    shoulder = float(arc[min(_shoulder(path.radius, arc, total, tuning), len(nodes) - 1)])
     rest = total - shoulder
     elbow, wrist = (shoulder + share * rest for share in (tuning.elbow_at, tuning.wrist_at))
     elbow = _bent(points, arc, shoulder, elbow, wrist, rest, tuning)
-    forks = [arc[_fork(path, nodes)] for path in _paths(limb)[1:]]
+    forks = [arc[_fork(branch, nodes)] for branch in _paths(limb)[1:]]
     if forks and min(forks) > elbow:
         wrist = min(wrist, min(forks))
     return {"shoulder": ((tuning.clavicle_at * shoulder, 1.0),), "upper_arm": ((shoulder, 1.0),),
