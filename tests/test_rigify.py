@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 
 from characters import load_character, strictly_inside_fraction
+from conftest import shared_path
+from rigdata import load_obj
 
 bpy = pytest.importorskip("bpy")
 import addon_utils  # noqa: E402  (Blender's own module, importable once bpy is)
@@ -206,6 +208,19 @@ def test_hands_that_show_fingers_get_the_human_metarig_with_palms_and_fingers_pl
     # the elbow bends back (+Y) by at least the tuned share of the arm's reach
     reach = np.linalg.norm(fit.tails["forearm.L"] - fit.heads["upper_arm.L"])
     assert fit.heads["forearm.L"][1] - fit.heads["upper_arm.L"][1] >= MetarigTuning().bend * reach * 0.99
+
+
+def test_a_limb_end_the_skeleton_lacks_is_placed_on_the_mesh_and_the_fit_says_so(metarigs):
+    """homer's arms end at the elbows (his forearms point at the viewer) and his legs at the ankles: the fit placed
+    hands and feet where the mesh goes on, and said nothing of it."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "homer.obj"))
+    vertices = vertices @ Y_UP_TO_Z_UP.T
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert not any(role.role == "hand" for role in skeleton.roles)
+    fit = fit_metarig(skeleton, (vertices, triangles), "basic_human", metarigs["basic_human"])
+    assert "hand.L" in fit.heads and "hand.R" in fit.heads
+    for side in ("L", "R"):
+        assert any(note.startswith(f"the skeleton has no hand ({side})") for note in fit.notes)
 
 
 def test_the_human_metarig_with_fingers_generates(metarigs):

@@ -27,7 +27,8 @@ How the bones are placed, in order:
   joints sit where the mesh bends): a skeleton without a toe gets its foot split at the metarig's ball. A chain
   whose last roles the skeleton lacks goes on to where the mesh ends ahead of it, when the mesh goes on there (an arm
   ending at the wrist gets its hand; a skeleton whose spine ends at the chest gets a neck and a head), else they share
-  the stretch of the last role (a leg whose shin reaches the ground gets its foot and toe from the shin's lower part).
+  the stretch of the last role (a leg whose shin reaches the ground gets its foot and toe from the shin's lower part);
+  either way the fit says so.
 - Limbs that Rigify bends with IK (legs, arms, paws): the joint between their first two bones is moved, when it does
   not already bend that way by ``bend`` of the limb's reach, so that knees bend forward and elbows backward (Rigify
   takes the bend direction from the chain); a limb bent sideways leans at most ``tilt`` from that. An animal's hind
@@ -539,10 +540,15 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
         direction = points[-1] - points[-2]
         direction = direction / max(np.linalg.norm(direction), 1e-300)
         reach = mesh_reach(body.vertices, points[-1], direction, tuning.extend_most * wanted, body.size)
-        if reach >= tuning.extend * wanted:
+        extended = reach >= tuning.extend * wanted
+        if extended:
             points = np.vstack([points, points[-1] + reach * direction])
             arc = np.r_[arc, arc[-1] + reach]
             spans[missing] = (arc[-2], arc[-1])
+        lacking = "/".join(dict.fromkeys(role for group in groups[missing:] for role in group))
+        side = f" ({named[0]})" if named is not None and named[0] else ""
+        body.notes.append(f"the skeleton has no {lacking}{side}: placed " + (
+            "where the mesh goes on past its last bone" if extended else "over its last bones"))
     cuts = _cuts(groups, spans, arc, lengths, tuning.shortest * body.size, tuning, pins)
     placed = point_at(points, arc, cuts)
     ends = {0: starts.get(0), len(groups): after}  # the chain's ends exactly there (a hip joint beside the path)
