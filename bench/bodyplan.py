@@ -14,6 +14,9 @@ below (``NAMED``, role per joint name; a joint is left out when the rig has no s
 which it is). Sides are compared by geometry (the side of the mirror plane a joint lies on), so no naming
 convention matters. Errors are in units of the mesh's largest extent.
 
+Heads: for the animals, whether Rigger's head (its bones of role head, else neck) lies from the middle of its bones
+the way the hand label (``HEADS``) says the head points, as Blender imports the file.
+
     .venv/bin/python bench/bodyplan.py [--models NAME ...] [--out DIR]
 
 Writes bodyplan.md, bodyplan.png and bodyplan.json to bench/results (or ``--out``; a run on ``--models`` writes to
@@ -144,6 +147,15 @@ NAMED = {
 }
 
 
+# Which way each animal's head points as Blender imports the file (the axis, in Blender's world, from the body's
+# middle to its head), from renders and the artists' joints; the humanoids' heads are in the named joints.
+HEADS = {**{f"Quaternius_{animal}": "-Y" for animal in ("Alpaca", "Deer", "Fox", "Husky", "ShibaInu", "Wolf")},
+         "rignet_15446": "-Y", "rignet_2982": "-Y", "rignet_3318": "-Y", "rignet_8338": "-Y", "rignet_11814": "-Y",
+         "alligator": "-X", "cow": "+X", "spot": "+Y"}
+AXIS_VECTORS = {f"{sign}{axis}": (1.0 if sign == "+" else -1.0) * np.eye(3)[k]
+                for k, axis in enumerate("XYZ") for sign in "+-"}
+
+
 def model_path(name):
     folder = SHARED_MODELS / "gt" / name
     return folder if folder.is_dir() else SHARED_MODELS / "nogt" / f"{name}.obj"
@@ -183,6 +195,8 @@ def measure(name):
     record["plan_seconds"] = skeleton.timings["body_plan"]
     record["rigger"] = plan_record(skeleton.body_plan, skeleton)
     record["file_frame"] = plan_record(file_frame_plan(skeleton, mesh, turn), None)
+    if name in HEADS:
+        record["head_right"] = head_right(skeleton, AXIS_VECTORS[HEADS[name]])
     if rig is not None:
         artist, head_joint = rigdata.armature_skeleton(rig.attached())
         plan, roles = recognise(artist, mesh)
@@ -196,6 +210,17 @@ def measure(name):
                                "nearest": nearest_joints(skeleton, truth, size),
                                "artist_roles": role_agreement(artist, head_joint, rig, NAMED[name], middle, size)}
     return record
+
+
+def head_right(skeleton, towards):
+    """Whether the skeleton's head (its bones of role head, else neck) lies from the middle of its bones towards
+    ``towards``; None when it names neither."""
+    middles = 0.5 * (skeleton.heads + skeleton.tails)
+    for roles in (("head",), ("neck",)):
+        bones = [bone for bone, role in enumerate(skeleton.roles) if role.role in roles]
+        if bones:
+            return bool((middles[bones].mean(axis=0) - middles.mean(axis=0)) @ towards > 0)
+    return None
 
 
 def plan_record(plan, skeleton):
@@ -337,6 +362,9 @@ def summarise(records):
         "over_max": sorted(((model, joint, error) for model, joint, error in found if error > TARGET_MAX_ERROR),
                            key=lambda row: -row[2]),
         "artist_role_agreement": (sum(agreement), len(agreement)),
+        "heads": (sum(record.get("head_right") is True for record in records),
+                  sum("head_right" in record for record in records),
+                  [record["model"] for record in records if record.get("head_right") is False]),
         "plan_ms_median": 1000 * float(np.median([record["plan_seconds"] for record in records])),
         "plan_ms_max": 1000 * float(np.max([record["plan_seconds"] for record in records])),
     })
@@ -386,7 +414,10 @@ def report(records, summary, run):
         f"artist joints (not in the error). The nearest joint of Rigger's skeleton, whatever its role, lies "
         f"{summary['named_floor']:.4f} from the scored artist joints on average: the floor of naming Rigger's own "
         f"joints, which named joints placed along the bones may go below. Recognition takes "
-        f"{summary['plan_ms_median']:.0f} ms (median; at most {summary['plan_ms_max']:.0f} ms) on top of the rig.", "",
+        f"{summary['plan_ms_median']:.0f} ms (median; at most {summary['plan_ms_max']:.0f} ms) on top of the rig. "
+        f"The animals' heads (bones named head, else neck) point the way the hand labels (``HEADS``) say on "
+        f"{summary['heads'][0]} / {summary['heads'][1]}"
+        + (f" (wrong: {', '.join(summary['heads'][2])})" if summary["heads"][2] else "") + ".", "",
     ]
     for source, title in (("rigger", "Rigger's skeletons (what `rig_mesh` reports)"),
                           ("artist", "the artists' skeletons (geometry only)"),
