@@ -212,15 +212,20 @@ def test_hands_that_show_fingers_get_the_human_metarig_with_palms_and_fingers_pl
 
 def test_a_limb_end_the_skeleton_lacks_is_placed_on_the_mesh_and_the_fit_says_so(metarigs):
     """homer's arms end at the elbows (his forearms point at the viewer) and his legs at the ankles: the fit placed
-    hands and feet where the mesh goes on, and said nothing of it."""
+    hands and feet where the mesh goes on, and said nothing of it. His feet went on down the shins, the toes below
+    the mesh and the IK controls pointing down; a foot runs forward along the ground."""
     vertices, triangles = load_obj(shared_path("models", "nogt", "homer.obj"))
     vertices = vertices @ Y_UP_TO_Z_UP.T
     skeleton = rigger.rig_mesh(vertices, triangles)
     assert not any(role.role == "hand" for role in skeleton.roles)
     fit = fit_metarig(skeleton, (vertices, triangles), "basic_human", metarigs["basic_human"])
     assert "hand.L" in fit.heads and "hand.R" in fit.heads
+    size = float(np.ptp(vertices, axis=0).max())
     for side in ("L", "R"):
         assert any(note.startswith(f"the skeleton has no hand ({side})") for note in fit.notes)
+        ankle, tip = fit.heads[f"foot.{side}"], fit.tails[f"toe.{side}"]  # the metarig's frame: front -Y, up +Z
+        assert ankle[1] - tip[1] >= 0.05 * size  # ahead ...
+        assert ankle[2] - tip[2] <= 0.1 * size  # ... rather than down
 
 
 def test_the_human_metarig_with_fingers_generates(metarigs):

@@ -26,7 +26,8 @@ How the bones are placed, in order:
   between such joints in the metarig's own proportions and move onto a skeleton joint near them (the skeleton's
   joints sit where the mesh bends): a skeleton without a toe gets its foot split at the metarig's ball. A chain
   whose last roles the skeleton lacks goes on to where the mesh ends ahead of it, when the mesh goes on there (an arm
-  ending at the wrist gets its hand; a skeleton whose spine ends at the chest gets a neck and a head), else they share
+  ending at the wrist gets its hand; a skeleton whose spine ends at the chest gets a neck and a head; a leg ending at
+  the ankle gets its foot forward along the ground, ``_foot_ahead``), else they share
   the stretch of the last role (a leg whose shin reaches the ground gets its foot and toe from the shin's lower part);
   either way the fit says so.
 - Limbs that Rigify bends with IK (legs, arms, paws): the joint between their first two bones is moved, when it does
@@ -539,12 +540,19 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
         wanted = scale * lengths[missing:].sum()
         direction = points[-1] - points[-2]
         direction = direction / max(np.linalg.norm(direction), 1e-300)
-        reach = mesh_reach(body.vertices, points[-1], direction, tuning.extend_most * wanted, body.size)
-        extended = reach >= tuning.extend * wanted
-        if extended:
-            points = np.vstack([points, points[-1] + reach * direction])
-            arc = np.r_[arc, arc[-1] + reach]
-            spans[missing] = (arc[-2], arc[-1])
+        foot = _foot_ahead(body, points[-1], wanted) if groups[missing][0] == "foot" else None
+        if foot is not None:  # a leg ending at the ankle: its foot runs forward on the ground, not on down the shin
+            extended = True
+            points = np.vstack([points, foot])
+            arc = arc_lengths(points)
+            spans[missing] = (arc[-3], arc[-1])
+        else:
+            reach = mesh_reach(body.vertices, points[-1], direction, tuning.extend_most * wanted, body.size)
+            extended = reach >= tuning.extend * wanted
+            if extended:
+                points = np.vstack([points, points[-1] + reach * direction])
+                arc = np.r_[arc, arc[-1] + reach]
+                spans[missing] = (arc[-2], arc[-1])
         lacking = "/".join(dict.fromkeys(role for group in groups[missing:] for role in group))
         side = f" ({named[0]})" if named is not None and named[0] else ""
         body.notes.append(f"the skeleton has no {lacking}{side}: placed " + (
@@ -557,6 +565,22 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
         if joint is not None and within_reach(placed[k], joint, beside):
             placed[k] = joint
     return body.local(placed)
+
+
+def _foot_ahead(body, ankle, length):
+    """(ball, tip) of a foot the skeleton lacks, from the mesh below the ``ankle``: its vertices below the ankle,
+    ahead of it by up to twice the foot's metarig ``length`` and beside it by up to half that; the tip where they
+    reach farthest ahead, on their lowest level, the ball 70% of the way there. None when the mesh has no foot ahead
+    (the leg ends on a round stump) or it reaches less than a quarter of the length."""
+    local = body.local(body.vertices) - body.local(ankle)
+    near = (local[:, 2] < 0) & (local[:, 1] <= 0) & (local[:, 1] >= -2 * length) & (np.abs(local[:, 0]) <= 0.5 * length)
+    if not near.any() or -local[near, 1].min() < 0.25 * length:
+        return None
+    ground = local[near, 2].min()
+    tip_local = np.array([0.0, local[near, 1].min(), ground])
+    tip = ankle + body.frame @ tip_local
+    ball = ankle + body.frame @ np.array([0.0, 0.7 * tip_local[1], ground])
+    return np.vstack([ball, tip])
 
 
 def _next_role(role):
