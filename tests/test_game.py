@@ -98,6 +98,22 @@ def test_left_bones_are_on_the_character_s_left_whichever_way_it_faces(turn):
         assert (middle[f"Left{word}"] - middle[f"Right{word}"]) @ left > 0
 
 
+def test_the_chain_going_on_from_a_bone_takes_the_name_and_a_branch_off_it_the_number():
+    """spot's front legs each have a stub branching off the upper leg (a bump seen from the front), above where the
+    lower leg goes on from it. Both are forearms; the stub, starting higher, took ``LeftForeArm`` and the lower leg
+    ``LeftForeArm_2``, and Rigify's front leg followed the stub into the belly."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "spot.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    up = np.asarray(skeleton.body_plan.up)
+    for side in ("Left", "Right"):
+        forearms = [k for k, name in enumerate(bones.names) if name.startswith(f"{side}ForeArm")]
+        assert len(forearms) == 2
+        lowest = min(forearms, key=lambda k: bones.tails[k] @ up)
+        assert bones.names[lowest] == f"{side}ForeArm"
+        assert np.allclose(bones.heads[lowest], bones.tails[bones.names.index(f"{side}Arm")])
+
+
 def test_a_plan_the_game_target_cannot_fill_falls_back_to_plain_saying_why():
     vertices, triangles = load_character("octopus")
     plan = rigger.rig_mesh(vertices, triangles).body_plan

@@ -228,6 +228,19 @@ def test_a_limb_end_the_skeleton_lacks_is_placed_on_the_mesh_and_the_fit_says_so
         assert ankle[2] - tip[2] <= 0.1 * size  # ... rather than down
 
 
+def test_a_stub_off_a_leg_is_not_the_leg(metarigs):
+    """spot's front legs each have a two-bone stub off the upper leg (a bump seen from the front), shorter than the
+    leg and farther out: the fit took the piece farthest out for the front leg, and Rigify's front paw hung in the
+    belly. A side's pieces much shorter than its longest do not compete."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "spot.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    fit = fit_metarig(skeleton, (vertices, triangles), "basic_quadruped", metarigs["basic_quadruped"])
+    size = float(np.ptp(vertices, axis=0).max())
+    ground = float(min(fit.tails[name][2] for name in fit.tails))  # the metarig's frame: up is +Z
+    for side in ("L", "R"):
+        assert fit.tails[f"front_toe.{side}"][2] - ground <= 0.05 * size
+
+
 def test_the_human_metarig_with_fingers_generates(metarigs):
     empty_scene()
     skeleton, mesh = hand_made_humanoid()

@@ -372,8 +372,9 @@ class _Bones:
 
     def name_instances(self, up):
         """``_2``, ``_3`` after the names that several chains share: ordered by the number of the bone each hangs
-        from (a forearm on ``LeftArm_2`` is ``LeftForeArm_2``), then from the highest start. Names are numbered
-        from the hips outwards, so a chain's parent is numbered before it."""
+        from (a forearm on ``LeftArm_2`` is ``LeftForeArm_2``), then the chains going on from that bone's end before
+        those branching off it on the way, then from the highest start. Names are numbered from the hips outwards,
+        so a chain's parent is numbered before it."""
         first_of_chain = {}
         for index, bone in enumerate(self.bones):
             first_of_chain.setdefault(bone["chain"], index)
@@ -387,8 +388,15 @@ class _Bones:
             suffix = "" if owner is None or self.bones[owner]["chain"] == chain else self.bones[owner]["suffix"]
             return int(suffix[1:] or 1)
 
+        def branching(chain):
+            """Whether the chain leaves the bone it hangs from before that bone's end (a side branch)."""
+            first = self.bones[first_of_chain[chain]]
+            owner = self.node_owner.get(first["start"])
+            return owner is not None and self.bones[owner]["chain"] != chain and \
+                not np.allclose(first["head"], self.bones[owner]["tail"])
+
         for chains in by_name.values():
-            chains.sort(key=lambda chain: (parent_number(chain),
+            chains.sort(key=lambda chain: (parent_number(chain), branching(chain),
                                            -round(float(self.bones[first_of_chain[chain]]["head"] @ up), 9),
                                            first_of_chain[chain]))
             for count, chain in enumerate(chains[1:], start=2):

@@ -93,6 +93,8 @@ class MetarigTuning(TuningTable):
     anchors: int = tuned(8, "a derived bone moves with this many placed joints nearest it in the metarig")
     heel_reach: float = tuned(0.6, "the heel is looked for among the vertices within this many foot lengths of the "
                                    "ankle, across the ground")
+    side_piece: float = tuned(0.5, "of a side's pieces of a limb's roles, those at least this share of the longest's "
+                                   "length compete, the farthest out winning (a stub off a leg is no leg)")
 
 
 @dataclass(frozen=True)
@@ -339,7 +341,7 @@ class _Body:
     mapping of the metarig's sides onto the skeleton's."""
 
     def __init__(self, skeleton, vertices, tuning):
-        self.skeleton, self.roles, self.vertices = skeleton, skeleton.roles, vertices
+        self.skeleton, self.roles, self.vertices, self.tuning = skeleton, skeleton.roles, vertices, tuning
         ends = np.concatenate([skeleton.heads, skeleton.tails])
         self.size = float(np.ptp(np.concatenate([ends, vertices]), axis=0).max())
         self.notes = []  # what the fit could not do as it should, in words
@@ -370,11 +372,14 @@ class _Body:
         """Points (K, 3) of the longest path through ``bones`` and the bone of each step, from the body outwards:
         ``order(bone)`` ranks a bone's role along the chain (the path runs from low to high rank; when all ranks
         tie, from the end where the piece hangs from the rest of the skeleton, else from the end nearer the torso's
-        middle). Of several pieces, the longest (on side ``side``, the one farthest out on it)."""
+        middle). Of several pieces, the longest (on side ``side``, the one farthest out on it of those at least
+        ``side_piece`` of the longest's length)."""
         pieces = _pieces(bones, self.head_node, self.tail_node)
         if side is not None:
             sign = 1 if side == self.side_map["L"] else -1
             left = self.frame[:, 0]
+            longest = max(self._length(piece) for piece in pieces)
+            pieces = [piece for piece in pieces if self._length(piece) >= self.tuning.side_piece * longest]
             piece = max(pieces, key=lambda piece: sign * (self.middle(piece) - self.centre) @ left)
         else:
             piece = max(pieces, key=lambda piece: self._length(piece))
@@ -494,9 +499,11 @@ def _fit_chain(body, chain, side, names, meta, tuning):
     if arc[-1] <= 0:
         return None
     lengths = np.array([np.linalg.norm(np.subtract(meta[name].tail, meta[name].head)) for name in names])
-    joints = _joints(body, groups, points, arc, step_roles, lengths, tuning, (skeleton_side, chain.digit))
+    noted = len(body.notes)
+    joints = _joints(body, groups, points, arc, step_roles, lengths, tuning, (skeleton_side, chain.digit), side)
     if chain.hock and _bent(joints, chain.bend)[0] < 0:  # the first joint bends backward: it is the hock
-        joints = _joints(body, _groups(chain.hock), points, arc, step_roles, lengths, tuning)
+        del body.notes[noted:]  # read again from the hock, which notes what it lacks itself
+        joints = _joints(body, _groups(chain.hock), points, arc, step_roles, lengths, tuning, side=side)
         joints[1] = _as_in_metarig(joints, [np.asarray(meta[name].head, float) for name in names[:3]], chain.bend)
     if groups[0] == ("palm",):
         joints[0] = _palm_head(joints, meta, names, side)
@@ -510,11 +517,12 @@ def _groups(roles):
     return [role if isinstance(role, tuple) else (role,) for role in roles]
 
 
-def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
+def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None, side=None):
     """A chain's joints in the metarig's frame, its bones taking the role ``groups`` on the path ``points`` (arc
     lengths ``arc``) whose steps have the roles ``step_roles``; with ``named`` (the skeleton's side and digit), a
     joint where a role begins moves to that role's named joint when it is within reach, and the path ends where the
-    role after the chain's begins (the torso at the neck's named joint)."""
+    role after the chain's begins (the torso at the neck's named joint). Roles the skeleton lacks are noted, on the
+    metarig's ``side``."""
     after = body.joints.get((_next_role(groups[-1][-1]), *named)) if named is not None else None
     if after is not None and 0 < (end := arc_nearest(points, arc, after)) < arc[-1]:
         kept = int(np.searchsorted(arc, end, side="left"))
@@ -554,8 +562,7 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None):
                 arc = np.r_[arc, arc[-1] + reach]
                 spans[missing] = (arc[-2], arc[-1])
         lacking = "/".join(dict.fromkeys(role for group in groups[missing:] for role in group))
-        side = f" ({named[0]})" if named is not None and named[0] else ""
-        body.notes.append(f"the skeleton has no {lacking}{side}: placed " + (
+        body.notes.append(f"the skeleton has no {lacking}{f' ({side})' if side else ''}: placed " + (
             "where the mesh goes on past its last bone" if extended else "over its last bones"))
     cuts = _cuts(groups, spans, arc, lengths, tuning.shortest * body.size, tuning, pins)
     placed = point_at(points, arc, cuts)
