@@ -30,7 +30,7 @@ toe tips, finger tips, heels. A place is a weighted sum of points on bones, so n
 the skeleton when it is moved (``Skeleton.transformed``).
 """
 from dataclasses import dataclass, replace
-from typing import NamedTuple
+from functools import cached_property
 
 import numpy as np
 
@@ -168,7 +168,7 @@ def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
     for k, limb in enumerate(body.limbs):
         side = _limb_side(skeleton, graph, limb, left)
         part = layout.parts[k]
-        path = _twin_path(body, limb)
+        path = _TwinPath(body, limb)
         if part == "leg":
             _leg(body, limb, path.points, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
         elif part == "arm":
@@ -240,26 +240,24 @@ def _filled(roles, skeleton, kind):
     return tuple(roles)
 
 
-class _TwinPath(NamedTuple):
+class _TwinPath:
     """A limb's main path read for its roles and joints: the joints' ``points``, the mesh's ``radius`` at them and its
-    ``reach`` beyond the last (:func:`_reach`)."""
+    ``reach`` beyond the last (:func:`_reach`), averaged with its twin's mirror image when both have as many joints:
+    twins get their roles cut, and their joints placed, alike though the mesh mirrors only nearly."""
 
-    points: np.ndarray
-    radius: np.ndarray
-    reach: float
+    def __init__(self, body, limb):
+        nodes = list(limb.main)
+        self.body, self.points, self.radius = body, body.graph.points[nodes], body.radius[nodes]
+        twin = body.limbs[limb.twin] if limb.twin >= 0 else None
+        self.mirrored = twin is not None and len(twin.main) == len(nodes) and body.plane is not None
+        if self.mirrored:
+            self.points = 0.5 * (self.points + body.plane.reflect(body.graph.points[list(twin.main)]))
+            self.radius = 0.5 * (self.radius + body.radius[list(twin.main)])
 
-
-def _twin_path(body, limb):
-    """The :class:`_TwinPath` of ``limb``, averaged with its twin's mirror image when both have as many joints: twins
-    get their roles cut, and their joints placed, alike though the mesh mirrors only nearly."""
-    nodes = list(limb.main)
-    points, radius = body.graph.points[nodes], body.radius[nodes]
-    twin = body.limbs[limb.twin] if limb.twin >= 0 else None
-    if twin is None or len(twin.main) != len(nodes) or body.plane is None:
-        return _TwinPath(points, radius, _reach(body, points))
-    points = 0.5 * (points + body.plane.reflect(body.graph.points[list(twin.main)]))
-    radius = 0.5 * (radius + body.radius[list(twin.main)])
-    return _TwinPath(points, radius, 0.5 * (_reach(body, points) + _reach(body, body.plane.reflect(points))))
+    @cached_property
+    def reach(self):
+        reach = _reach(self.body, self.points)
+        return 0.5 * (reach + _reach(self.body, self.body.plane.reflect(self.points))) if self.mirrored else reach
 
 
 def _paths(limb):
@@ -647,7 +645,7 @@ def joint_places(skeleton, body, layout, tuning=RoleTuning()):
         if part not in ("leg", "arm") or len(limb.main) < 2:
             continue
         side = _limb_side(skeleton, graph, limb, left)
-        path = _twin_path(body, limb)
+        path = _TwinPath(body, limb)
         arc = arc_lengths(path.points)
         found = _leg_places(body, path, arc, layout.front[k], tuning) if part == "leg" else \
             _arm_places(body, limb, path, arc, tuning)
