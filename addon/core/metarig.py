@@ -93,6 +93,11 @@ class MetarigTuning(TuningTable):
     anchors: int = tuned(8, "a derived bone moves with this many placed joints nearest it in the metarig")
     heel_reach: float = tuned(0.6, "the heel is looked for among the vertices within this many foot lengths of the "
                                    "ankle, across the ground")
+    foot_ahead: float = tuned(2.0, "a foot the skeleton lacks is looked for among the vertices below the ankle up to "
+                                   "this many of its metarig lengths ahead ...")
+    foot_beside: float = tuned(0.5, "... and this many beside it; ...")
+    foot_least: float = tuned(0.25, "... none when they reach less than this many ahead (a leg ending on a stump)")
+    ball_at: float = tuned(0.7, "such a foot's ball lies this share of the way from the ankle to the tip")
     side_piece: float = tuned(0.5, "of a side's pieces of a limb's roles, those at least this share of the longest's "
                                    "length compete, the farthest out winning (a stub off a leg is no leg)")
 
@@ -548,7 +553,7 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None, 
         wanted = scale * lengths[missing:].sum()
         direction = points[-1] - points[-2]
         direction = direction / max(np.linalg.norm(direction), 1e-300)
-        foot = _foot_ahead(body, points[-1], wanted) if groups[missing][0] == "foot" else None
+        foot = _foot_ahead(body, points[-1], wanted, tuning) if groups[missing][0] == "foot" else None
         if foot is not None:  # a leg ending at the ankle: its foot runs forward on the ground, not on down the shin
             extended = True
             points = np.vstack([points, foot])
@@ -574,20 +579,18 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None, 
     return body.local(placed)
 
 
-def _foot_ahead(body, ankle, length):
-    """(ball, tip) of a foot the skeleton lacks, from the mesh below the ``ankle``: its vertices below the ankle,
-    ahead of it by up to twice the foot's metarig ``length`` and beside it by up to half that; the tip where they
-    reach farthest ahead, on their lowest level, the ball 70% of the way there. None when the mesh has no foot ahead
-    (the leg ends on a round stump) or it reaches less than a quarter of the length."""
-    local = body.local(body.vertices) - body.local(ankle)
-    near = (local[:, 2] < 0) & (local[:, 1] <= 0) & (local[:, 1] >= -2 * length) & (np.abs(local[:, 0]) <= 0.5 * length)
-    if not near.any() or -local[near, 1].min() < 0.25 * length:
+def _foot_ahead(body, ankle, length, tuning):
+    """(ball, tip) of a foot the skeleton lacks, from the mesh's vertices below the ``ankle`` and ahead of it (within
+    ``foot_ahead`` and ``foot_beside`` of the foot's metarig ``length``): the tip where they reach farthest ahead, on
+    their lowest level, the ball ``ball_at`` of the way there. None when they reach less than ``foot_least`` ahead."""
+    local = body.local(body.vertices) - body.local(ankle)  # the metarig's frame: left, back (-front), up
+    near = (local[:, 2] < 0) & (local[:, 1] <= 0) & (local[:, 1] >= -tuning.foot_ahead * length) & (
+        np.abs(local[:, 0]) <= tuning.foot_beside * length)
+    if not near.any() or -local[near, 1].min() < tuning.foot_least * length:
         return None
-    ground = local[near, 2].min()
-    tip_local = np.array([0.0, local[near, 1].min(), ground])
-    tip = ankle + body.frame @ tip_local
-    ball = ankle + body.frame @ np.array([0.0, 0.7 * tip_local[1], ground])
-    return np.vstack([ball, tip])
+    ground, ahead = local[near, 2].min(), local[near, 1].min()
+    return np.vstack([ankle + body.frame @ np.array([0.0, tuning.ball_at * ahead, ground]),
+                      ankle + body.frame @ np.array([0.0, ahead, ground])])
 
 
 def _next_role(role):
