@@ -114,6 +114,20 @@ def test_the_chain_going_on_from_a_bone_takes_the_name_and_a_branch_off_it_the_n
         assert np.allclose(bones.heads[lowest], bones.tails[bones.names.index(f"{side}Arm")])
 
 
+def test_a_foot_the_skeleton_lacks_runs_forward_along_the_ground():
+    """homer's legs end at the ankles: his game Foot went on down the shin, 0.04 long, with no ToeBase, where game
+    engines and foot IK expect a foot from the ankle to the ball and a toe on to the tip. He faces +Z."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "homer.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    size, ground = float(np.ptp(vertices, axis=0).max()), float(vertices[:, 1].min())
+    for side in ("Left", "Right"):
+        foot, toe = bones.names.index(f"{side}Foot"), bones.names.index(f"{side}ToeBase")
+        assert bones.parents[toe] == foot and np.allclose(bones.tails[foot], bones.heads[toe])
+        assert bones.tails[toe][2] - bones.heads[foot][2] >= 0.08 * size  # ahead ...
+        assert bones.tails[toe][1] - ground <= 0.01 * size  # ... on the ground
+
+
 def test_a_plan_the_game_target_cannot_fill_falls_back_to_plain_saying_why():
     vertices, triangles = load_character("octopus")
     plan = rigger.rig_mesh(vertices, triangles).body_plan

@@ -6,8 +6,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .tuning import TuningTable, tuned
+
 TORSO = ("hips", "spine", "chest")
 LIMBS = ("upper_arm", "forearm", "hand", "thigh", "shin", "foot")
+
+
+@dataclass(frozen=True)
+class FootTuning(TuningTable):
+    """The tuned numbers of finding a foot the skeleton lacks (``foot_ahead``), in the foot's expected lengths."""
+
+    ahead: float = tuned(2.0, "the foot is looked for among the vertices below the ankle up to this far ahead ...")
+    beside: float = tuned(0.5, "... and this far beside it; ...")
+    least: float = tuned(0.25, "... none when they reach less than this far ahead (a leg ending on a stump)")
+    ball_at: float = tuned(0.7, "the foot's ball lies this share of the way from the ankle to the tip")
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,3 +116,18 @@ class _Reading:
                 ankle = ends[np.argmin([np.linalg.norm(leg_ends - end, axis=1).min() for end in ends])]
                 directions.append(ends[np.argmax(np.linalg.norm(ends - ankle, axis=1))] - ankle)
         return [np.sum(directions, axis=0)] if directions else []
+
+
+def foot_ahead(vertices, ankle, faced, length, tuning=FootTuning()):
+    """(ball, tip) of a foot the skeleton lacks, from the mesh's ``vertices`` below the ``ankle`` and ahead of it (the
+    :class:`Facing` ``faced``; within ``ahead`` and ``beside`` of the foot's expected ``length``): the tip where they
+    reach farthest ahead, on their lowest level, the ball ``ball_at`` of the way there; a leg ending at the ankle has
+    its foot run forward along the ground, not on down the shin. None when they reach less than ``least`` ahead."""
+    offsets = np.asarray(vertices, dtype=np.float64) - ankle
+    across, ahead, height = offsets @ faced.left, offsets @ faced.front, offsets @ faced.up
+    near = (height < 0) & (ahead >= 0) & (ahead <= tuning.ahead * length) & (np.abs(across) <= tuning.beside * length)
+    if not near.any() or ahead[near].max() < tuning.least * length:
+        return None
+    reach, ground = float(ahead[near].max()), float(height[near].min())
+    return np.vstack([ankle + tuning.ball_at * reach * faced.front + ground * faced.up,
+                      ankle + reach * faced.front + ground * faced.up])

@@ -39,7 +39,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .facing import facing
+from .facing import facing, foot_ahead
 from .polyline import arc_lengths, arc_nearest, point_at, segment_distances
 from .roles import BoneRole, landmarks, named_joints, within_reach
 from .skeleton import Skeleton
@@ -107,9 +107,10 @@ def game_skeleton(skeleton, vertices):
     bones.name_instances(up)
     bones.at_named_joints(MERGE_TOLERANCE * size)
     names, heads, tails, parents, roles = bones.finished(arriving)
+    faced = facing(skeleton)
     if skeleton.body_plan.kind == "humanoid":
         names, heads, tails, parents, roles = _completed_ends(names, heads, tails, parents, roles,
-                                                              {**joints, **landmarks(skeleton)})
+                                                              {**joints, **landmarks(skeleton)}, vertices, faced)
     parents = _twin_parents(names, heads, tails, parents)
     heads, tails = _mirrored_twins(names, heads, tails, skeleton.stages.get("mirror_plane"), size)
     hips = heads[bones.hips] if bones.hips is not None else graph.points[start]
@@ -120,7 +121,7 @@ def game_skeleton(skeleton, vertices):
     tails = np.vstack([foot + ROOT_LENGTH * size * up, tails])
     parents = [-1] + [parent + 1 for parent in parents]
     roles = [BoneRole("root"), *roles]
-    if facing(skeleton).swapped:
+    if faced.swapped:
         names, roles = _own_sides(names, roles)
     game = Skeleton(names, heads, tails, parents, roles=roles, body_plan=skeleton.body_plan)
     return GameSkeleton(game, tuple(owner + 1 for owner in bones.owners(len(skeleton))))
@@ -479,13 +480,14 @@ def _finger_spans(points, real):
     return list(zip(cuts, cuts[1:]))
 
 
-def _completed_ends(names, heads, tails, parents, roles, places):
+def _completed_ends(names, heads, tails, parents, roles, places, vertices, faced):
     """A humanoid's ``Hand`` on every forearm, ``Foot`` on every shin (``Leg``) and ``Head`` on a ``Neck`` that ends
     without one (fingers forking at the wrist, a leg ending at the ground, a neck bone running into a round head), as
     ``ENDS`` says: from the named wrist (ankle, head joint) in ``places`` when it lies along the bone, which then ends
     there, else from the bone's end; to the hand's reach (the ball of the foot, else its toes' tip; the head's top)
-    when that lies beyond, else on along the bone. The bone's fingers (toes; jaw and ears) hang from it. Game
-    engines' humanoids and mocap need all three."""
+    when that lies beyond, else on along the bone. A foot the mesh shows ahead of the ankle (``core.facing.foot_ahead``,
+    the ``vertices`` and the character's facing ``faced``) runs there instead, to its ball, and a ``ToeBase`` on to
+    its tip. The bone's fingers (toes; jaw and ears) hang from it. Game engines' humanoids and mocap need all three."""
     names, heads, tails, parents, roles = list(names), heads.copy(), tails.copy(), list(parents), list(roles)
     for limb in range(len(names)):
         stem, _, suffix = names[limb].partition("_")  # LeftForeArm, 2
@@ -514,12 +516,20 @@ def _completed_ends(names, heads, tails, parents, roles, places):
                 if point is not None and np.linalg.norm(point - start) > 0.1 * bone_length:
                     finish = np.asarray(point, dtype=np.float64)
                     break
+            foot = foot_ahead(vertices, start, faced, bone_length) if end_word == "Foot" else None
+            if foot is not None:
+                finish = foot[0]
             tails[limb] = start
             names.append(end_name)
             heads, tails = np.vstack([heads, start]), np.vstack([tails, finish])
             end = len(names) - 1
             parents.append(limb)
             roles.append(BoneRole(end_word.lower(), letter))
+            if foot is not None and f"{side_word}ToeBase{'_' + suffix if suffix else ''}" not in names:
+                names.append(f"{side_word}ToeBase{'_' + suffix if suffix else ''}")
+                heads, tails = np.vstack([heads, foot[0]]), np.vstack([tails, foot[1]])
+                parents.append(end)
+                roles.append(BoneRole("toe", letter))
             for child in range(end):
                 if parents[child] == limb and roles[child].role in carried:
                     parents[child] = end

@@ -27,7 +27,7 @@ How the bones are placed, in order:
   joints sit where the mesh bends): a skeleton without a toe gets its foot split at the metarig's ball. A chain
   whose last roles the skeleton lacks goes on to where the mesh ends ahead of it, when the mesh goes on there (an arm
   ending at the wrist gets its hand; a skeleton whose spine ends at the chest gets a neck and a head; a leg ending at
-  the ankle gets its foot forward along the ground, ``_foot_ahead``), else they share
+  the ankle gets its foot forward along the ground, ``core.facing.foot_ahead``), else they share
   the stretch of the last role (a leg whose shin reaches the ground gets its foot and toe from the shin's lower part);
   either way the fit says so.
 - Limbs that Rigify bends with IK (legs, arms, paws): the joint between their first two bones is moved, when it does
@@ -53,7 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .facing import TORSO, facing
+from .facing import TORSO, facing, foot_ahead
 from .polyline import arc_lengths, arc_nearest, point_at
 from .roles import CHAINS, BoneRole, mesh_reach, named_joints, within_reach
 from .tuning import TuningTable, tuned
@@ -93,11 +93,6 @@ class MetarigTuning(TuningTable):
     anchors: int = tuned(8, "a derived bone moves with this many placed joints nearest it in the metarig")
     heel_reach: float = tuned(0.6, "the heel is looked for among the vertices within this many foot lengths of the "
                                    "ankle, across the ground")
-    foot_ahead: float = tuned(2.0, "a foot the skeleton lacks is looked for among the vertices below the ankle up to "
-                                   "this many of its metarig lengths ahead ...")
-    foot_beside: float = tuned(0.5, "... and this many beside it; ...")
-    foot_least: float = tuned(0.25, "... none when they reach less than this many ahead (a leg ending on a stump)")
-    ball_at: float = tuned(0.7, "such a foot's ball lies this share of the way from the ankle to the tip")
     side_piece: float = tuned(0.5, "of a side's pieces of a limb's roles, those at least this share of the longest's "
                                    "length compete, the farthest out winning (a stub off a leg is no leg)")
 
@@ -356,7 +351,7 @@ class _Body:
         self.head_node, self.tail_node = self.node[:count], self.node[count:]
         self.points = np.zeros((self.node.max() + 1, 3))
         self.points[self.node] = ends
-        faced = facing(skeleton, self.points, self.head_node, self.tail_node)
+        self.faced = faced = facing(skeleton, self.points, self.head_node, self.tail_node)
         self.up, self.centre = faced.up, faced.centre
         self.frame = np.column_stack([faced.left, -faced.front, faced.up])
         self.side_map = {"L": faced.side("L"), "R": faced.side("R"), None: None}
@@ -553,7 +548,7 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None, 
         wanted = scale * lengths[missing:].sum()
         direction = points[-1] - points[-2]
         direction = direction / max(np.linalg.norm(direction), 1e-300)
-        foot = _foot_ahead(body, points[-1], wanted, tuning) if groups[missing][0] == "foot" else None
+        foot = foot_ahead(body.vertices, points[-1], body.faced, wanted) if groups[missing][0] == "foot" else None
         if foot is not None:  # a leg ending at the ankle: its foot runs forward on the ground, not on down the shin
             extended = True
             points = np.vstack([points, foot])
@@ -577,20 +572,6 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None, 
         if joint is not None and within_reach(placed[k], joint, beside):
             placed[k] = joint
     return body.local(placed)
-
-
-def _foot_ahead(body, ankle, length, tuning):
-    """(ball, tip) of a foot the skeleton lacks, from the mesh's vertices below the ``ankle`` and ahead of it (within
-    ``foot_ahead`` and ``foot_beside`` of the foot's metarig ``length``): the tip where they reach farthest ahead, on
-    their lowest level, the ball ``ball_at`` of the way there. None when they reach less than ``foot_least`` ahead."""
-    local = body.local(body.vertices) - body.local(ankle)  # the metarig's frame: left, back (-front), up
-    near = (local[:, 2] < 0) & (local[:, 1] <= 0) & (local[:, 1] >= -tuning.foot_ahead * length) & (
-        np.abs(local[:, 0]) <= tuning.foot_beside * length)
-    if not near.any() or -local[near, 1].min() < tuning.foot_least * length:
-        return None
-    ground, ahead = local[near, 2].min(), local[near, 1].min()
-    return np.vstack([ankle + body.frame @ np.array([0.0, tuning.ball_at * ahead, ground]),
-                      ankle + body.frame @ np.array([0.0, ahead, ground])])
 
 
 def _next_role(role):
