@@ -148,10 +148,13 @@ def _run_methods(args):
 
         print("body plan and bone roles (after every method):")
         _print_tuning(BodyPlanTuning)
+        from .core.facing import FootTuning
         from .core.metarig import MetarigTuning
 
         print("the rigify target's metarig fitting:")
         _print_tuning(MetarigTuning)
+        print("feet the skeleton lacks (the rigify and game targets):")
+        _print_tuning(FootTuning)
     for where, error in registry.failures.items():
         print(f"failed to load {where}: {error}", file=sys.stderr)
     return 0

@@ -337,6 +337,7 @@ def test_methods_lists_every_method_and_its_parameters():
     tuned = run("methods", "--tuning")
     assert tuned.returncode == 0 and "tuning (rigger.methods.silhouette.tuning." in tuned.stdout
     assert "body plan and bone roles (after every method):" in tuned.stdout and "knee_at = " in tuned.stdout
+    assert "[rigger.core.metarig.MetarigTuning]" in tuned.stdout and "[rigger.core.facing.FootTuning]" in tuned.stdout
 
 
 def test_ctrl_c_is_one_line_and_the_shell_s_status(monkeypatch, capsys, tmp_path):
