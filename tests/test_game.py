@@ -128,6 +128,19 @@ def test_a_foot_the_skeleton_lacks_runs_forward_along_the_ground():
         assert bones.tails[toe][1] - ground <= 0.01 * size  # ... on the ground
 
 
+def test_the_spine_ends_on_the_midline_where_the_neck_begins():
+    """rignet_8333's shoulders begin at their named joints, off the midline: moving a shoulder's head there also moved
+    the end of ``Spine2``, which all of them start from, so the spine ended 2.6% of the size off the midline, at one
+    shoulder, and the neck began elsewhere."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_8333", "rignet_8333.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    plane, size = skeleton.stages["mirror_plane"], float(np.ptp(vertices, axis=0).max())
+    end = bones.tails[bones.names.index("Spine2")]
+    assert abs(end[plane.axis] - plane.offset) <= 1e-9 * size
+    np.testing.assert_allclose(end, bones.heads[bones.names.index("Neck")], atol=1e-9 * size)
+
+
 def test_a_plan_the_game_target_cannot_fill_falls_back_to_plain_saying_why():
     vertices, triangles = load_character("octopus")
     plan = rigger.rig_mesh(vertices, triangles).body_plan

@@ -406,8 +406,9 @@ class _Bones:
                         bone["suffix"] = f"_{count}"
 
     def at_named_joints(self, tolerance):
-        """Move the head of each first bone of a Mixamo name to its role's named joint, with the bones ending there
-        (siblings starting there have joints of their own), when it is within reach (``core.roles.within_reach``)."""
+        """Move the head of each first bone of a Mixamo name to its role's named joint, with the bones of its side
+        ending there (siblings starting there have joints of their own; a sided branch off a midline bone leaves that
+        bone's end on the midline), when it is within reach (``core.roles.within_reach``)."""
         for bone in self.bones:
             role = bone["role"]
             key = (role.role, role.side, None)
@@ -419,7 +420,8 @@ class _Bones:
                 continue
             bone["head"] = new.copy()
             for other in ending:
-                other["tail"] = new.copy()
+                if other["side"] == bone["side"]:  # a shoulder's joint off the midline leaves the spine's end there
+                    other["tail"] = new.copy()
 
     def finished(self, arriving):
         """(names, heads, tails, parents, roles): each bone hangs from the game bone holding the joint its chain
