@@ -392,17 +392,16 @@ def _quadruped_spine(body, rows, legs, lengths, tuning):
 
 
 def _head_score(body, spine, legs, lengths, tuning):
-    """How much the last end of ``spine`` looks like a head: limbs (not legs) hanging near it, higher, thicker. Height
-    outweighs thickness, which only decides between ends as high: the spine may end in a thin neck before a big head
-    (a crocodile's) while the rump is wide."""
+    """How much the last end of ``spine`` looks like a head, compared in this order: limbs (not legs) hanging near
+    it, higher, thicker. Thickness only decides between ends as high: the spine may end in a thin neck before a big
+    head (a crocodile's) while the rump is wide."""
     points = body.graph.points
     arc = arc_lengths(points[spine])
     near = arc >= arc[-1] * (1 - tuning.end_part)
-    score = 4 * sum(1 for k in range(len(body.limbs)) if k not in legs and lengths[k] >= tuning.min_limb * body.size
-                    and body.bases[k] in spine and near[spine.index(body.bases[k])])
-    score += 2 * (body.height(points[spine[-1]]) > body.height(points[spine[0]]))
+    limbs = sum(1 for k in range(len(body.limbs)) if k not in legs and lengths[k] >= tuning.min_limb * body.size
+                and body.bases[k] in spine and near[spine.index(body.bases[k])])
     thickness = _end_thickness(body, spine, tuning)
-    return score + (thickness[1] > thickness[0])
+    return limbs, body.height(points[spine[-1]]) > body.height(points[spine[0]]), thickness[1] > thickness[0]
 
 
 def _end_thickness(body, spine, tuning):
