@@ -890,3 +890,29 @@ def test_a_limb_from_another_view_does_not_hang_from_a_leg_s_bone_across():
     assert len(across) == 2 and len([b for b in range(first) if parents[b] in across]) == 2
     ear_roots = [bone for bone in range(first, len(parents)) if parents[bone] < first]
     assert ear_roots and all(builder.chain_of_bone[parents[bone]] == 0 for bone in ear_roots)
+
+
+def _hangs_from_its_own_side_or_the_middle(skeleton):
+    sides = [name[-2:] if name.endswith((".L", ".R")) else "" for name in skeleton.names]
+    assert sides[int(skeleton.roots[0])] == ""  # the root is on the middle, not one twin
+    for bone, parent in enumerate(skeleton.parents):
+        if parent >= 0 and sides[bone]:
+            assert sides[parent] in ("", sides[bone]), (skeleton.names[bone], skeleton.names[parent])
+
+
+def test_an_octopus_s_arms_hang_from_its_body_not_from_one_arm(default_rig):
+    """Seen from above, every chain leaving the octopus's middle is an arm off the mirror plane. The first arm used to
+    be the root and carry the other seven; now a chain on the plane is the body they all hang from."""
+    _, _, skeleton = default_rig("octopus")
+    _hangs_from_its_own_side_or_the_middle(skeleton)
+
+
+def test_a_penguin_whose_axis_is_a_fan_gets_a_body_and_head_and_its_flippers_hang_from_them():
+    """rignet_8184's round body prunes to a fan: only the flippers leave its middle. The right flipper was the root
+    and carried the left one, and no bone reached the head. Now a chain runs up the mirror plane to the crown."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_8184", "rignet_8184.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    _hangs_from_its_own_side_or_the_middle(skeleton)
+    top = vertices[:, 1].max()  # Y up
+    assert skeleton.tails[:, 1].max() > top - 0.05 * np.ptp(vertices[:, 1])
+    assert skeleton.body_plan.kind == "bird"

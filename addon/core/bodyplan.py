@@ -13,9 +13,10 @@ The rules, in order (``Body`` gives the up axis, the mirror plane, the spine and
   arms (a hunched monster); a bird when it leans forward with flat wings (``wing_flat``) or no arms; arms hang
   above the hips, else from the hips reaching out or up (``_chest``);
 - without legs: one pair of long limbs on a small body is a bird in flight (wings); an upright body with long limbs
-  high on it is a humanoid without legs; a long body lying down (the mesh lower than it is long) whose limbs are
-  short beside it (fins, or none) and that tapers, curves or has fins is a fish or a serpent (not a plain log or
-  column); anything else is ``other``.
+  high on it is a humanoid without legs; else a body with one pair of limbs ``wing_ratio`` times its length is a
+  bird (a penguin); a long body lying down (the mesh lower than it is long) whose limbs are short beside it (fins,
+  or none) and that tapers, curves or has fins is a fish or a serpent (not a plain log or column); anything else is
+  ``other``.
 
 Recognition also places the named joints along the chains (``core.roles``: a knee between bone ends where the
 artists' rigs have it) and keeps them in ``BodyPlan.joints``.
@@ -58,6 +59,8 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
                                      "no plan (a bird's body leans about 90)")
     long_limb: float = tuned(0.2, "limbs at least this long are arms, wings or legs; shorter ones ears, fins or stubs")
     small_body: float = tuned(0.25, "a spine shorter than this is a small body (a bat's, between its wings)")
+    wing_ratio: float = tuned(1.3, "so is one not upright with arms high on it whose one pair of long limbs is this "
+                                   "many times longer (a penguin's body and head between its flippers)")
     many_limbs: int = tuned(6, "this many long limbs off the plane besides the legs are no known plan (an "
                                "octopus; a humanoid has two arms and maybe two long ears)")
     fish_body: float = tuned(0.45, "a legless body with a spine at least this long may be a fish or a serpent")
@@ -218,22 +221,21 @@ def _legless(body, parts, front, lengths, long_pairs, spine_length, forward, con
     spine = list(body.spine)
     ends = graph.points[[spine[0], spine[-1]]]
     rise = _angle_from_up(body, ends[1] - ends[0]) if spine_length > 0 else 90.0
+    longest_pair = max(long_pairs, key=lambda pair: max(lengths[k] for k in pair), default=())
     if long_pairs and spine_length < tuning.small_body * size:
-        for k in max(long_pairs, key=lambda pair: max(lengths[k] for k in pair)):
-            parts[k] = "wing"
-        spine = _upward(body, spine)
-        _name_parts(body, parts, lengths, spine, -1, 0, "bird", tuning)
-        return _layout(body, "bird", confidence * (0.8 if len(long_pairs) == 1 else 0.65),
-                       "a pair of long limbs on a small body: wings, no legs", parts, front, spine, -1, 0, forward)
-    if long_pairs and min(rise, 180 - rise) < tuning.upright and spine_length >= tuning.small_body * size:
-        spine = _upward(body, spine)
-        attach = [spine.index(body.bases[k]) / max(len(spine) - 1, 1) for pair in long_pairs for k in pair
-                  if body.bases[k] in spine]
+        return _flying(body, parts, front, lengths, long_pairs, longest_pair, spine, forward, confidence, tuning)
+    if long_pairs and min(rise, 180 - rise) < tuning.upright:
+        upward = _upward(body, spine)
+        attach = [upward.index(body.bases[k]) / max(len(upward) - 1, 1) for pair in long_pairs for k in pair
+                  if body.bases[k] in upward]
         if attach and max(attach) >= 0.5:
-            chest = _chest(body, spine, 0, [], lengths, tuning)
-            _name_parts(body, parts, lengths, spine, 0, chest, "humanoid", tuning)
+            chest = _chest(body, upward, 0, [], lengths, tuning)
+            _name_parts(body, parts, lengths, upward, 0, chest, "humanoid", tuning)
             return _layout(body, "humanoid", confidence * 0.7, "an upright body with arms high on it, no legs",
-                           parts, front, spine, 0, chest, forward)
+                           parts, front, upward, 0, chest, forward)
+    if len(long_pairs) == 1 and len(longest_pair) == 2 and \
+            spine_length * tuning.wing_ratio <= min(lengths[k] for k in longest_pair):
+        return _flying(body, parts, front, lengths, long_pairs, longest_pair, spine, forward, confidence, tuning)
     longest = max(lengths, default=0.0)
     if spine_length >= tuning.fish_body * size and rise >= tuning.lying and 180 - rise >= tuning.lying \
             and longest < tuning.fin_share * spine_length and body.high - body.low <= tuning.low_body * spine_length:
@@ -251,6 +253,16 @@ def _legless(body, parts, front, lengths, long_pairs, spine_length, forward, con
         return _other(body, parts, "one long body without fins that neither tapers nor curves (a log or a column)",
                       confidence)
     return _other(body, parts, _legless_reason(long_pairs, spine_length, size), confidence)
+
+
+def _flying(body, parts, front, lengths, long_pairs, wings, spine, forward, confidence, tuning):
+    """The layout of a bird in flight: the pair ``wings`` on the spine, named from its lower end."""
+    for k in wings:
+        parts[k] = "wing"
+    spine = _upward(body, spine)
+    _name_parts(body, parts, lengths, spine, -1, 0, "bird", tuning)
+    return _layout(body, "bird", confidence * (0.8 if len(long_pairs) == 1 else 0.65),
+                   "a pair of long limbs on a small body: wings, no legs", parts, front, spine, -1, 0, forward)
 
 
 def _legless_reason(long_pairs, spine_length, size):

@@ -152,7 +152,7 @@ def _bones(sil, islands, other_views, rules, symmetry, exact=True):
         if isinstance(placed, Blob):
             builder.add_blob(sil, placed.point, placed.radius)
         else:
-            builder.add_island(placed.root_point, placed.chains)
+            builder.add_island(placed.root_point, placed.chains, sil)
     for view_of in other_views:
         builder.add_limbs(hidden_limbs(sil, view_of, builder.lines, rules), (sil, view_of.sil))
     return builder

@@ -6,7 +6,7 @@ from ...core.graphs import components
 from ...core.joints import chain_joints, symmetric_joints
 from ...core.mirror import mirror_chain_pairs, mirror_completed
 from ...core.naming import bone_names
-from ...core.polyline import nearest_on_segments
+from ...core.polyline import arc_lengths, nearest_on_segments, point_at, segment_distances
 from .depth import is_across
 
 
@@ -25,15 +25,18 @@ class BoneBuilder:
         self.lines = []  # one polyline per chain, indexed by chain number
         self.across = set()  # the bones across the depth (``depth.is_across``): a leg's, no limb hangs from them
 
-    def add_island(self, root_point, placed):
+    def add_island(self, root_point, placed, sil=None):
         """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk, the
         widest on the mirror plane when one leaves it there (a spine, not an arm, carries the body). Across a plane,
-        a chain on it never hangs from a chain off it (``_on_plane_parents``), and across the mesh's own plane twins
-        that leave the middle leave it together (``_twins_together``)."""
+        a chain on it never hangs from a chain off it (``_on_plane_parents``), across the mesh's own plane twins
+        that leave the middle leave it together (``_twins_together``), and when only twins leave a root on the
+        plane, the body gets a chain on the plane for them to hang from (``_stem``, with the island's view ``sil``)."""
         if self.symmetry is not None:
             placed = self._on_plane_parents(placed)
             if self.exact:
                 placed = self._twins_together(placed)
+            if sil is not None:
+                placed = self._stem(root_point, placed, sil)
         roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
         on_plane = {i: self.symmetry is not None and self.symmetry.side(placed[i][0]) == 0 for i in roots}
         trunk = max(roots, key=lambda i: (on_plane[i], placed[i][2].mean()))
@@ -91,6 +94,42 @@ class BoneBuilder:
             line, _, widths = placed[far]
             moved[far] = (np.vstack([start, line[1:]]), placed[near][1], widths)
         return moved
+
+    def _stem(self, root_point, placed, sil):
+        """The placed chains with a body chain first when the root lies on the mirror plane and every chain leaving
+        it lies off the plane (a penguin's or a bat's round body whose axis is a fan: only wings and ears survive
+        pruning): the chain runs on the plane from the root, the way the twins leave it on average, to the
+        outline, at the root's depth, so no twin hangs from its twin and the body and head get bones."""
+        roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
+        if self.symmetry.side(root_point[None]) != 0 or any(self._on_plane(placed[i][0]) for i in roots):
+            return placed
+        radius = max(placed[i][2][0] for i in roots)
+        away = np.mean([point_at(line, arc_lengths(line), radius) - root_point  # where each leaves the root's disc
+                        for line, _, _ in (placed[i] for i in roots)], axis=0)
+        axis = self.symmetry.plane[0]
+        along = np.cross(np.eye(3)[axis], sil.direction)  # the plane's line in the view
+        if np.linalg.norm(along) < 1e-9:
+            return placed  # the view looks across the plane's normal: the plane is the whole view, no fan to see
+        along = along / np.linalg.norm(along) * (1.0 if along @ away >= 0 else -1.0)
+        start, depth = sil.project(root_point[None])
+        step = sil.project(root_point[None] + sil.cell * along[None])[0] - start
+        count = int(np.ceil(np.ptp(np.concatenate(sil.loops), axis=0).max() / sil.cell)) + 1  # across the outline
+        line2d = start + np.arange(count + 1)[:, None] * step
+        front, _ = sil.depth(line2d)
+        outside = np.flatnonzero(np.isnan(front))
+        end = outside[0] if len(outside) else len(line2d)
+        if end < 2:
+            return placed
+        line = sil.lift(line2d[:end], depth[0])
+        flat = np.c_[line2d[:end], np.zeros(end)]  # the outline's distance: the body's half-width, as on the axis
+        outline = [np.c_[loop, np.zeros(len(loop))] for loop in sil.loops]
+        starts = np.concatenate(outline)
+        ends = np.concatenate([np.roll(loop, -1, axis=0) for loop in outline])
+        widths = np.concatenate([segment_distances(flat[k:k + 64], starts, ends).min(axis=1)
+                                 for k in range(0, end, 64)])  # in blocks: a fine outline has many segments
+        widths[0] = radius
+        return [(line, -1, widths)] + [(line_, parent + 1 if parent >= 0 else -1, widths_)
+                                       for line_, parent, widths_ in placed]
 
     def add_limbs(self, limbs, views):
         """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone already there that their
