@@ -916,3 +916,16 @@ def test_a_penguin_whose_axis_is_a_fan_gets_a_body_and_head_and_its_flippers_han
     top = vertices[:, 1].max()  # Y up
     assert skeleton.tails[:, 1].max() > top - 0.05 * np.ptp(vertices[:, 1])
     assert skeleton.body_plan.kind == "bird"
+
+
+def test_a_bat_s_ears_hang_from_its_head_and_its_wings_from_its_body():
+    """rignet_2586's round body prunes to a fan too: wings and ears all leave its middle. Each pair now leaves the
+    body chain level with where it leaves the middle's disc, so turning the head carries the ears."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_2586", "rignet_2586.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    _hangs_from_its_own_side_or_the_middle(skeleton)
+    firsts = [bone for bone, parent in enumerate(skeleton.parents)
+              if skeleton.names[bone].endswith(".L") and not skeleton.names[parent].endswith(".L")]
+    wing, ear = sorted(firsts, key=lambda bone: skeleton.tails[bone, 1])  # Y up: the ears point up
+    assert skeleton.heads[ear, 1] > skeleton.heads[wing, 1] + 0.05 * np.ptp(vertices[:, 1])
+    assert skeleton.parents[ear] != skeleton.parents[wing]

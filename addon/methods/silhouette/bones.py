@@ -99,37 +99,54 @@ class BoneBuilder:
         """The placed chains with a body chain first when the root lies on the mirror plane and every chain leaving
         it lies off the plane (a penguin's or a bat's round body whose axis is a fan: only wings and ears survive
         pruning): the chain runs on the plane from the root, the way the twins leave it on average, to the
-        outline, at the root's depth, so no twin hangs from its twin and the body and head get bones."""
+        outline (``_body_line``). Each twin leaves it level with where it leaves the root's disc (``_levels``),
+        hanging from the body chain's bone there (a bat's ears from its head), so no twin hangs from its twin."""
         roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
         if self.symmetry.side(root_point[None]) != 0 or any(self._on_plane(placed[i][0]) for i in roots):
             return placed
-        radius = max(placed[i][2][0] for i in roots)
-        away = np.mean([point_at(line, arc_lengths(line), radius) - root_point  # where each leaves the root's disc
-                        for line, _, _ in (placed[i] for i in roots)], axis=0)
-        axis = self.symmetry.plane[0]
-        along = np.cross(np.eye(3)[axis], sil.direction)  # the plane's line in the view
+        along = np.cross(np.eye(3)[self.symmetry.plane[0]], sil.direction)  # the plane's line in the view
         if np.linalg.norm(along) < 1e-9:
-            return placed  # the view looks across the plane's normal: the plane is the whole view, no fan to see
-        along = along / np.linalg.norm(along) * (1.0 if along @ away >= 0 else -1.0)
-        start, depth = sil.project(root_point[None])
-        step = sil.project(root_point[None] + sil.cell * along[None])[0] - start
-        count = int(np.ceil(np.ptp(np.concatenate(sil.loops), axis=0).max() / sil.cell)) + 1  # across the outline
-        line2d = start + np.arange(count + 1)[:, None] * step
-        front, _ = sil.depth(line2d)
-        outside = np.flatnonzero(np.isnan(front))
-        end = outside[0] if len(outside) else len(line2d)
-        if end < 2:
+            return placed  # the view looks along the plane: twins are split in depth, not seen as a fan
+        radius = max(placed[i][2][0] for i in roots)
+        exits = {i: point_at(placed[i][0], arc_lengths(placed[i][0]), radius) for i in roots}  # off the disc
+        away = np.mean([exits[i] - root_point for i in roots], axis=0)
+        along *= (1.0 if along @ away >= 0 else -1.0) / np.linalg.norm(along)
+        line, widths = _body_line(sil, root_point, along, radius)
+        if len(line) < 2:
             return placed
-        line = sil.lift(line2d[:end], depth[0])
-        flat = np.c_[line2d[:end], np.zeros(end)]  # the outline's distance: the body's half-width, as on the axis
-        outline = [np.c_[loop, np.zeros(len(loop))] for loop in sil.loops]
-        starts = np.concatenate(outline)
-        ends = np.concatenate([np.roll(loop, -1, axis=0) for loop in outline])
-        widths = np.concatenate([segment_distances(flat[k:k + 64], starts, ends).min(axis=1)
-                                 for k in range(0, end, 64)])  # in blocks: a fine outline has many segments
-        widths[0] = radius
-        return [(line, -1, widths)] + [(line_, parent + 1 if parent >= 0 else -1, widths_)
-                                       for line_, parent, widths_ in placed]
+        level = self._levels({i: (exits[i] - root_point) @ along for i in roots}, placed, sil.cell, len(line))
+        bounds = [0] + sorted({at for at in level.values() if 0 < at < len(line) - 1}) + [len(line) - 1]
+        pieces = [(line[a:b + 1], k - 1, np.r_[widths[a] if k == 0 else 0.0, widths[a + 1:b + 1]])
+                  for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:]))]
+        moved = []
+        for i, (chain, parent, chain_widths) in enumerate(placed):
+            at = level.get(i, 0)
+            if at == 0:
+                moved.append((chain, parent + len(pieces) if parent >= 0 else -1, chain_widths))
+            else:
+                beyond = arc_lengths(chain) > radius
+                moved.append((np.vstack([line[at], chain[beyond]]), bounds.index(at) - 1,
+                              np.r_[widths[at], chain_widths[beyond]]))
+        return pieces + moved
+
+    def _levels(self, height, placed, cell, count):
+        """Root chain -> the point of the body chain (``count`` points a ``cell`` apart) it leaves from, given how
+        far along it each leaves the root's disc (``height``): twins level at their mean, none closer than the
+        joint spacing to another level or the ends (no stub bones), and all at the root when some leave backwards
+        (a fan open all round, an octopus seen from above: the body chain's way is no body's)."""
+        for pair in mirror_chain_pairs([placed[i][0] for i in height], self.symmetry):
+            twins = [list(height)[k] for k in pair]
+            height.update(dict.fromkeys(twins, np.mean([height[i] for i in twins])))
+        gap = self.cutting.tuning.joint_spacing * self.bone_length / cell
+        if min(height.values()) < -gap * cell:
+            return dict.fromkeys(height, 0)
+        level = {i: int(np.clip(np.rint(h / cell), 0, count - 1)) for i, h in height.items()}
+        kept = 0
+        for at in sorted(set(level.values())):
+            near = kept if at - kept < gap else count - 1 if count - 1 - at < gap else at
+            level.update({i: near for i in level if level[i] == at})
+            kept = near
+        return level
 
     def add_limbs(self, limbs, views):
         """Bones along extra chains, (polyline, half-widths) each, hung from the nearest bone already there that their
@@ -288,3 +305,23 @@ class BoneBuilder:
     def names(self):
         """The bones' names (``bone_names``), mirror-suffixed across the builder's symmetry."""
         return bone_names(self.chain_of_bone, self.index_in_chain, self.lines, self.symmetry)
+
+
+def _body_line(sil, root_point, along, radius):
+    """Points a grid cell apart from ``root_point`` the way ``along`` (in the view ``sil``) to the outline, at the
+    root's depth, and the body's half-width at each: the outline's distance, as on the axis (the root's disc
+    ``radius`` at the first)."""
+    start, depth = sil.project(root_point[None])
+    step = sil.project(root_point[None] + sil.cell * along[None])[0] - start
+    count = int(np.ceil(np.ptp(np.concatenate(sil.loops), axis=0).max() / sil.cell)) + 1  # across the outline
+    line2d = start + np.arange(count + 1)[:, None] * step
+    outside = np.flatnonzero(np.isnan(sil.depth(line2d)[0]))
+    line2d = line2d[:outside[0] if len(outside) else len(line2d)]
+    flat = np.c_[line2d, np.zeros(len(line2d))]
+    outline = [np.c_[loop, np.zeros(len(loop))] for loop in sil.loops]
+    starts = np.concatenate(outline)
+    ends = np.concatenate([np.roll(loop, -1, axis=0) for loop in outline])
+    widths = np.concatenate([segment_distances(flat[k:k + 64], starts, ends).min(axis=1)
+                             for k in range(0, len(flat), 64)] or [np.zeros(0)])  # in blocks: many segments
+    widths[:1] = radius
+    return sil.lift(line2d, depth[0]), widths
