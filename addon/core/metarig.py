@@ -7,7 +7,7 @@ The metarigs (:data:`METARIGS`): a humanoid whose hands show named fingers gets 
 bones a finger), other humanoids ``basic_human``; a quadruped ``basic_quadruped``, the generic one (paws, whose every
 bone the skeleton can place: Rigify's wolf, cat and horse add faces, manes and hooves no skeleton shows), with ears and
 a jaw added as Rigify's horse has them (two-bone simple tentacles on the head) when the skeleton shows them; a bird
-``bird`` (a bird with legs: a bird in flight whose skeleton is two wings has no body to hang a rig from). Fish and
+``bird`` (a bird with legs: Rigify's bird stands on them, and a bird in flight shows none to place). Fish and
 serpents get none (Rigify's shark fits a shark, and a body plan cannot tell it from a snake).
 
 How the bones are placed, in order:
