@@ -308,20 +308,29 @@ class BoneBuilder:
 
 
 def _body_line(sil, root_point, along, radius):
-    """Points a grid cell apart from ``root_point`` the way ``along`` (in the view ``sil``) to the outline, at the
-    root's depth, and the body's half-width at each: the outline's distance, as on the axis (the root's disc
-    ``radius`` at the first)."""
+    """Points a grid cell apart from ``root_point`` the way ``along`` (in the view ``sil``), each in the middle of
+    the depth interval holding the one before (a head leaning back), to where none does (the outline, or the edge
+    of an octopus's mantle above its arms); and the body's half-width at each: the outline's distance, as on the
+    axis (the root's disc ``radius`` at the first)."""
     start, depth = sil.project(root_point[None])
     step = sil.project(root_point[None] + sil.cell * along[None])[0] - start
     count = int(np.ceil(np.ptp(np.concatenate(sil.loops), axis=0).max() / sil.cell)) + 1  # across the outline
     line2d = start + np.arange(count + 1)[:, None] * step
-    outside = np.flatnonzero(np.isnan(sil.depth(line2d)[0]))
-    line2d = line2d[:outside[0] if len(outside) else len(line2d)]
+    depths = [float(depth[0])]
+    for layer in sil.layers(line2d[1:]):
+        holding = layer[(layer[:, 0] <= depths[-1]) & (layer[:, 1] >= depths[-1])]
+        if not len(holding):
+            break
+        depths.append(float(holding[0].mean()))
+    line2d = line2d[:len(depths)]
+    reach = max(1, int(radius / sil.cell))  # a part's bumps are no bends of the body: smoothed over its disc
+    padded = np.pad(np.array(depths), reach, mode="edge")
+    depths = np.r_[depth[0], np.convolve(padded, np.full(2 * reach + 1, 1.0 / (2 * reach + 1)), mode="valid")[1:]]
     flat = np.c_[line2d, np.zeros(len(line2d))]
     outline = [np.c_[loop, np.zeros(len(loop))] for loop in sil.loops]
     starts = np.concatenate(outline)
     ends = np.concatenate([np.roll(loop, -1, axis=0) for loop in outline])
     widths = np.concatenate([segment_distances(flat[k:k + 64], starts, ends).min(axis=1)
-                             for k in range(0, len(flat), 64)] or [np.zeros(0)])  # in blocks: many segments
-    widths[:1] = radius
-    return sil.lift(line2d, depth[0]), widths
+                             for k in range(0, len(flat), 64)])  # in blocks: a fine outline has many segments
+    widths[0] = radius
+    return sil.lift(line2d, depths), widths
