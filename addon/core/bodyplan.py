@@ -59,8 +59,8 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
                                      "no plan (a bird's body leans about 90)")
     long_limb: float = tuned(0.2, "limbs at least this long are arms, wings or legs; shorter ones ears, fins or stubs")
     small_body: float = tuned(0.25, "a spine shorter than this is a small body (a bat's, between its wings)")
-    wing_ratio: float = tuned(1.3, "so is one not upright with arms high on it whose one pair of long limbs is this "
-                                   "many times longer (a penguin's body and head between its flippers)")
+    wing_ratio: float = tuned(1.3, "a legless body's one pair of long limbs this many times its spine's length are "
+                                   "wings, unless high on an upright body (a penguin's flippers)")
     many_limbs: int = tuned(6, "this many long limbs off the plane besides the legs are no known plan (an "
                                "octopus; a humanoid has two arms and maybe two long ears)")
     fish_body: float = tuned(0.45, "a legless body with a spine at least this long may be a fish or a serpent")
