@@ -316,6 +316,8 @@ def _body_line(sil, root_point, along, radius):
     step = sil.project(root_point[None] + sil.cell * along[None])[0] - start
     count = int(np.ceil(np.ptp(np.concatenate(sil.loops), axis=0).max() / sil.cell)) + 1  # across the outline
     line2d = start + np.arange(count + 1)[:, None] * step
+    outside = np.flatnonzero(np.isnan(sil.depth(line2d)[0]))  # the outline first: depths are cheaper than layers
+    line2d = line2d[:outside[0] if len(outside) else len(line2d)]
     depths = [float(depth[0])]
     for layer in sil.layers(line2d[1:]):
         holding = layer[(layer[:, 0] <= depths[-1]) & (layer[:, 1] >= depths[-1])]
