@@ -377,14 +377,14 @@ def test_polls_explain_why_an_operator_cannot_run(scene):
 
 
 def test_a_head_on_two_stubs_is_no_humanoid(scene):
-    """Suzanne, Blender's monkey head: its ears and chin read as two legs under a body that leans 110° from up,
-    below its hips. No plan fits that (a humanoid stands up, a bird's body lies level): the rig stays plain and the
-    report says why."""
+    """Suzanne, Blender's monkey head: seen from above, a ball with ears, so a body chain runs from its middle to the
+    back of the head, and features of the face read as two legs under it with the chin for a tail much longer than
+    them. No plan fits that: the rig stays plain and the report says why."""
     bpy.ops.mesh.primitive_monkey_add()
     obj = bpy.context.active_object
     activate(obj)
     result, printed = reports_of(bpy.ops.rigger.rig)
-    assert result == {'FINISHED'} and "below its hips: not a body plan Rigger knows" in printed
+    assert result == {'FINISHED'} and "below its hips farther than they reach: not a body plan Rigger knows" in printed
     assert obj.rigger_armature["rigger_target"] == "plain"
 
 

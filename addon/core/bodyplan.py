@@ -11,7 +11,8 @@ The rules, in order (``Body`` gives the up axis, the mirror plane, the spine and
 - two legs in one row, hanging from ``biped_lift`` or higher, make a biped: a humanoid when its
   torso, from the hips to the spine's upper end, leans less than ``upright`` from up, or leans more but has round
   arms (a hunched monster); a bird when it leans forward with flat wings (``wing_flat``) or no arms; arms hang
-  above the hips, else from the hips reaching out or up (``_chest``);
+  above the hips, else from the hips reaching out or up (``_chest``); none when the body hangs below its hips
+  (``overturned``) or an upright torso runs on below them much farther than the legs reach (``tail_legs``: a head);
 - without legs: one pair of long limbs on a small body is a bird in flight (wings); an upright body with long limbs
   high on it is a humanoid without legs; else a body with one pair of limbs ``wing_ratio`` times its length is a
   bird (a penguin); a long body lying down (the mesh lower than it is long) whose limbs are short beside it (fins,
@@ -57,6 +58,8 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
     upright: float = tuned(45.0, "degrees: a biped whose torso leans less than this from up is a humanoid")
     overturned: float = tuned(100.0, "degrees: a biped whose body leans more than this from up hangs below its hips: "
                                      "no plan (a bird's body leans about 90)")
+    tail_legs: float = tuned(1.3, "an upright biped whose spine runs on below its hips farther than this many times "
+                                  "its legs is no plan (Suzanne's chin read as a tail 1.6; tailed bipeds up to 1.1)")
     long_limb: float = tuned(0.2, "limbs at least this long are arms, wings or legs; shorter ones ears, fins or stubs")
     small_body: float = tuned(0.25, "a spine shorter than this is a small body (a bat's, between its wings)")
     wing_ratio: float = tuned(1.3, "a legless body's one pair of long limbs this many times its spine's length are "
@@ -196,6 +199,10 @@ def lay_out(body, tuning=BodyPlanTuning()):
         if lean > tuning.overturned:
             return _other(body, parts, f"{len(legs)} legs under a body leaning {lean:.0f} degrees, below its hips: "
                                        f"not a body plan Rigger knows", confidence)
+        below = length(body.graph.points[list(spine[:hips + 1])])
+        if lean < tuning.upright and below > tuning.tail_legs * max(lengths[k] for k in legs):
+            return _other(body, parts, f"{len(legs)} legs under an upright torso that runs on below its hips farther "
+                                       f"than they reach: not a body plan Rigger knows", confidence)
         paired = all(limbs[k].twin in legs for k in legs)
         margin = min(1.0, abs(lean - tuning.upright) / tuning.upright)
         chest = _chest(body, spine, hips, legs, lengths, tuning)
