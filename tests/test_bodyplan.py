@@ -555,3 +555,25 @@ def test_bad_settings_and_values_get_a_clear_error():
         skeleton.body_plan = "humanoid"
     with pytest.raises(ValueError, match="one string per point"):
         Labels(np.zeros((2, 3)), ("only one",))
+
+
+def test_how_finely_a_spine_is_cut_does_not_decide_a_legless_plan():
+    """The penguin's flippers leave its spine a third of the way up. Whether they are "arms high on an upright body"
+    is a share of the spine's length, not of its joints: the plan stays a bird with its head cut in one bone. (Turned
+    Z up, as Blender imports it: the plan prefers Z up, so read in the file's frame it lies down.)"""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_8184", "rignet_8184.obj"))
+    vertices = vertices @ np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]).T
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    up = np.asarray(skeleton.body_plan.up)
+    middle = [bone for bone, name in enumerate(skeleton.names) if not name.endswith((".L", ".R"))]
+    last = max(middle, key=lambda bone: skeleton.tails[bone] @ up)
+    merged = skeleton.parents[last]  # the head's last two bones become one
+    assert merged in middle and skeleton.names[merged].rsplit(".", 1)[0] == skeleton.names[last].rsplit(".", 1)[0]
+    keep = [bone for bone in range(len(skeleton)) if bone != last]
+    tails = skeleton.tails.copy()
+    tails[merged] = skeleton.tails[last]
+    index = {bone: k for k, bone in enumerate(keep)}
+    coarser = Skeleton([skeleton.names[b] for b in keep], skeleton.heads[keep], tails[keep],
+                       [index[skeleton.parents[b]] if skeleton.parents[b] >= 0 else -1 for b in keep])
+    plan, _ = recognise(coarser, (vertices, triangles), plane=skeleton.stages.get("mirror_plane"), prefer_up=up)
+    assert plan.kind == "bird"

@@ -233,7 +233,8 @@ def _legless(body, parts, front, lengths, long_pairs, spine_length, forward, con
         return _flying(body, parts, front, lengths, long_pairs, longest_pair, spine, forward, confidence, tuning)
     if long_pairs and min(rise, 180 - rise) < tuning.upright:
         upward = _upward(body, spine)
-        attach = [upward.index(body.bases[k]) / max(len(upward) - 1, 1) for pair in long_pairs for k in pair
+        arc = arc_lengths(body.graph.points[upward])
+        attach = [arc[upward.index(body.bases[k])] / max(arc[-1], 1e-300) for pair in long_pairs for k in pair
                   if body.bases[k] in upward]
         if attach and max(attach) >= 0.5:
             chest = _chest(body, upward, 0, [], lengths, tuning)
