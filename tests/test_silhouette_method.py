@@ -932,4 +932,25 @@ def test_a_bat_s_ears_hang_from_its_head_and_its_wings_from_its_body():
               if skeleton.names[bone].endswith(".L") and not skeleton.names[parent].endswith(".L")]
     wing, ear = sorted(firsts, key=lambda bone: skeleton.tails[bone, 1])  # Y up: the ears point up
     assert skeleton.heads[ear, 1] > skeleton.heads[wing, 1] + 0.05 * np.ptp(vertices[:, 1])
-    assert skeleton.parents[ear] != skeleton.parents[wing]
+    head = skeleton.parents[ear]  # the head's first bone, starting where the ears do: it carries them
+    np.testing.assert_allclose(skeleton.heads[head], skeleton.heads[ear], atol=1e-9)
+    assert skeleton.parents[wing] != head
+
+
+def test_twins_leave_a_fan_s_body_chain_level_apart_and_all_at_the_root_when_the_fan_opens_all_round():
+    """``_levels``: how far along the body chain each root chain leaves the root's disc becomes a point of the chain,
+    twins at their mean, no two levels (nor a level and the chain's ends) closer than the joint spacing; a chain
+    leaving the other way puts every chain at the root."""
+    builder = bone_builder(0.3, plane=(0, 0.0))
+
+    def chain(x, y):
+        return np.array([[0.0, 0.0, 0.0], [x, y, 0.0], [2 * x, y, 0.0]]), -1, np.full(3, 0.1)
+
+    placed = [chain(1.0, 0.5), chain(-1.0, 0.52), chain(1.0, 1.0), chain(-1.0, 1.0), chain(1.0, 0.56),
+              chain(-1.0, 0.56)]
+    level = builder._levels({0: 0.5, 1: 0.52, 2: 1.0, 3: 1.0, 4: 0.56, 5: 0.56}, placed, 0.01, 201)
+    assert level[0] == level[1] == 51 and level[2] == level[3] == 100  # twins level at their mean
+    assert level[4] == level[5] == 51  # 0.05 above another level: closer than the spacing (0.35 of 0.3)
+    assert builder._levels({0: 0.05, 1: 0.05}, placed, 0.01, 201) == {0: 0, 1: 0}  # next to the root
+    assert builder._levels({0: 1.95, 1: 1.95}, placed, 0.01, 201) == {0: 200, 1: 200}  # next to the end
+    assert set(builder._levels({0: 0.5, 1: 0.5, 2: -0.5, 3: -0.5}, placed, 0.01, 201).values()) == {0}

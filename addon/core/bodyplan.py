@@ -14,10 +14,10 @@ The rules, in order (``Body`` gives the up axis, the mirror plane, the spine and
   above the hips, else from the hips reaching out or up (``_chest``); none when the body hangs below its hips
   (``overturned``) or an upright torso runs on below them much farther than the legs reach (``tail_legs``: a head);
 - without legs: one pair of long limbs on a small body is a bird in flight (wings); an upright body with long limbs
-  high on it is a humanoid without legs; else a body with one pair of limbs ``wing_ratio`` times its length is a
-  bird (a penguin); a long body lying down (the mesh lower than it is long) whose limbs are short beside it (fins,
-  or none) and that tapers, curves or has fins is a fish or a serpent (not a plain log or column); anything else is
-  ``other``.
+  high on it is a humanoid without legs; else a body with one pair of limbs at least ``wing_ratio`` times its
+  length is a bird (a penguin); a long body lying down (the mesh lower than it is long) whose limbs are short
+  beside it (fins, or none) and that tapers, curves or has fins is a fish or a serpent (not a plain log or
+  column); anything else is ``other``.
 
 Recognition also places the named joints along the chains (``core.roles``: a knee between bone ends where the
 artists' rigs have it) and keeps them in ``BodyPlan.joints``.
@@ -230,10 +230,11 @@ def _legless(body, parts, front, lengths, long_pairs, spine_length, forward, con
     rise = _angle_from_up(body, ends[1] - ends[0]) if spine_length > 0 else 90.0
     longest_pair = max(long_pairs, key=lambda pair: max(lengths[k] for k in pair), default=())
     if long_pairs and spine_length < tuning.small_body * size:
-        return _flying(body, parts, front, lengths, long_pairs, longest_pair, spine, forward, confidence, tuning)
+        return _flying(body, parts, front, lengths, long_pairs, longest_pair, spine, forward, confidence, tuning,
+                       "a pair of long limbs on a small body: wings, no legs")
     if long_pairs and min(rise, 180 - rise) < tuning.upright:
         upward = _upward(body, spine)
-        arc = arc_lengths(body.graph.points[upward])
+        arc = arc_lengths(graph.points[upward])
         attach = [arc[upward.index(body.bases[k])] / max(arc[-1], 1e-300) for pair in long_pairs for k in pair
                   if body.bases[k] in upward]
         if attach and max(attach) >= 0.5:
@@ -243,7 +244,8 @@ def _legless(body, parts, front, lengths, long_pairs, spine_length, forward, con
                            parts, front, upward, 0, chest, forward)
     if len(long_pairs) == 1 and len(longest_pair) == 2 and \
             spine_length * tuning.wing_ratio <= min(lengths[k] for k in longest_pair):
-        return _flying(body, parts, front, lengths, long_pairs, longest_pair, spine, forward, confidence, tuning)
+        return _flying(body, parts, front, lengths, long_pairs, longest_pair, spine, forward, confidence, tuning,
+                       f"a pair of limbs at least {tuning.wing_ratio:g} times the spine's length: wings, no legs")
     longest = max(lengths, default=0.0)
     if spine_length >= tuning.fish_body * size and rise >= tuning.lying and 180 - rise >= tuning.lying \
             and longest < tuning.fin_share * spine_length and body.high - body.low <= tuning.low_body * spine_length:
@@ -263,20 +265,21 @@ def _legless(body, parts, front, lengths, long_pairs, spine_length, forward, con
     return _other(body, parts, _legless_reason(long_pairs, spine_length, size), confidence)
 
 
-def _flying(body, parts, front, lengths, long_pairs, wings, spine, forward, confidence, tuning):
+def _flying(body, parts, front, lengths, long_pairs, wings, spine, forward, confidence, tuning, reason):
     """The layout of a bird in flight: the pair ``wings`` on the spine, named from its lower end."""
     for k in wings:
         parts[k] = "wing"
     spine = _upward(body, spine)
     _name_parts(body, parts, lengths, spine, -1, 0, "bird", tuning)
-    return _layout(body, "bird", confidence * (0.8 if len(long_pairs) == 1 else 0.65),
-                   "a pair of long limbs on a small body: wings, no legs", parts, front, spine, -1, 0, forward)
+    return _layout(body, "bird", confidence * (0.8 if len(long_pairs) == 1 else 0.65), reason, parts, front, spine,
+                   -1, 0, forward)
 
 
 def _legless_reason(long_pairs, spine_length, size):
     if not long_pairs:
         return f"no legs, no long limbs and a body {spine_length / size:.2f} of the size long: no known plan"
-    return f"no legs, {len(long_pairs)} pair(s) of long limbs: not wings on a small body nor arms on an upright one"
+    return (f"no legs, {len(long_pairs)} pair(s) of long limbs: not wings (on a small body, or one pair much longer "
+            f"than it) nor arms high on an upright body")
 
 
 # Legs and where they stand.

@@ -29,14 +29,16 @@ class BoneBuilder:
         """Bones along the placed chains of one island; the widest chain leaving the root becomes its trunk, the
         widest on the mirror plane when one leaves it there (a spine, not an arm, carries the body). Across a plane,
         a chain on it never hangs from a chain off it (``_on_plane_parents``), across the mesh's own plane twins
-        that leave the middle leave it together (``_twins_together``), and when only twins leave a root on the
-        plane, the body gets a chain on the plane for them to hang from (``_stem``, with the island's view ``sil``)."""
+        that leave the middle leave it together (``_twins_together``), and when every chain leaving a root on the
+        mesh's plane lies off it, the body gets a chain on the plane for them to hang from (``_stem``, with the
+        island's view ``sil``)."""
+        from_start = set()  # chains hanging from their parent chain's first bone (by default: from its last)
         if self.symmetry is not None:
             placed = self._on_plane_parents(placed)
             if self.exact:
                 placed = self._twins_together(placed)
-            if sil is not None:
-                placed = self._stem(root_point, placed, sil)
+                if sil is not None:
+                    placed, from_start = self._stem(root_point, placed, sil)
         roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
         on_plane = {i: self.symmetry is not None and self.symmetry.side(placed[i][0]) == 0 for i in roots}
         trunk = max(roots, key=lambda i: (on_plane[i], placed[i][2].mean()))
@@ -49,7 +51,7 @@ class BoneBuilder:
         for i in order:
             line, parent, _ = placed[i]
             if parent >= 0:
-                up = last_bone[parent]
+                up = (first_bone if i in from_start else last_bone)[parent]
             elif i == trunk:
                 up = attach
             else:
@@ -96,54 +98,61 @@ class BoneBuilder:
         return moved
 
     def _stem(self, root_point, placed, sil):
-        """The placed chains with a body chain first when the root lies on the mirror plane and every chain leaving
-        it lies off the plane (a penguin's or a bat's round body whose axis is a fan: only wings and ears survive
-        pruning): the chain runs on the plane from the root, the way the twins leave it on average, to the
-        outline (``_body_line``). Each twin leaves it level with where it leaves the root's disc (``_levels``),
-        hanging from the body chain's bone there (a bat's ears from its head), so no twin hangs from its twin."""
+        """(placed chains, the ones among them that hang from their parent chain's first bone): with a body chain
+        first when the root lies on the mirror plane and every chain leaving it lies off the plane (a penguin's or a
+        bat's round body whose axis is a fan: only wings and ears survive pruning). The chain runs on the plane from
+        the root, the way those chains leave it on average, to the outline (``_body_line``), in pieces: each pair of
+        twins leaves it level with where the pair leaves the root's disc (``_levels``), from the first bone of the
+        piece that starts there (a bat's ears turn with its head), so no twin hangs from its twin."""
         roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
         if self.symmetry.side(root_point[None]) != 0 or any(self._on_plane(placed[i][0]) for i in roots):
-            return placed
+            return placed, set()
         along = np.cross(np.eye(3)[self.symmetry.plane[0]], sil.direction)  # the plane's line in the view
         if np.linalg.norm(along) < 1e-9:
-            return placed  # the view looks along the plane: twins are split in depth, not seen as a fan
+            return placed, set()  # the view looks straight across the plane: it sees no line of it
         radius = max(placed[i][2][0] for i in roots)
         exits = {i: point_at(placed[i][0], arc_lengths(placed[i][0]), radius) for i in roots}  # off the disc
         away = np.mean([exits[i] - root_point for i in roots], axis=0)
         along *= (1.0 if along @ away >= 0 else -1.0) / np.linalg.norm(along)
         line, widths = _body_line(sil, root_point, along, radius)
         if len(line) < 2:
-            return placed
+            return placed, set()
         level = self._levels({i: (exits[i] - root_point) @ along for i in roots}, placed, sil.cell, len(line))
         bounds = [0] + sorted({at for at in level.values() if 0 < at < len(line) - 1}) + [len(line) - 1]
-        pieces = [(line[a:b + 1], k - 1, np.r_[widths[a] if k == 0 else 0.0, widths[a + 1:b + 1]])
-                  for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:]))]
-        moved = []
+        pieces = [(line[a:b + 1], k - 1, np.r_[widths[a] if k == 0 else 0.0, widths[a + 1:b + 1]])  # 0: no disc
+                  for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:]))]                        # to leave
+        moved, from_start = [], set()
         for i, (chain, parent, chain_widths) in enumerate(placed):
             at = level.get(i, 0)
             if at == 0:
                 moved.append((chain, parent + len(pieces) if parent >= 0 else -1, chain_widths))
-            else:
-                beyond = arc_lengths(chain) > radius
-                moved.append((np.vstack([line[at], chain[beyond]]), bounds.index(at) - 1,
-                              np.r_[widths[at], chain_widths[beyond]]))
-        return pieces + moved
+                continue
+            beyond = arc_lengths(chain) > radius
+            beyond[-1] = True  # a chain ending within the disc keeps its tip
+            piece = bounds.index(at)  # the piece starting there (the last one, ending there, at the outline)
+            if piece < len(pieces):
+                from_start.add(len(pieces) + i)
+            moved.append((np.vstack([line[at], chain[beyond]]), min(piece, len(pieces) - 1),
+                          np.r_[widths[at], chain_widths[beyond]]))
+        return pieces + moved, from_start
 
-    def _levels(self, height, placed, cell, count):
+    def _levels(self, along_line, placed, cell, count):
         """Root chain -> the point of the body chain (``count`` points a ``cell`` apart) it leaves from, given how
-        far along it each leaves the root's disc (``height``): twins level at their mean, none closer than the
-        joint spacing to another level or the ends (no stub bones), and all at the root when some leave backwards
-        (a fan open all round, an octopus seen from above: the body chain's way is no body's)."""
-        for pair in mirror_chain_pairs([placed[i][0] for i in height], self.symmetry):
-            twins = [list(height)[k] for k in pair]
-            height.update(dict.fromkeys(twins, np.mean([height[i] for i in twins])))
-        gap = self.cutting.tuning.joint_spacing * self.bone_length / cell
-        if min(height.values()) < -gap * cell:
-            return dict.fromkeys(height, 0)
-        level = {i: int(np.clip(np.rint(h / cell), 0, count - 1)) for i, h in height.items()}
+        far along that chain each leaves the root's disc (``along_line``): twins level at their mean, none closer
+        than the joint spacing to another level or the ends (no stub bones), and all at the root when some leave
+        the other way (a fan open all round, an octopus seen from above: the body chain's way is no body's)."""
+        chains = list(along_line)
+        along_line = dict(along_line)
+        for pair in mirror_chain_pairs([placed[i][0] for i in chains], self.symmetry):
+            twins = [chains[k] for k in pair]
+            along_line.update(dict.fromkeys(twins, np.mean([along_line[i] for i in twins])))
+        least = self.cutting.tuning.joint_spacing * self.bone_length
+        if min(along_line.values()) < -least:
+            return dict.fromkeys(chains, 0)
+        level = {i: int(np.clip(np.rint(at / cell), 0, count - 1)) for i, at in along_line.items()}
         kept = 0
         for at in sorted(set(level.values())):
-            near = kept if at - kept < gap else count - 1 if count - 1 - at < gap else at
+            near = kept if (at - kept) * cell < least else count - 1 if (count - 1 - at) * cell < least else at
             level.update({i: near for i in level if level[i] == at})
             kept = near
         return level
@@ -314,10 +323,10 @@ def _body_line(sil, root_point, along, radius):
     axis (the root's disc ``radius`` at the first)."""
     start, depth = sil.project(root_point[None])
     step = sil.project(root_point[None] + sil.cell * along[None])[0] - start
-    count = int(np.ceil(np.ptp(np.concatenate(sil.loops), axis=0).max() / sil.cell)) + 1  # across the outline
+    count = int(np.ceil(np.ptp(np.concatenate(sil.loops), axis=0).max() / sil.cell))  # across the outline
     line2d = start + np.arange(count + 1)[:, None] * step
-    outside = np.flatnonzero(np.isnan(sil.depth(line2d)[0]))  # the outline first: depths are cheaper than layers
-    line2d = line2d[:outside[0] if len(outside) else len(line2d)]
+    outside = np.flatnonzero(np.isnan(sil.depth(line2d[1:])[0])) + 1  # the outline first (depths are cheaper than
+    line2d = line2d[:outside[0] if len(outside) else len(line2d)]      # layers); the root is inside
     depths = [float(depth[0])]
     for layer in sil.layers(line2d[1:]):
         holding = layer[(layer[:, 0] <= depths[-1]) & (layer[:, 1] >= depths[-1])]
