@@ -954,3 +954,18 @@ def test_twins_leave_a_fan_s_body_chain_level_apart_and_all_at_the_root_when_the
     assert builder._levels({0: 0.05, 1: 0.05}, placed, 0.01, 201) == {0: 0, 1: 0}  # next to the root
     assert builder._levels({0: 1.95, 1: 1.95}, placed, 0.01, 201) == {0: 200, 1: 200}  # next to the end
     assert set(builder._levels({0: 0.5, 1: 0.5, 2: -0.5, 3: -0.5}, placed, 0.01, 201).values()) == {0}
+
+
+def test_a_fan_s_body_line_runs_to_the_outline_in_the_middle_of_the_depth_and_stops_at_once_outside():
+    """``_body_line`` in a box 2 wide, 3 tall and 1 deep seen from the front: from the middle up to the top, at the
+    box's middle depth, the half-width 1 (the outline's distance) along it; from a root outside the mesh, no line
+    (one point) rather than an error."""
+    from rigger.methods.silhouette.bones import _body_line
+    from rigger.silhouette import trace
+    vertices, triangles = box((-1, 0, 0), (1, 3, 1))
+    sil = trace(vertices, triangles.astype(np.int32), "Z", resolution=128)
+    line, widths = _body_line(sil, np.array([0.0, 1.0, 0.5]), np.array([0.0, 1.0, 0.0]), 0.3)
+    assert line[-1, 1] == pytest.approx(3.0, abs=2 * sil.cell) and np.allclose(line[:, [0, 2]], [0.0, 0.5])
+    assert widths[0] == 0.3 and np.allclose(widths[1:len(widths) // 2], 1.0, atol=2 * sil.cell)
+    outside, _ = _body_line(sil, np.array([3.0, 1.0, 0.5]), np.array([0.0, 1.0, 0.0]), 0.3)
+    assert len(outside) == 1
