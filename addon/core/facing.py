@@ -72,11 +72,10 @@ class _Reading:
         self.centre = points[np.concatenate([head_node[torso], tail_node[torso]])].mean(axis=0)
 
     def bones_of(self, roles, side):
-        """The bones whose role is in ``roles``, of skeleton side ``side``."""
-        return [bone for bone, role in enumerate(self.roles) if role.role in roles and role.side == side]
+        return role_bones(self.roles, roles, side)
 
     def middle(self, bones):
-        return 0.5 * (self.skeleton.heads[bones] + self.skeleton.tails[bones]).mean(axis=0)
+        return bones_middle(self.skeleton, bones)
 
     def front(self):
         """The character's front across up (the rules in :func:`facing`'s docstring)."""
@@ -116,6 +115,18 @@ class _Reading:
                 ankle = ends[np.argmin([np.linalg.norm(leg_ends - end, axis=1).min() for end in ends])]
                 directions.append(ends[np.argmax(np.linalg.norm(ends - ankle, axis=1))] - ankle)
         return [np.sum(directions, axis=0)] if directions else []
+
+
+def role_bones(bone_roles, roles, side, digit=None):
+    """The bones (of a skeleton whose bones have ``bone_roles``) whose role is in ``roles``, of skeleton side
+    ``side`` (and finger ``digit``)."""
+    return [bone for bone, role in enumerate(bone_roles) if role.role in roles and role.side == side
+            and (digit is None or role.digit == digit)]
+
+
+def bones_middle(skeleton, bones):
+    """The mean of the midpoints of ``skeleton``'s ``bones``."""
+    return 0.5 * (skeleton.heads[bones] + skeleton.tails[bones]).mean(axis=0)
 
 
 def foot_ahead(vertices, ankle, faced, length, tuning=FootTuning()):

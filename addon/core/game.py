@@ -527,8 +527,9 @@ def _completed_ends(names, heads, tails, parents, roles, places, vertices, faced
             end = len(names) - 1
             parents.append(limb)
             roles.append(BoneRole(end_word.lower(), letter))
-            if foot is not None and f"{side_word}ToeBase{'_' + suffix if suffix else ''}" not in names:
-                names.append(f"{side_word}ToeBase{'_' + suffix if suffix else ''}")
+            toe_name = f"{side_word}ToeBase{'_' + suffix if suffix else ''}"
+            if foot is not None and toe_name not in names:
+                names.append(toe_name)
                 heads, tails = np.vstack([heads, foot[0]]), np.vstack([tails, foot[1]])
                 parents.append(end)
                 roles.append(BoneRole("toe", letter))

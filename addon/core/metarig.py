@@ -53,7 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .facing import TORSO, facing, foot_ahead
+from .facing import TORSO, bones_middle, facing, foot_ahead, role_bones
 from .polyline import arc_lengths, arc_nearest, point_at
 from .roles import CHAINS, BoneRole, mesh_reach, named_joints, within_reach
 from .tuning import TuningTable, tuned
@@ -361,12 +361,10 @@ class _Body:
         return np.asarray(points) @ self.frame
 
     def middle(self, bones):
-        return 0.5 * (self.skeleton.heads[bones] + self.skeleton.tails[bones]).mean(axis=0)
+        return bones_middle(self.skeleton, bones)
 
     def bones_of(self, roles, side, digit=None):
-        """The bones whose role is in ``roles``, of skeleton side ``side`` (and finger ``digit``)."""
-        return [bone for bone, role in enumerate(self.roles) if role.role in roles and role.side == side
-                and (digit is None or role.digit == digit)]
+        return role_bones(self.roles, roles, side, digit)
 
     def path(self, bones, order, side):
         """Points (K, 3) of the longest path through ``bones`` and the bone of each step, from the body outwards:
