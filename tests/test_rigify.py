@@ -415,6 +415,31 @@ def test_a_quadruped_gets_rigifys_quadruped_with_paws_tail_and_neck(registered):
     assert (head - hips) @ front > 0  # the rig faces where the head is
 
 
+def test_a_quadruped_s_hind_paws_stay_under_their_legs_and_its_ik_bends_the_knees_forward(registered):
+    """The sample quadruped's hind legs end on stumps that bend back. The fit looked for a foot ahead of the ankle
+    and found the front paw, 1.6 foot lengths ahead: the hind foot ran under the belly to it, and moving the hind
+    paw's IK control towards the hip bent the knee backward."""
+    empty_scene()
+    rig = rig_object(build_character("quadruped"), "silhouette", target="rigify").armature
+    world = rig.matrix_world
+    front = -np.array(world)[:3, 1]
+    for side in ("L", "R"):
+        hip = np.array(world @ rig.data.bones[f"ORG-thigh.{side}"].head_local)
+        knee = np.array(world @ rig.data.bones[f"DEF-shin.{side}"].head_local)
+        toe = np.array(world @ rig.data.bones[f"DEF-toe.{side}"].tail_local)
+        assert abs((toe - knee) @ front) < 0.5 * np.linalg.norm(hip - toe)  # under the leg, not at the front paws
+        control = rig.pose.bones[f"foot_ik.{side}"]
+        saved = control.matrix.copy()
+        try:
+            control.matrix = Matrix.Translation(Vector(0.3 * (hip - np.array(control.head)))) @ control.matrix
+            bpy.context.view_layer.update()
+            moved = np.array(world @ rig.pose.bones[f"DEF-shin.{side}"].head) - knee
+        finally:
+            control.matrix = saved
+            bpy.context.view_layer.update()
+        assert moved @ front > 0.02  # the knee goes forward
+
+
 def test_rigify_is_enabled_when_it_is_not_and_a_clear_error_says_how_when_it_cannot_be(registered, monkeypatch):
     addon_utils.disable("rigify", default_set=True)
     assert not hasattr(bpy.ops.pose, "rigify_generate") or not addon_utils.check("rigify")[1]
