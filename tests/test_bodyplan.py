@@ -81,11 +81,11 @@ def test_rigger_s_humanoid_has_two_legs_two_arms_and_a_head(rigged):
     assert counted(roles)[("head", None)] >= 1 and counted(roles)[("hips", None)] == 1
 
 
-def test_rigger_s_humanoid_with_hands_on_hips_keeps_its_legs_and_head(rigged):
-    """The method joins each hand to the hip it rests on, so an arm runs out from the hips; its legs, upper arms and
-    head are still named."""
+def test_rigger_s_humanoid_with_hands_on_hips_keeps_its_legs_arms_and_head(rigged):
+    """Each hand rests on a hip, closing a loop the method cuts where the hand touches: the arms hang from the
+    shoulders and are named as arms, though they bend down to the hips."""
     roles = rigged["humanoid_hips"].roles
-    assert has_sides(roles, "thigh", "shin", "foot", "upper_arm")
+    assert has_sides(roles, "thigh", "shin", "foot", "upper_arm", "forearm")
     assert counted(roles)[("head", None)] >= 1
 
 

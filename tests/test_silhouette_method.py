@@ -213,6 +213,31 @@ def test_the_hole_between_arm_and_body_is_cut():
     assert list(skeleton.roots) == [0]  # … and the result is still a tree
 
 
+def test_an_arm_resting_on_the_hip_hangs_whole_from_the_shoulder(default_rig):
+    """The hole between a hand on the hip and the body closes a loop, once cut where the ways round from the root
+    met: mid upper arm. The forearm and the elbow then hung from the hips, so raising the upper arm tore the arm
+    open at the cut. The arm tapers to its hand, which is where it touches the body."""
+    vertices, triangles, skeleton = default_rig("humanoid_hips")
+    truth = samples.ground_truth_bones("humanoid_hips")
+    middles = 0.5 * (skeleton.heads + skeleton.tails)
+
+    def nearest_bone(name):
+        k = truth.names.index(name)
+        return int(np.argmin(np.linalg.norm(middles - 0.5 * (truth.heads[k] + truth.tails[k]), axis=1)))
+
+    def ancestors(bone):
+        while bone >= 0:
+            yield bone
+            bone = int(skeleton.parents[bone])
+
+    for side in "LR":
+        upper_arm, forearm, hand = (nearest_bone(f"{part}.{side}") for part in ("upper_arm", "forearm", "hand"))
+        assert upper_arm in set(ancestors(forearm)) and upper_arm in set(ancestors(hand))
+        elbow = truth.tails[truth.names.index(f"upper_arm.{side}")]
+        assert np.linalg.norm(skeleton.joints() - elbow, axis=1).min() < 0.05  # a joint at the elbow
+        assert skeleton.roles[forearm].role == "forearm"
+
+
 @pytest.mark.parametrize("seed", [0, 1])
 def test_same_skeleton_when_moved_rotated_or_scaled(default_rig, seed):
     vertices, triangles, reference = default_rig("humanoid")

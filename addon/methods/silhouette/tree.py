@@ -6,8 +6,8 @@ A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch p
    first, swallows the axis nodes it reaches without leaving its disc, so a round head becomes one node.
 2. Spur pruning (``prune_spurs``): branches that are bumps or outline noise go, repeatedly, since removing one can
    expose another.
-3. Rooting at the most central branch point, then cutting every cycle (holes in the silhouette) where the two ways
-   around it from the root meet, or where two parts touch (``_cut_cycle``).
+3. Rooting at the most central branch point, then cutting every cycle (holes in the silhouette) where two parts
+   touch (``_cut_cycle``).
 """
 from dataclasses import dataclass
 
@@ -363,32 +363,31 @@ def rooted_chains(points, keys, chains, radius, tuning):
         nodes = chains[i] if dist[chains[i][0]] <= dist[chains[i][-1]] else chains[i][::-1]
         chain_of_end[nodes[-1]] = len(ordered)
         ordered.append(Chain(nodes, chain_of_end.get(nodes[0], -1) if nodes[0] != root else -1))
-    # cycles: cut each remaining chain where the ways round from the root meet, or at a contact
+    # cycles: cut each remaining chain where two parts touch
     for i in range(len(chains)):
         if i in tree:
             continue
-        for half in _cut_cycle(chains[i], points, radius, dist, tuning):
+        for half in _cut_cycle(chains[i], points, radius, tuning):
             if len(half) > 1:
                 ordered.append(Chain(half, chain_of_end.get(half[0], -1) if half[0] != root else -1))
     return root, ordered
 
 
-def _cut_cycle(nodes, points, radius, dist, tuning):
-    """The chain ``nodes`` that closes a cycle (a hole in the silhouette), cut into the halves that hang from its
-    two ends (``dist``: each node's distance from the root along the tree): where the ways round from the root meet
-    (an arm whose hand rests on the hip: the arm, and the hip's side up to the hand), or, where the cycle narrows to
-    ``contact`` of its median width, there (two parts touching: a curled tail's tip on the back), keeping the longer
-    half alone (the tail; the shorter is the back's side of the contact, no limb)."""
+def _cut_cycle(nodes, points, radius, tuning):
+    """The chain ``nodes`` that closes a cycle (a hole in the silhouette), cut into the parts that hang from its ends.
+    Where it narrows to ``contact`` of its median width, two parts touch there (a curled tail's tip on the back): it
+    is cut there and the longer half stays alone (the tail; the shorter is the back's side of the contact, no limb).
+    Else it is a limb resting on the body (an arm whose hand rests on the hip), cut where it touches: a limb tapers
+    to its tip, so it hangs whole from the end farther from its narrowest node (the shoulder, not the hip)."""
     inner = radius[nodes[1:-1]]
-    if len(inner) and inner.min() < tuning.contact * np.median(inner):
-        cut = 1 + int(np.argmin(inner))
+    if not len(inner):
+        return [nodes]
+    cut = 1 + int(np.argmin(inner))
+    if inner.min() < tuning.contact * np.median(inner):
         halves = (nodes[:cut + 1], nodes[cut:][::-1])
         return [max(halves, key=lambda half: length(points[half]))]
     steps = arc_lengths(points[nodes])
-    from_start = dist[nodes[0]] + steps
-    from_end = dist[nodes[-1]] + (steps[-1] - steps)
-    cut = int(np.clip(np.searchsorted(from_start - from_end, 0.0), 1, len(nodes) - 1))
-    return [nodes[:cut], nodes[cut:][::-1]]
+    return [nodes[1:][::-1]] if steps[cut] < 0.5 * steps[-1] else [nodes[:-1]]
 
 
 def _root_single_path(chains, keys, radius, tuning):
