@@ -242,6 +242,21 @@ def test_a_humanoid_game_rig_has_hands_and_feet_though_its_limbs_end_without(pat
         assert all(names[bones.parents[k]] == f"{side}Hand" for k in fingers)
 
 
+def test_a_hand_resting_on_the_hip_ends_at_its_fingertips_not_in_the_pelvis():
+    """The hands-on-hips humanoid's arm ends where its hand touches the hip. The mesh on past that end, the hip's,
+    counted as the hand's reach: the arm's roles had no hand, so the game rig's Hand went on from the forearm's end
+    into the pelvis (0.16 off the fingertips) and would weigh the hip."""
+    from rigger import samples
+
+    skeleton, game, _ = rigged("humanoid_hips")
+    assert {role.side for role in skeleton.roles if role.role == "hand"} == {"L", "R"}
+    truth = samples.ground_truth_bones("humanoid_hips")
+    tips = [truth.tails[truth.names.index(f"hand.{side}")] for side in "LR"]
+    for side in ("Left", "Right"):
+        end = game.skeleton.tails[game.skeleton.names.index(f"{side}Hand")]
+        assert min(np.linalg.norm(end - tip) for tip in tips) < 0.05
+
+
 def test_a_neck_running_into_a_round_head_gets_a_head():
     """woody's neck bone runs into the middle of its round head and no bone goes on: the game rig's Head hangs from the
     Neck's end and reaches the top of the head, as Mixamo's do."""

@@ -34,7 +34,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .polyline import arc_lengths
+from .polyline import arc_lengths, segment_distances
 from .stages import Labels, Stage
 from .tuning import TuningTable, tuned
 
@@ -247,8 +247,8 @@ class _TwinPath:
 
     def __init__(self, body, limb):
         nodes = list(limb.main)
-        self.body, self.points, self.radius = body, body.graph.points[nodes], body.radius[nodes]
-        twin = body.limbs[limb.twin] if limb.twin >= 0 else None
+        self.body, self.limb, self.points, self.radius = body, limb, body.graph.points[nodes], body.radius[nodes]
+        self.twin = twin = body.limbs[limb.twin] if limb.twin >= 0 else None
         self.mirrored = twin is not None and len(twin.main) == len(nodes) and body.plane is not None
         if self.mirrored:
             self.points = 0.5 * (self.points + body.plane.reflect(body.graph.points[list(twin.main)]))
@@ -256,8 +256,10 @@ class _TwinPath:
 
     @cached_property
     def reach(self):
-        reach = _reach(self.body, self.points)
-        return 0.5 * (reach + _reach(self.body, self.body.plane.reflect(self.points))) if self.mirrored else reach
+        reach = _reach(self.body, self.points, self.limb)
+        if not self.mirrored:
+            return reach
+        return 0.5 * (reach + _reach(self.body, self.body.plane.reflect(self.points), self.twin))
 
 
 def _paths(limb):
@@ -418,24 +420,36 @@ def _shoulder(radius, arc, total, tuning):
     return int(np.searchsorted(middle, tuning.shoulder_at * total))
 
 
-def _reach(body, points):
+def _reach(body, points, limb=None):
     """How far the mesh goes on beyond the last of ``points``, along the last bone's direction (``mesh_reach``, up to
-    a quarter of the size)."""
+    a quarter of the size); with the ``limb`` they run along, not the mesh nearer a bone off that limb."""
     direction = points[-1] - points[-2]
     norm = np.linalg.norm(direction)
     if not norm > 0:
         return 0.0
-    return mesh_reach(body.vertices, points[-1], direction / norm, 0.25 * body.size, body.size)
+    others = None
+    if limb is not None:
+        graph, own = body.graph, {limb.attach, *limb.before}
+        off = [bone for bone, (head, tail) in enumerate(zip(graph.head_node, graph.tail_node))
+               if not (head in own and tail in own)]
+        others = (graph.points[graph.head_node[off]], graph.points[graph.tail_node[off]]) if off else None
+    return mesh_reach(body.vertices, points[-1], direction / norm, 0.25 * body.size, body.size, others)
 
 
-def mesh_reach(vertices, point, direction, limit, size):
+def mesh_reach(vertices, point, direction, limit, size, bones=None):
     """How far the mesh (its ``vertices``) goes on beyond ``point`` along ``direction`` (unit), up to ``limit``: its
-    vertices within a tube as thick as the mesh is at ``point`` (at least 0.02 of the ``size``)."""
+    vertices within a tube as thick as the mesh is at ``point`` (at least 0.02 of the ``size``). With ``bones``
+    ((B, 3) heads and tails), not those nearer one of them than ``point`` by 0.01 of the size: that mesh is another
+    part's, which the limb's end touches (a hand resting on the hip)."""
     offsets = vertices - point
     along = offsets @ direction
     across = np.linalg.norm(offsets - np.outer(along, direction), axis=1)
     tube = max(2 * float(np.linalg.norm(offsets, axis=1).min()), 0.02 * size)
-    beyond = along[(along > 0) & (across <= tube) & (along <= limit)]
+    inside = (along > 0) & (across <= tube) & (along <= limit)
+    if bones is not None and inside.any():
+        nearest = segment_distances(vertices[inside], *bones).min(axis=1)
+        inside[inside] = np.linalg.norm(offsets[inside], axis=1) <= nearest + 0.01 * size
+    beyond = along[inside]
     return float(beyond.max()) if len(beyond) else 0.0
 
 
