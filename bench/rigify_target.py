@@ -12,7 +12,8 @@ skinned with ``skin_meshes``, as the panel and the command line do. The sample c
   whole target (metarig added, fitted, generated); regenerate: Rigify's Generate Rig again from the kept metarig
   after moving one of its bones, as a user editing the metarig does (must succeed and keep the mesh bound);
 - DEF bones, vertices weighted (every vertex has a DEF weight), vertex groups that are not DEF bones (must be 0),
-  seam gap: the largest weight difference between vertices at one place (0: a seam cannot crack);
+  seam gap: the largest weight difference between vertices at one place (0: a seam cannot crack); rest: how far
+  the skinned mesh, nothing posed, lies from the mesh as it was (the largest vertex distance, in mesh sizes);
 - IK: each IK limb's control moved 30% of the limb's reach towards the limb's root: the middle joint (knee, elbow)
   must move the way the metarig bends it (knees and rear knees forward, elbows and front elbows back, in the
   rig's frame): limbs right / limbs tried;
@@ -40,6 +41,7 @@ from benchkit import (SHARED_MODELS, markdown_table, picked, results_folder, run
 from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
 
 IK_REACH = 0.3  # share of a limb's reach its IK control moves towards the limb's root
+REST_TOLERANCE = 1e-4  # a skinned mesh at rest within this share of its size of the mesh as it was is undeformed
 RIGIFY_PLANS = ("humanoid", "quadruped")
 
 
@@ -92,9 +94,11 @@ def measure(source, name):
         record["metarig"] = metarig_name = metarig[rigify.KIND_PROPERTY]
         record["fit_seconds"] = fit_seconds(result.skeleton, combined_arrays([obj]), metarig_name)
         record["def_bones"] = len(result.bones)
+        rest = np.array([tuple(vertex.co) for vertex in obj.data.vertices])
         outcomes, _ = skin_meshes([obj], rig)
         record["skin_seconds"] = outcomes[obj.name].seconds
         record.update(weights(obj))
+        record["rest_error"] = rest_error(obj, rest)
         record["ik"] = ik_bends(rig, metarig)
         record["regenerate_seconds"], record["regenerated_bound"] = regenerate(rig, metarig, obj)
         record["drawing"] = drawing(obj, rig)
@@ -135,6 +139,20 @@ def weights(obj):
     np.maximum.at(high, places, table)
     np.minimum.at(low, places, table)
     return {"weighted": weighted, "non_def_groups": int((~deform).sum()), "seam_gap": float((high - low).max())}
+
+
+def rest_error(obj, rest):
+    """How far the skinned mesh, its rig at rest, lies from the mesh as it was (``rest``): the largest vertex
+    distance in units of the mesh's size (0: the rig deforms nothing until posed)."""
+    import bpy
+
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    mesh = evaluated.to_mesh()
+    try:
+        posed = np.array([tuple(vertex.co) for vertex in mesh.vertices])
+    finally:
+        evaluated.to_mesh_clear()
+    return float(np.linalg.norm(posed - rest, axis=1).max() / max(float(np.ptp(rest, axis=0).max()), 1e-300))
 
 
 def ik_limbs(metarig):
@@ -265,7 +283,8 @@ def rows(records):
             cell_seconds(record.get("build_seconds") if record.get("target") == "rigify" else None),
             cell_seconds(record.get("regenerate_seconds")), record.get("def_bones", "—"),
             f"{record['weighted']} / {record['vertices']}" if "weighted" in record else "—",
-            f"{record['seam_gap']:.0e}" if "seam_gap" in record else "—", ik_cell(record),
+            f"{record['seam_gap']:.0e}" if "seam_gap" in record else "—",
+            f"{record['rest_error']:.0e}" if "rest_error" in record else "—", ik_cell(record),
             table_cell(note, 140) if note else ""])
     return table
 
@@ -275,10 +294,12 @@ def summary(records):
     built = [r for r in expected if r.get("target") == "rigify" and "error" not in r and "weighted" in r]
     full = [r for r in built if r["weighted"] == r["vertices"] and r["non_def_groups"] == 0]
     cracked = [r for r in built if r["seam_gap"] > 0]
+    bent = [r for r in built if r["rest_error"] > REST_TOLERANCE]
     limbs = [item for r in built for item in r.get("ik", [])]
     regenerated = [r for r in built if r.get("regenerated_bound")]
     others = [r for r in records if r.get("plan") not in RIGIFY_PLANS and "plan" in r]
     return {"expected": len(expected), "built": len(built), "fully_weighted": len(full), "cracked": len(cracked),
+            "rest_worst": max((r["rest_error"] for r in built), default=0.0), "bent": [r["model"] for r in bent],
             "ik_right": sum(item["right"] for item in limbs), "ik_limbs": len(limbs),
             "regenerated": len(regenerated), "others": len(others),
             "others_built": [r["model"] for r in others if r.get("target") == "rigify" and "error" not in r],
@@ -305,7 +326,10 @@ def report(records, totals, pose, run):
              f"{totals['fully_weighted']} / {totals['built']} fully weighted, {totals['cracked']} with a seam gap",
              weighted],
         ]), "",
-        f"Also: IK bends the right way (knees forward, elbows back) on {totals['ik_right']} / {totals['ik_limbs']} "
+        f"At rest the skinned mesh lies within {totals['rest_worst']:.0e} of the size of the mesh as it was"
+        + (f"; more than {REST_TOLERANCE:.0e} off on {', '.join(totals['bent'])}" if totals["bent"] else "")
+        + ". "
+        f"IK bends the right way (knees forward, elbows back) on {totals['ik_right']} / {totals['ik_limbs']} "
         f"limbs; regenerating from the edited metarig kept the mesh bound on {totals['regenerated']} / "
         f"{totals['built']}. Of the {totals['others']} models of other plans, "
         f"{', '.join(totals['others_built']) or 'none'} (birds with legs) got the bird metarig and "
@@ -320,7 +344,7 @@ def report(records, totals, pose, run):
                       f"moved {pose['knee_forward']:.3f} m forward and {pose['knee_up']:.3f} m up."]
     lines += ["", "## Models", "",
               *markdown_table(["model", "plan", "target", "metarig", "fit", "build", "regenerate", "DEF bones",
-                               "weighted", "seam gap", "IK right", "warnings / failure"], rows(records)),
+                               "weighted", "seam gap", "rest", "IK right", "warnings / failure"], rows(records)),
               "", "Build: the metarig added, fitted and generated (Rigify's generate is most of it). A `plain` target "
                   "is the fallback of a plan the rigify target does not fill.", ""]
     return "\n".join(lines)

@@ -56,6 +56,7 @@ import numpy as np
 from .facing import TORSO, bones_middle, facing, foot_ahead, role_bones
 from .polyline import arc_lengths, arc_nearest, point_at
 from .roles import CHAINS, BoneRole, mesh_reach, named_joints, within_reach
+from .rotations import about, between
 from .tuning import TuningTable, tuned
 
 FORWARD, BACKWARD = 1, -1  # the way a limb's first joint bends (a knee, an elbow)
@@ -288,6 +289,7 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
         fit.z_axes[name] = np.asarray(meta[name].z_axis, dtype=np.float64)
         if name not in wanted:
             _keep_length(fit, name, body.size * tuning.shortest)
+    _roll_on(fit, meta)
     fit.removed = _removed(meta, fit.heads)
     fit.notes = _notes(spec, fit, body)
     return fit
@@ -764,6 +766,48 @@ def _heel(body, fit, side, tuning):
     centre[2] = ground
     outward = across if across[0] * (1 if side == "L" else -1) >= 0 else -across  # the metarig's left is +X
     return centre - 0.5 * width * outward, centre + 0.5 * width * outward
+
+
+def _roll_on(fit, meta):
+    """Roll each placed bone connected to a placed parent as the metarig rolls it relative to that parent, where
+    the metarig's own Z axis (``fit.z_axes``) would roll it more than a quarter turn from there. A bone pointing past
+    that axis (a tail curling up over the back, where the metarig's runs back) turns it half a turn, and Rigify's
+    bendy tail crumples at rest; a chain bent like the metarig's keeps the metarig's rolls."""
+    def depth(name):
+        parent = meta[name].parent
+        return 0 if parent not in fit.heads else 1 + depth(parent)
+
+    for name in sorted(fit.heads, key=depth):
+        parent = meta[name].parent
+        if parent not in fit.heads or not meta[name].connected:
+            continue
+        ways = [_unit(np.subtract(tail, head)) for head, tail in (
+            (meta[parent].head, meta[parent].tail), (meta[name].head, meta[name].tail),
+            (fit.heads[parent], fit.tails[parent]), (fit.heads[name], fit.tails[name]))]
+        if any(way is None for way in ways) or ways[0] @ ways[1] <= 0 or ways[2] @ ways[3] <= 0:
+            continue  # a turn this sharp carries no roll across
+        meta_parent, meta_bone, parent_way, way = ways
+        z_axes = [_across(meta[parent].z_axis, meta_parent), _across(meta[name].z_axis, meta_bone),
+                  _across(fit.z_axes[parent], parent_way), _across(fit.z_axes[name], way)]
+        if any(z is None for z in z_axes):
+            continue
+        meta_parent_z, meta_z, parent_z, own = z_axes
+        carried = _across(between(meta_parent, meta_bone) @ meta_parent_z, meta_bone)  # the metarig's twist ...
+        twist = np.arctan2(np.cross(carried, meta_z) @ meta_bone, carried @ meta_z)
+        wanted = about(way, twist) @ _across(between(parent_way, way) @ parent_z, way)  # ... on the fitted chain
+        if own @ wanted < 0:
+            fit.z_axes[name] = wanted
+
+
+def _unit(vector):
+    norm = float(np.linalg.norm(vector))
+    return np.asarray(vector, dtype=np.float64) / norm if norm > 1e-12 else None
+
+
+def _across(vector, axis):
+    """The unit part of ``vector`` across unit ``axis`` (None when it runs along it)."""
+    vector = np.asarray(vector, dtype=np.float64)
+    return _unit(vector - (vector @ axis) * axis)
 
 
 def _derived(point, meta_points, fitted_points, tuning):

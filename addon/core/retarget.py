@@ -37,6 +37,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .rotations import between
+
 REFERENCE_JUMP = 10.0  # a first frame the joints leave by this many times the clip's median step is no motion
 SIDES = (("Left", ("left", "l")), ("Right", ("right", "r")))
 SIDED_WORDS = {  # a game bone's word: aliases of the word, best first (sides are added around them)
@@ -241,7 +243,7 @@ def retarget(clip, rig, mapping=None):
         if SWUNG.fullmatch(_word(rig.names[bone])):
             end = _segment_end(clip, joint, mapping, rig, bone)
             if end is not None:
-                swing[bone] = _between(directions[bone], turn @ (clip.rest[end, :3, 3] - clip.rest[joint, :3, 3]))
+                swing[bone] = between(directions[bone], turn @ (clip.rest[end, :3, 3] - clip.rest[joint, :3, 3]))
     ground, ankles = _planted(clip, mapping)
     level = {index[name]: _level(clip, mapping.driven[name], _flat_frames(clip, mapping, ground, side), turn, up)
              for side in ("Left", "Right") for name in (f"{side}Foot", f"{side}ToeBase")
@@ -445,22 +447,6 @@ def _segment_end(clip, joint, mapping, rig, bone):
     return None
 
 
-def _between(a, b):
-    """The smallest rotation taking direction ``a`` onto direction ``b``."""
-    a, b = _unit(a), _unit(b)
-    axis = np.cross(a, b)
-    sine, cosine = np.linalg.norm(axis), float(a @ b)
-    if sine < 1e-12:
-        if cosine > 0:
-            return np.eye(3)
-        other = np.eye(3)[np.argmin(np.abs(a))]
-        axis = _unit(np.cross(a, other))
-        return 2 * np.outer(axis, axis) - np.eye(3)
-    axis /= sine
-    cross = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    return np.eye(3) + sine * cross + (1 - cosine) * cross @ cross
-
-
 def _leg_length(points, mapping, side):
     """The mocap's hip joint to knee to ankle on ``side``, from (J, 4, 4) matrices ``points``."""
     joints = mapping.legs.get(side)
@@ -577,8 +563,8 @@ def _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale,
             for frame in range(len(world)):  # knees bend forward: towards the thigh's turned rest forward
                 pole = knee[frame] + world[frame, thigh] @ forward
                 new_knee = _two_bone(hip[frame], pole, target[frame], upper, lower)
-                world[frame, thigh] = _between(knee[frame] - hip[frame], new_knee - hip[frame]) @ world[frame, thigh]
-                world[frame, shin] = _between(ankle[frame] - knee[frame], target[frame] - new_knee) @ world[frame, shin]
+                world[frame, thigh] = between(knee[frame] - hip[frame], new_knee - hip[frame]) @ world[frame, thigh]
+                world[frame, shin] = between(ankle[frame] - knee[frame], target[frame] - new_knee) @ world[frame, shin]
 
 
 def _ankle(rig, world, heads, shin, foot):
