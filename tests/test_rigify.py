@@ -228,6 +228,22 @@ def test_a_limb_end_the_skeleton_lacks_is_placed_on_the_mesh_and_the_fit_says_so
         assert ankle[2] - tip[2] <= 0.1 * size  # ... rather than down
 
 
+def test_a_hind_leg_bends_at_its_hock_where_the_skeleton_does(metarigs):
+    """The fox's hind leg bends back at its hock, high above the paw, but its roles start the foot near the ground:
+    Rigify's shin ran straight from the knee to the paw, most of it outside the leg, and a paw lifted by IK moved
+    the lower leg as one stick."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_Fox", "Quaternius_Fox.obj"))
+    vertices = vertices @ Y_UP_TO_Z_UP.T
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    fit = fit_metarig(skeleton, (vertices, triangles), "basic_quadruped", metarigs["basic_quadruped"])
+    for side in ("L", "R"):  # the metarig's frame: front -Y, up +Z
+        knee, hock, ball = (fit.heads[f"{bone}.{side}"] for bone in ("shin", "foot", "toe"))
+        line = (ball - knee) / np.linalg.norm(ball - knee)
+        off = (hock - knee) - ((hock - knee) @ line) * line
+        assert off[1] > 0.15 * np.linalg.norm(ball - knee)  # the hock lies behind the line from the knee to the paw
+        assert hock[2] - ball[2] > 0.3 * (knee[2] - ball[2])  # ... high above the paw
+
+
 def test_a_stub_off_a_leg_is_not_the_leg(metarigs):
     """spot's front legs each have a two-bone stub off the upper leg (a bump seen from the front), shorter than the
     leg and farther out: the fit took the piece farthest out for the front leg, and Rigify's front paw hung in the

@@ -34,8 +34,9 @@ How the bones are placed, in order:
   not already bend that way by ``bend`` of the limb's reach, so that knees bend forward and elbows backward (Rigify
   takes the bend direction from the chain); a limb bent sideways leans at most ``tilt`` from that. An animal's hind
   leg whose first joint bends backward is read one joint down: that joint is its hock, and its knee (hidden in the
-  body) goes where the metarig has it relative to the hip and the hock. A joint the skeleton bends the wrong way by
-  more than ``bend_move`` stays (the fit says so).
+  body) goes where the metarig has it relative to the hip and the hock; one whose shin bends back well above the paw
+  (its roles begin the foot near the ground) has its hock, where Rigify's foot begins, at that bend. A joint the
+  skeleton bends the wrong way by more than ``bend_move`` stays (the fit says so).
 - Twins that mirror within ``mirror_tolerance`` of the size are made exact mirror images across the midline.
 - The heel (Rigify's ``heel.02``, the foot's rocking edge) runs across the back of the foot on the ground, from the
   mesh: the foot's vertices below the ankle, their rearmost and their width.
@@ -94,6 +95,8 @@ class MetarigTuning(TuningTable):
     anchors: int = tuned(8, "a derived bone moves with this many placed joints nearest it in the metarig")
     heel_reach: float = tuned(0.6, "the heel is looked for among the vertices within this many foot lengths of the "
                                    "ankle, across the ground")
+    hock_bend: float = tuned(0.15, "a hind leg's shin with a joint this share of its length behind it bends there: "
+                                   "that joint is the hock, where Rigify's foot begins (a fox's shin 0.33)")
     side_piece: float = tuned(0.5, "of a side's pieces of a limb's roles, those at least this share of the longest's "
                                    "length compete, the farthest out winning (a stub off a leg is no leg)")
 
@@ -505,12 +508,32 @@ def _fit_chain(body, chain, side, names, meta, tuning):
         del body.notes[noted:]  # read again from the hock, which notes what it lacks itself
         joints = _joints(body, _groups(chain.hock), points, arc, step_roles, lengths, tuning, side=side)
         joints[1] = _as_in_metarig(joints, [np.asarray(meta[name].head, float) for name in names[:3]], chain.bend)
+    elif chain.hock:
+        _hock(joints, body.local(points), tuning)
     if groups[0] == ("palm",):
         joints[0] = _palm_head(joints, meta, names, side)
     if chain.bend and not _bend(joints, chain.bend, tuning):
         body.notes.append(f"the skeleton's {names[0]} bends too far the wrong way to move its joint: its IK bends "
                           f"that way (move the metarig's {names[1]} head and regenerate)")
     return joints
+
+
+def _hock(joints, path, tuning):
+    """Move a hind leg's hock (``joints[2]``, where Rigify's foot begins) to the joint of the skeleton's ``path``
+    between the knee and it that lies farthest behind the line between them, when that is ``hock_bend`` of their
+    distance or more: the skeleton bends there, where its roles (a foot near the ground) ran the shin on down to the
+    paw. The paw, from the old hock on, becomes the toe."""
+    knee, low = joints[1], joints[2]
+    reach = float(np.linalg.norm(low - knee))
+    between = [point for point in path if np.linalg.norm(point - knee) > 1e-9 * reach and
+               np.linalg.norm(point - low) > 1e-9 * reach and (point - knee) @ (low - knee) > 0 and
+               (point - low) @ (knee - low) > 0]
+    if not between or not reach > 0:
+        return
+    behind = [_bent(np.array([knee, point, low]), BACKWARD)[0] for point in between]
+    k = int(np.argmax(behind))
+    if behind[k] >= tuning.hock_bend * reach:
+        joints[3], joints[2] = joints[2], between[k]
 
 
 def _groups(roles):
