@@ -244,6 +244,20 @@ def test_a_hind_leg_bends_at_its_hock_where_the_skeleton_does(metarigs):
         assert hock[2] - ball[2] > 0.3 * (knee[2] - ball[2])  # ... high above the paw
 
 
+@pytest.mark.parametrize("name, metarig", [("humanoid", "basic_human"), ("bear", "basic_quadruped")])
+def test_rigifys_pelvis_and_breast_helpers_stay_inside_the_body(metarigs, name, metarig):
+    """Rigify's pelvis and breast bones deform the hips and the chest. Placed among their nearest joints, the legs'
+    among them, they spread as the legs did: the sample humanoid's breasts lay wholly outside its chest, and the
+    bear's were 3.6 times Rigify's size, so moving a front paw dented the chest."""
+    vertices, triangles = load_character(name)
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    fit = fit_metarig(skeleton, (vertices, triangles), metarig, metarigs[metarig])
+    for helper in ("pelvis.L", "pelvis.R", "breast.L", "breast.R"):
+        head, tail = (point @ fit.frame.T for point in (fit.heads[helper], fit.tails[helper]))  # the mesh's frame
+        assert strictly_inside_fraction(vertices, triangles, head + np.linspace(0, 1, 11)[:, None] * (tail - head)) \
+            >= 0.9, helper
+
+
 def test_a_stub_off_a_leg_is_not_the_leg(metarigs):
     """spot's front legs each have a two-bone stub off the upper leg (a bump seen from the front), shorter than the
     leg and farther out: the fit took the piece farthest out for the front leg, and Rigify's front paw hung in the

@@ -43,9 +43,10 @@ How the bones are placed, in order:
 - Palms run from inside the hand (where the metarig's do, as a share of the way from the wrist) to their finger.
 - Chains start exactly where the metarig starts them on another chain (the neck at the torso's end, the tail at its
   start): Rigify connects such chains only when their ends coincide.
-- Derived bones (pelvis, breast: Rigify's deforming helpers) keep their place among the joints around them: each
+- Derived bones (pelvis, breast: Rigify's deforming helpers) keep their place among the torso's joints: each
   nearest placed joint carries the metarig's point at its own offset, scaled by how much the fit spread those
-  joints, weighted by inverse square distance.
+  joints, weighted by inverse square distance (a leg's joints, placed by legs longer or shorter than the metarig's,
+  would spread them out of the body).
 - Bones whose part the skeleton lacks are removed (what hangs from them hangs from the nearest kept bone above): a
   tail, an arm, ears, the fingers of a hand that shows none, and the face of Rigify's human (a face rig needs eyes,
   lids and lips that no skeleton shows).
@@ -92,7 +93,7 @@ class MetarigTuning(TuningTable):
                                           "(a posed figure's differ more and keep their pose)")
     merge: float = tuned(1e-6, "bone ends closer than this are one joint")
     shortest: float = tuned(0.002, "no placed bone is shorter than this")
-    anchors: int = tuned(8, "a derived bone moves with this many placed joints nearest it in the metarig")
+    anchors: int = tuned(8, "a derived bone moves with this many placed torso joints nearest it in the metarig")
     heel_reach: float = tuned(0.6, "the heel is looked for among the vertices within this many foot lengths of the "
                                    "ankle, across the ground")
     hock_bend: float = tuned(0.15, "a hind leg's shin with a joint this share of its length behind it bends there: "
@@ -270,7 +271,8 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
     midline = [chain.names(None) for chain in spec.chains if not chain.sided]
     middle = _mirror_twins(fit, units, midline, tuning.mirror_tolerance * body.size)
     _join_chains(fit, spec, meta)
-    placed = list(fit.heads)
+    torso = {name for chain in spec.chains if TORSO in chain.roles for name in chain.names(None)}
+    placed = [name for name in fit.heads if name in torso]  # the helpers' anchors: the legs' would spread them
     meta_points = np.array([meta[name].head for name in placed] + [meta[name].tail for name in placed], float)
     fitted_points = np.array([fit.heads[name] for name in placed] + [fit.tails[name] for name in placed])
     for template in spec.heels:
