@@ -258,6 +258,19 @@ def test_rigifys_pelvis_and_breast_helpers_stay_inside_the_body(metarigs, name, 
             >= 0.9, helper
 
 
+def test_a_front_leg_hangs_from_the_end_of_its_shoulder_blade(metarigs):
+    """The bear's front legs run forward and down from the withers along the shoulder blade before they turn down.
+    The shoulder joint, named at a share of the leg's height, lay on the blade above where the roles begin the
+    upper arm: Rigify's shoulder ended a third of the leg above where its front leg began, and the paw lifted by IK
+    folded at the wrist."""
+    vertices, triangles = load_character("bear")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    fit = fit_metarig(skeleton, (vertices, triangles), "basic_quadruped", metarigs["basic_quadruped"])
+    size = float(np.ptp(vertices, axis=0).max())
+    for side in ("L", "R"):
+        assert np.linalg.norm(fit.tails[f"shoulder.{side}"] - fit.heads[f"front_thigh.{side}"]) < 1e-6 * size
+
+
 def test_a_stub_off_a_leg_is_not_the_leg(metarigs):
     """spot's front legs each have a two-bone stub off the upper leg (a bump seen from the front), shorter than the
     leg and farther out: the fit took the piece farthest out for the front leg, and Rigify's front paw hung in the

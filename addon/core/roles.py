@@ -20,8 +20,9 @@ Roles are whole bones; named joints are points (:func:`named_joints`: where each
 digit): point}``), placed along the chains where the artists' rigs have them rather than at the nearest bone end
 (:func:`joint_places`, at recognition, stored in ``BodyPlan.joints``): on a leg the ankle where it comes down to
 ``ankle_height``, the hip joint at ``hip_rise`` of the height from there to where the leg hangs (on the thigh's line
-when the thigh stands upright), the knee ``knee_at`` of the way between (a bend there winning) and the ball of the
-foot ``toe_at`` of the way to the toes' tip; on an arm the shoulder joint where the arm leaves the torso, the elbow
+when the thigh stands upright; a front leg's shoulder joint no higher than where its upper arm's bones begin), the
+knee ``knee_at`` of the way between (a bend there winning) and the ball of the foot ``toe_at`` of the way to the
+toes' tip; on an arm the shoulder joint where the arm leaves the torso, the elbow
 and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the hand (the mesh beyond the last
 joint included; a bend winning for the elbow), the collarbone's start ``clavicle_at`` of the way in; on an upright
 humanoid's spine the hips, spine, chest and neck at ``hips_at`` ... ``neck_at`` of the height from the hip joints to
@@ -340,13 +341,8 @@ def _leg(body, limb, points, front, tuning, put):
     """Roles along a leg's main path (``points``): hips (or shoulder), thigh, shin, foot, toe (front legs: shoulder,
     upper_arm, forearm, hand)."""
     nodes = list(limb.main)
-    steps = np.diff(points, axis=0)
-    lengths = np.maximum(np.linalg.norm(steps, axis=1), 1e-300)
-    down = -(steps @ body.up) / lengths
     last = len(nodes) - 1
-    off = 0 if body.plane is None else next(
-        (i for i in range(last + 1) if abs(body.plane.distance(points[i])) > tuning.plane_exit * body.size), last)
-    thigh = next((i for i in range(off, last) if down[i] >= tuning.thigh_drop), off if off < last else 0)
+    thigh = _thigh_start(body, points, tuning)
     heights = body.height(points)
     low = [i for i in range(thigh + 2, last + 1) if heights[i] <= tuning.foot_height]
     ankle = min(low, key=lambda i: abs(heights[i] - tuning.ankle_height)) if low else last
@@ -361,6 +357,17 @@ def _leg(body, limb, points, front, tuning, put):
         split = _fork(path, nodes)
         put(path[split:], ["toe" if split >= ankle else roles[min(split, len(roles) - 1)] if roles else "other"]
             * (len(path) - 1 - split))
+
+
+def _thigh_start(body, points, tuning):
+    """Index of the joint a leg's thigh (a front leg's upper arm) starts at along its path ``points``: the first
+    off the mirror plane from which the path runs down (``thigh_drop``); before it, it runs in the body."""
+    steps = np.diff(points, axis=0)
+    down = -(steps @ body.up) / np.maximum(np.linalg.norm(steps, axis=1), 1e-300)
+    last = len(points) - 1
+    off = 0 if body.plane is None else next(
+        (i for i in range(last + 1) if abs(body.plane.distance(points[i])) > tuning.plane_exit * body.size), last)
+    return next((i for i in range(off, last) if down[i] >= tuning.thigh_drop), off if off < last else 0)
 
 
 def _segments(names, cuts):
@@ -753,7 +760,9 @@ def _down_to(heights, arc, level):
 
 def _leg_places(body, path, arc, front, tuning):
     """{role: spots} along a leg's path: the ankle where it comes down to ``ankle_height``, the hip joint at
-    ``hip_rise`` of the height from the ankle to where the leg hangs, on the line of the thigh when that stands
+    ``hip_rise`` of the height from the ankle to where the leg hangs (a front leg's shoulder joint no higher than
+    where its path turns down, :func:`_thigh_start`: a bear's runs along its shoulder blade first), on the line of
+    the thigh when that stands
     within ``thigh_lean`` of up (the path from the knee halfway up to the hip, carried on up: the path may reach the
     hip slanting in from the body's middle; a bent hind leg's thigh line leads elsewhere), the
     knee at ``knee_at`` of the way between (a bend near there winning), the toe at ``toe_at`` of the way from the
@@ -764,6 +773,9 @@ def _leg_places(body, path, arc, front, tuning):
     ankle_height = float(np.interp(ankle, arc, heights))
     hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
     hip = _down_to(heights, arc, hip_height)
+    if front:  # no higher than where the roles begin the upper arm: above, the path runs along a shoulder blade
+        hip = max(hip, float(arc[_thigh_start(body, points, tuning)]))
+        hip_height = float(np.interp(hip, arc, heights))
     knee = _bent(points, arc, hip, hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
     tip = arc[-1] + path.reach
     toe = ankle + tuning.toe_at * (tip - ankle)
