@@ -527,15 +527,15 @@ def _hock(joints, path, tuning):
     paw. The paw, from the old hock on, becomes the toe."""
     knee, low = joints[1], joints[2]
     reach = float(np.linalg.norm(low - knee))
-    between = [point for point in path if np.linalg.norm(point - knee) > 1e-9 * reach and
-               np.linalg.norm(point - low) > 1e-9 * reach and (point - knee) @ (low - knee) > 0 and
-               (point - low) @ (knee - low) > 0]
-    if not between or not reach > 0:
+    inside = [point for point in path if np.linalg.norm(point - knee) > 1e-9 * reach and
+              np.linalg.norm(point - low) > 1e-9 * reach and (point - knee) @ (low - knee) > 0 and
+              (point - low) @ (knee - low) > 0]
+    if not inside or not reach > 0:
         return
-    behind = [_bent(np.array([knee, point, low]), BACKWARD)[0] for point in between]
+    behind = [_bent(np.array([knee, point, low]), BACKWARD)[0] for point in inside]
     k = int(np.argmax(behind))
     if behind[k] >= tuning.hock_bend * reach:
-        joints[3], joints[2] = joints[2], between[k]
+        joints[3], joints[2] = joints[2], inside[k]
 
 
 def _groups(roles):

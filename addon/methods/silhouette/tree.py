@@ -381,7 +381,7 @@ def _cut_cycle(nodes, points, radius, tuning):
     to its tip, so it hangs whole from the end farther from its narrowest node (the shoulder, not the hip)."""
     inner = radius[nodes[1:-1]]
     if not len(inner):
-        return [nodes]
+        return []  # a single link closing the cycle: dropping it opens it
     cut = 1 + int(np.argmin(inner))
     if inner.min() < tuning.contact * np.median(inner):
         halves = (nodes[:cut + 1], nodes[cut:][::-1])
