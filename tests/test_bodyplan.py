@@ -577,3 +577,20 @@ def test_how_finely_a_spine_is_cut_does_not_decide_a_legless_plan():
                        [index[skeleton.parents[b]] if skeleton.parents[b] >= 0 else -1 for b in keep])
     plan, _ = recognise(coarser, (vertices, triangles), plane=skeleton.stages.get("mirror_plane"), prefer_up=up)
     assert plan.kind == "bird"
+
+
+def test_a_knee_bends_below_where_the_thigh_begins():
+    """The ogre's legs slant out from its belly through its loincloth before they turn down: the corner where they
+    turn down was taken for the knee, and the hip joint, on the thigh's line up from the knee, fell near the middle
+    of the belly. The knee is a bend below where the thigh's bones begin; the hip joint then stands above it."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "ogre.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    joints, up = named_joints(skeleton), np.asarray(skeleton.body_plan.up)
+    height = float(np.ptp(vertices @ up))
+    for side in ("L", "R"):
+        thighs = [bone for bone, role in enumerate(skeleton.roles) if role.role == "thigh" and role.side == side]
+        top = max(float(skeleton.heads[bone] @ up) for bone in thighs)  # where the thigh's bones begin
+        hip, knee = joints[("thigh", side, None)], joints[("shin", side, None)]
+        assert knee @ up < top - 0.02 * height
+        rise = hip - knee
+        assert rise @ up > np.cos(np.radians(30)) * np.linalg.norm(rise)  # the thigh stands up from the knee

@@ -21,10 +21,10 @@ digit): point}``), placed along the chains where the artists' rigs have them rat
 (:func:`joint_places`, at recognition, stored in ``BodyPlan.joints``): on a leg the ankle where it comes down to
 ``ankle_height``, the hip joint at ``hip_rise`` of the height from there to where the leg hangs (on the thigh's line
 when the thigh stands upright; a front leg's shoulder joint no higher than where its upper arm's bones begin), the
-knee ``knee_at`` of the way between (a bend there winning) and the ball of the foot ``toe_at`` of the way to the
-toes' tip; on an arm the shoulder joint where the arm leaves the torso, the elbow
-and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the hand (the mesh beyond the last
-joint included; a bend winning for the elbow), the collarbone's start ``clavicle_at`` of the way in; on an upright
+knee ``knee_at`` of the way between (a bend there, below where the thigh's bones begin, winning) and the ball of
+the foot ``toe_at`` of the way to the toes' tip; on an arm the shoulder joint where the arm leaves the torso, the
+elbow and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the hand (the mesh beyond the
+last joint included; a bend winning for the elbow), the collarbone's start ``clavicle_at`` of the way in; on an upright
 humanoid's spine the hips, spine, chest and neck at ``hips_at`` ... ``neck_at`` of the height from the hip joints to
 the shoulder joints. :func:`landmarks` gives the ends no role begins at, placed the same way: head top, hand and
 toe tips, finger tips, heels. A place is a weighted sum of points on bones, so named joints and landmarks follow
@@ -762,21 +762,21 @@ def _leg_places(body, path, arc, front, tuning):
     """{role: spots} along a leg's path: the ankle where it comes down to ``ankle_height``, the hip joint at
     ``hip_rise`` of the height from the ankle to where the leg hangs (a front leg's shoulder joint no higher than
     where its path turns down, :func:`_thigh_start`: a bear's runs along its shoulder blade first), on the line of
-    the thigh when that stands
-    within ``thigh_lean`` of up (the path from the knee halfway up to the hip, carried on up: the path may reach the
-    hip slanting in from the body's middle; a bent hind leg's thigh line leads elsewhere), the
-    knee at ``knee_at`` of the way between (a bend near there winning), the toe at ``toe_at`` of the way from the
-    ankle to the tip."""
+    the thigh when that stands within ``thigh_lean`` of up (the path from the knee halfway up to the hip, carried on
+    up: the path may reach the hip slanting in from the body's middle; a bent hind leg's thigh line leads
+    elsewhere), the knee at ``knee_at`` of the way between (a bend near there, below where the thigh's bones begin,
+    winning), the toe at ``toe_at`` of the way from the ankle to the tip."""
     points = path.points
     heights = body.height(points)
     ankle = _down_to(heights, arc, tuning.ankle_height)
     ankle_height = float(np.interp(ankle, arc, heights))
     hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
     hip = _down_to(heights, arc, hip_height)
-    if front:  # no higher than where the roles begin the upper arm: above, the path runs along a shoulder blade
-        hip = max(hip, float(arc[_thigh_start(body, points, tuning)]))
+    thigh_from = float(arc[_thigh_start(body, points, tuning)])  # above, the path runs in the body
+    if front:  # a shoulder joint no higher than where the upper arm's bones begin (a bear's run along its blade)
+        hip = max(hip, thigh_from)
         hip_height = float(np.interp(hip, arc, heights))
-    knee = _bent(points, arc, hip, hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
+    knee = _bent(points, arc, max(hip, thigh_from), hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
     tip = arc[-1] + path.reach
     toe = ankle + tuning.toe_at * (tip - ankle)
     thigh = 0.5 * (hip + knee)
