@@ -13,7 +13,8 @@ skinned with ``skin_meshes``, as the panel and the command line do. The sample c
   after moving one of its bones, as a user editing the metarig does (must succeed and keep the mesh bound);
 - DEF bones, vertices weighted (every vertex has a DEF weight), vertex groups that are not DEF bones (must be 0),
   seam gap: the largest weight difference between vertices at one place (0: a seam cannot crack); rest: how far
-  the skinned mesh, nothing posed, lies from the mesh as it was (the largest vertex distance, in mesh sizes);
+  the skinned mesh, nothing posed, lies from the mesh as it was (the largest vertex distance, in mesh sizes); the
+  share of Rigify's pelvis and breast deform bones inside the mesh (they deform the body from inside);
 - IK: each IK limb's control moved 30% of the limb's reach towards the limb's root: the middle joint (knee, elbow)
   must move the way the metarig bends it (knees and rear knees forward, elbows and front elbows back, in the
   rig's frame): limbs right / limbs tried;
@@ -42,6 +43,7 @@ from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-fr
 
 IK_REACH = 0.3  # share of a limb's reach its IK control moves towards the limb's root
 REST_TOLERANCE = 1e-3  # a skinned mesh at rest within this share of its size of the mesh as it was is undeformed
+HELPERS_INSIDE = 0.9  # Rigify's pelvis and breast deform the body from inside it: this share of them at least
 RIGIFY_PLANS = ("humanoid", "quadruped")
 
 
@@ -92,8 +94,10 @@ def measure(source, name):
         rig = result.armature
         metarig = rig[rigify.METARIG_PROPERTY]
         record["metarig"] = metarig_name = metarig[rigify.KIND_PROPERTY]
-        record["fit_seconds"] = fit_seconds(result.skeleton, combined_arrays([obj]), metarig_name)
+        mesh = combined_arrays([obj])
+        record["fit_seconds"] = fit_seconds(result.skeleton, mesh, metarig_name)
         record["def_bones"] = len(result.bones)
+        record["helpers_inside"] = helpers_inside(result.bones, mesh)
         rest = np.array([tuple(vertex.co) for vertex in obj.data.vertices])
         outcomes, _ = skin_meshes([obj], rig)
         record["skin_seconds"] = outcomes[obj.name].seconds
@@ -139,6 +143,20 @@ def weights(obj):
     np.maximum.at(high, places, table)
     np.minimum.at(low, places, table)
     return {"weighted": weighted, "non_def_groups": int((~deform).sum()), "seam_gap": float((high - low).max())}
+
+
+def helpers_inside(bones, mesh):
+    """The share of points along Rigify's pelvis and breast deform bones (``bones``, the rig's DEF bones in the
+    mesh's frame: every tenth of their length) inside ``mesh`` (vertices, triangles: winding number above 0.5);
+    None when the rig has neither."""
+    from rigdata import winding_numbers
+
+    helpers = [k for k, name in enumerate(bones.names) if name.startswith(("DEF-pelvis", "DEF-breast"))]
+    if not helpers:
+        return None
+    steps = np.linspace(0.0, 1.0, 11)[None, :, None]
+    points = (bones.heads[helpers][:, None] * (1 - steps) + bones.tails[helpers][:, None] * steps).reshape(-1, 3)
+    return float((winding_numbers(points, *mesh) > 0.5).mean())
 
 
 def rest_error(obj, rest):
@@ -295,11 +313,15 @@ def summary(records):
     full = [r for r in built if r["weighted"] == r["vertices"] and r["non_def_groups"] == 0]
     cracked = [r for r in built if r["seam_gap"] > 0]
     bent = [r for r in built if r["rest_error"] > REST_TOLERANCE]
+    outside = sorted((r["helpers_inside"], r["model"]) for r in built if r.get("helpers_inside") is not None
+                     and r["helpers_inside"] < HELPERS_INSIDE)
     limbs = [item for r in built for item in r.get("ik", [])]
     regenerated = [r for r in built if r.get("regenerated_bound")]
     others = [r for r in records if r.get("plan") not in RIGIFY_PLANS and "plan" in r]
     return {"expected": len(expected), "built": len(built), "fully_weighted": len(full), "cracked": len(cracked),
             "rest_worst": max((r["rest_error"] for r in built), default=0.0), "bent": [r["model"] for r in bent],
+            "helpers_outside": outside,
+            "with_helpers": sum(r.get("helpers_inside") is not None for r in built),
             "ik_right": sum(item["right"] for item in limbs), "ik_limbs": len(limbs),
             "regenerated": len(regenerated), "others": len(others),
             "others_built": [r["model"] for r in others if r.get("target") == "rigify" and "error" not in r],
@@ -329,6 +351,10 @@ def report(records, totals, pose, run):
         f"At rest the skinned mesh lies within {totals['rest_worst']:.0e} of the size of the mesh as it was"
         + (f"; more than {REST_TOLERANCE:.0e} off on {', '.join(totals['bent'])}" if totals["bent"] else "")
         + ". "
+        f"Rigify's pelvis and breast bones lie at least {HELPERS_INSIDE:.0%} inside the mesh on "
+        f"{totals['with_helpers'] - len(totals['helpers_outside'])} / {totals['with_helpers']} rigs"
+        + (" (less on " + ", ".join(f"{model} {share:.0%}" for share, model in totals["helpers_outside"]) + ")"
+           if totals["helpers_outside"] else "") + ". "
         f"IK bends the right way (knees forward, elbows back) on {totals['ik_right']} / {totals['ik_limbs']} "
         f"limbs; regenerating from the edited metarig kept the mesh bound on {totals['regenerated']} / "
         f"{totals['built']}. Of the {totals['others']} models of other plans, "
