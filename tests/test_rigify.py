@@ -244,11 +244,13 @@ def test_a_hind_leg_bends_at_its_hock_where_the_skeleton_does(metarigs):
         assert hock[2] - ball[2] > 0.3 * (knee[2] - ball[2])  # ... high above the paw
 
 
-@pytest.mark.parametrize("name, metarig", [("humanoid", "basic_human"), ("bear", "basic_quadruped")])
+@pytest.mark.parametrize("name, metarig", [("humanoid", "basic_human"), ("bear", "basic_quadruped"),
+                                           ("quadruped", "basic_quadruped")])
 def test_rigifys_pelvis_and_breast_helpers_stay_inside_the_body(metarigs, name, metarig):
     """Rigify's pelvis and breast bones deform the hips and the chest. Placed among their nearest joints, the legs'
     among them, they spread as the legs did: the sample humanoid's breasts lay wholly outside its chest, and the
-    bear's were 3.6 times Rigify's size, so moving a front paw dented the chest."""
+    bear's were 3.6 times Rigify's size, so moving a front paw dented the chest. The sample quadruped's chest is
+    thinner than the metarig's proportions make it: its breasts stood half out of it."""
     vertices, triangles = load_character(name)
     skeleton = rigger.rig_mesh(vertices, triangles)
     fit = fit_metarig(skeleton, (vertices, triangles), metarig, metarigs[metarig])

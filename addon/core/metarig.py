@@ -46,7 +46,8 @@ How the bones are placed, in order:
 - Derived bones (pelvis, breast: Rigify's deforming helpers) keep their place among the torso's joints: each
   nearest placed joint carries the metarig's point at its own offset, scaled by how much the fit spread those
   joints, weighted by inverse square distance (a leg's joints, placed by legs longer or shorter than the metarig's,
-  would spread them out of the body).
+  would spread them out of the body); their ends stay within ``helper_depth`` of the body's half-thickness from
+  the torso bone they hang from.
 - Bones whose part the skeleton lacks are removed (what hangs from them hangs from the nearest kept bone above): a
   tail, an arm, ears, the fingers of a hand that shows none, and the face of Rigify's human (a face rig needs eyes,
   lids and lips that no skeleton shows).
@@ -94,6 +95,8 @@ class MetarigTuning(TuningTable):
     merge: float = tuned(1e-6, "bone ends closer than this are one joint")
     shortest: float = tuned(0.002, "no placed bone is shorter than this")
     anchors: int = tuned(8, "a derived bone moves with this many placed torso joints nearest it in the metarig")
+    helper_depth: float = tuned(0.8, "... and its ends lie at most this share of the mesh's half-thickness from the "
+                                     "bone it hangs from (inside the body it deforms)")
     heel_reach: float = tuned(0.6, "the heel is looked for among the vertices within this many foot lengths of the "
                                    "ankle, across the ground")
     hock_bend: float = tuned(0.15, "a hind leg's shin with a joint this share of its length behind it bends there: "
@@ -287,6 +290,8 @@ def fit_metarig(skeleton, mesh, metarig, bones, tuning=MetarigTuning()):
             if bone is not None and (bone.parent is None or bone.parent in fit.heads):
                 fit.heads[name], fit.tails[name] = (_derived(np.asarray(point, float), meta_points, fitted_points,
                                                              tuning) for point in (bone.head, bone.tail))
+                if bone.parent in fit.heads:
+                    _within_body(fit, name, bone.parent, body, tuning)
                 fit.roles[name] = BoneRole(role, side)
     extra = [[template.replace("{s}", "L")] for template in (*spec.heels, *(name for name, _ in spec.derived))]
     _mirror_twins(fit, extra, (), tuning.mirror_tolerance * body.size, middle)
@@ -833,6 +838,22 @@ def _across(vector, axis):
     """The unit part of ``vector`` across unit ``axis`` (None when it runs along it)."""
     vector = np.asarray(vector, dtype=np.float64)
     return _unit(vector - (vector @ axis) * axis)
+
+
+def _within_body(fit, name, parent, body, tuning):
+    """Pull the ends of derived bone ``name`` towards its ``parent`` bone to at most ``helper_depth`` of the mesh's
+    half-thickness there (the distance from the parent's nearest point to the nearest vertex): a thin body's
+    pelvis and breast would stand out of it in the metarig's proportions."""
+    start, span = fit.heads[parent], fit.tails[parent] - fit.heads[parent]
+    for ends in (fit.heads, fit.tails):
+        point = ends[name]
+        share = np.clip((point - start) @ span / max(float(span @ span), 1e-300), 0.0, 1.0)
+        anchor = start + share * span
+        depth = float(np.linalg.norm(body.vertices - anchor @ body.frame.T, axis=1).min())  # in the mesh's frame
+        off = point - anchor
+        reach = float(np.linalg.norm(off))
+        if reach > tuning.helper_depth * depth:
+            ends[name] = anchor + off * (tuning.helper_depth * depth / reach)
 
 
 def _derived(point, meta_points, fitted_points, tuning):
