@@ -242,6 +242,27 @@ def test_a_humanoid_game_rig_has_hands_and_feet_though_its_limbs_end_without(pat
         assert all(names[bones.parents[k]] == f"{side}Hand" for k in fingers)
 
 
+def test_a_missing_foot_is_the_mesh_ahead_of_its_own_ankle():
+    """``foot_ahead`` on points: ankle at the origin, front +Y, up +Z, a foot 1 long expected. A paw of another leg
+    1.6 ahead with nothing between is no foot (the sample quadruped's hind foot ran to its front paw). A foot whose
+    vertices below the ankle begin only at its toes, 0.7 ahead, its instep above the ankle's height between, is one
+    (rignet_smith's). So is a box foot with no vertex between its back, 0.3 ahead, and its toe."""
+    from rigger.core.facing import Facing, foot_ahead
+
+    faced = Facing(np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0]), np.array([-1.0, 0.0, 0.0]), np.zeros(3),
+                   False)
+    ankle = np.zeros(3)
+
+    def points(*rows):
+        return np.array([(x, y, z) for y, z in rows for x in (-0.1, 0.1)])
+
+    assert foot_ahead(points((1.6, -0.1), (1.8, -0.1), (-0.1, -0.1)), ankle, faced, 1.0) is None
+    smith = foot_ahead(points((0.71, -0.3), (0.95, -0.3), (0.2, 0.1), (0.45, 0.1), (0.6, 0.05)), ankle, faced, 1.0)
+    assert smith is not None and smith[1][1] == pytest.approx(0.95)
+    box = foot_ahead(points((0.3, -0.1), (1.0, -0.1)), ankle, faced, 1.0)
+    assert box is not None and box[1][1] == pytest.approx(1.0)
+
+
 def test_a_hand_resting_on_the_hip_ends_at_its_fingertips_not_in_the_pelvis():
     """The hands-on-hips humanoid's arm ends where its hand touches the hip. The mesh on past that end, the hip's,
     counted as the hand's reach: the arm's roles had no hand, so the game rig's Hand went on from the forearm's end

@@ -24,6 +24,7 @@ from rigger.blender.headless import empty_scene  # noqa: E402
 from rigger.blender.pipeline import TARGET_PROPERTY, rig_object, skin_meshes  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
 from rigger.core.bodyplan import BodyPlan  # noqa: E402
+from rigger.core.facing import TORSO  # noqa: E402
 from rigger.core.metarig import METARIGS, MetarigTuning, choose_metarig, fit_metarig  # noqa: E402
 from rigger.core.roles import BoneRole, named_joints  # noqa: E402
 from rigger.core.skeleton import Skeleton  # noqa: E402
@@ -254,10 +255,19 @@ def test_rigifys_pelvis_and_breast_helpers_stay_inside_the_body(metarigs, name, 
     vertices, triangles = load_character(name)
     skeleton = rigger.rig_mesh(vertices, triangles)
     fit = fit_metarig(skeleton, (vertices, triangles), metarig, metarigs[metarig])
+    bones = {bone.name: bone for bone in metarigs[metarig]}
+    torso = [bone for chain in METARIGS[metarig].chains if TORSO in chain.roles for bone in chain.names(None)]
+
+    def share_of_torso(heads, tails, bone):  # a bone's length as a share of the torso's
+        return np.linalg.norm(np.subtract(tails[bone], heads[bone])) / sum(
+            np.linalg.norm(np.subtract(tails[other], heads[other])) for other in torso)
+
+    meta_heads, meta_tails = ({bone: getattr(bones[bone], end) for bone in bones} for end in ("head", "tail"))
     for helper in ("pelvis.L", "pelvis.R", "breast.L", "breast.R"):
         head, tail = (point @ fit.frame.T for point in (fit.heads[helper], fit.tails[helper]))  # the mesh's frame
         assert strictly_inside_fraction(vertices, triangles, head + np.linspace(0, 1, 11)[:, None] * (tail - head)) \
             >= 0.9, helper
+        assert share_of_torso(fit.heads, fit.tails, helper) <= 1.2 * share_of_torso(meta_heads, meta_tails, helper)
 
 
 def test_a_front_leg_hangs_from_the_end_of_its_shoulder_blade(metarigs):

@@ -56,19 +56,22 @@ def test_a_path_with_a_body_is_rooted_at_the_body():
 def test_loops_are_cut_where_parts_touch_and_the_result_is_a_tree():
     """A body (node 0 at the hips, node 1 at the chest, joined by a spine 2-5) with legs and a head, and an arm from
     the chest tapering to a hand that rests on the hips (nodes 6-14): the arm hangs whole from the chest, its tip
-    at the hips left off. A link straight from the hips to the chest (no node between) closing a second loop goes."""
+    at the hips left off. Feet touching, a link between the legs' tips (no node between) closing a second loop,
+    goes: each leg keeps its own foot."""
     spine = [(0.0, y, 1.0) for y in (1.0, 2.0, 3.0, 4.0)]
     arm = [(1.2 + 0.2 * k, 4.5 - 0.5 * k, 0.5 - 0.04 * k) for k in range(9)]
     limbs = [[(x, -y, 0.3) for y in range(1, 5)] for x in (-0.5, 0.5)] + [[(0.0, 5.0 + y, 0.6) for y in range(4)]]
     nodes = np.array([(0.0, 0.0, 1.5), (0.0, 5.0, 1.5)] + spine + arm + limbs[0] + limbs[1] + limbs[2])
     points, radius = nodes[:, :2], nodes[:, 2]
     leg_a, leg_b, head = (list(range(15 + 4 * k, 19 + 4 * k)) for k in range(3))
-    chains = [[0, 2, 3, 4, 5, 1], [1] + list(range(6, 15)) + [0], [0] + leg_a, [0] + leg_b, [1] + head, [0, 1]]
+    chains = [[0, 2, 3, 4, 5, 1], [1] + list(range(6, 15)) + [0], [0] + leg_a, [0] + leg_b, [1] + head,
+              [leg_a[-1], leg_b[-1]]]
     root, rooted = rooted_chains(points, [0, 1], chains, radius, TUNING)
     links = [(a, b) for chain in rooted for a, b in zip(chain.nodes, chain.nodes[1:])]
     assert len(links) == len({frozenset(link) for link in links}) == len(nodes) - 1  # every node once: a tree
     arm_chain = next(chain for chain in rooted if 6 in chain.nodes)
     assert arm_chain.nodes == [1] + list(range(6, 15))
+    assert {frozenset((leg_a[-1], leg_b[-1]))}.isdisjoint(frozenset(link) for link in links)
 
 
 def test_a_wide_branch_reaching_far_is_a_limb_not_a_bump():

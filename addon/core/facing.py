@@ -19,8 +19,10 @@ class FootTuning(TuningTable):
     ahead: float = tuned(2.0, "the foot is looked for among the vertices below the ankle up to this far ahead ...")
     beside: float = tuned(0.5, "... and this far beside it; ...")
     least: float = tuned(0.25, "... none when they reach less than this far ahead (a leg ending on a stump)")
-    gap: float = tuned(0.5, "the foot is one piece from the ankle on: it ends where the mesh ahead, up to this "
-                            "high above the ankle, has a gap this long (another leg's foot lies beyond)")
+    gap: float = tuned(0.8, "the foot is one piece from the ankle on: it ends where the mesh's vertices ahead have "
+                            "a gap this long (another leg's foot lies beyond; a box foot's are 0.7 apart) ...")
+    instep: float = tuned(0.5, "... counting those up to this high above the ankle (a foot's top, before its toes "
+                               "reach below the ankle)")
     ball_at: float = tuned(0.7, "the foot's ball lies this share of the way from the ankle to the tip")
 
 
@@ -134,13 +136,13 @@ def bones_middle(skeleton, bones):
 def foot_ahead(vertices, ankle, faced, length, tuning=FootTuning()):
     """(ball, tip) of a foot the skeleton lacks, from the mesh's ``vertices`` below the ``ankle`` and ahead of it (the
     :class:`Facing` ``faced``; within ``ahead`` and ``beside`` of the foot's expected ``length``), from the ankle on
-    up to the first ``gap`` in the mesh there: the tip where they reach farthest ahead, on their lowest level, the ball
-    ``ball_at`` of the way there; a leg ending at the ankle has its foot run forward along the ground, not on down the
-    shin. None when they reach less than ``least`` ahead."""
+    up to the first ``gap`` between the vertices there (up to ``instep`` above it): the tip where they reach farthest
+    ahead, on their lowest level, the ball ``ball_at`` of the way there; a leg ending at the ankle has its foot run
+    forward along the ground, not on down the shin. None when they reach less than ``least`` ahead."""
     offsets = np.asarray(vertices, dtype=np.float64) - ankle
     across, ahead, height = offsets @ faced.left, offsets @ faced.front, offsets @ faced.up
     near = (ahead >= 0) & (ahead <= tuning.ahead * length) & (np.abs(across) <= tuning.beside * length)
-    order = np.sort(ahead[near & (height < tuning.gap * length)])
+    order = np.sort(ahead[near & (height < tuning.instep * length)])
     breaks = np.flatnonzero(np.diff(np.r_[0.0, order]) > tuning.gap * length)
     near &= (height < 0) & (ahead < (order[breaks[0]] if len(breaks) else np.inf))
     if not near.any() or ahead[near].max() < tuning.least * length:

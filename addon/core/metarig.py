@@ -58,7 +58,7 @@ import numpy as np
 
 from .facing import TORSO, bones_middle, facing, foot_ahead, role_bones
 from .polyline import arc_lengths, arc_nearest, point_at
-from .roles import CHAINS, BoneRole, mesh_reach, named_joints, within_reach
+from .roles import CHAINS, BoneRole, RoleTuning, mesh_reach, named_joints, within_reach
 from .rotations import about, between
 from .tuning import TuningTable, tuned
 
@@ -510,10 +510,14 @@ def _fit_chain(body, chain, side, names, meta, tuning):
         return None
     lengths = np.array([np.linalg.norm(np.subtract(meta[name].tail, meta[name].head)) for name in names])
     noted = len(body.notes)
-    joints = _joints(body, groups, points, arc, step_roles, lengths, tuning, (skeleton_side, chain.digit), side)
+    own = set(body.bones_of(set(wanted) | {"finger", "toe"}, skeleton_side))  # the limb's, its digits' too
+    others = [bone for bone in range(len(body.roles)) if bone not in own]
+    joints = _joints(body, groups, points, arc, step_roles, lengths, tuning, (skeleton_side, chain.digit), side,
+                     others)
     if chain.hock and _bent(joints, chain.bend)[0] < 0:  # the first joint bends backward: it is the hock
         del body.notes[noted:]  # read again from the hock, which notes what it lacks itself
-        joints = _joints(body, _groups(chain.hock), points, arc, step_roles, lengths, tuning, side=side)
+        joints = _joints(body, _groups(chain.hock), points, arc, step_roles, lengths, tuning, side=side,
+                         others=others)
         joints[1] = _as_in_metarig(joints, [np.asarray(meta[name].head, float) for name in names[:3]], chain.bend)
     elif chain.hock:
         _hock(joints, body.local(points), tuning)
@@ -532,9 +536,9 @@ def _hock(joints, path, tuning):
     paw. The paw, from the old hock on, becomes the toe."""
     knee, low = joints[1], joints[2]
     reach = float(np.linalg.norm(low - knee))
-    inside = [point for point in path if np.linalg.norm(point - knee) > 1e-9 * reach and
-              np.linalg.norm(point - low) > 1e-9 * reach and (point - knee) @ (low - knee) > 0 and
-              (point - low) @ (knee - low) > 0]
+    arc = arc_lengths(path)
+    after, before = arc_nearest(path, arc, knee), arc_nearest(path, arc, low)
+    inside = [point for point, at in zip(path, arc) if after < at < before]
     if not inside or not reach > 0:
         return
     behind = [_bent(np.array([knee, point, low]), BACKWARD)[0] for point in inside]
@@ -547,12 +551,13 @@ def _groups(roles):
     return [role if isinstance(role, tuple) else (role,) for role in roles]
 
 
-def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None, side=None):
+def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None, side=None, others=()):
     """A chain's joints in the metarig's frame, its bones taking the role ``groups`` on the path ``points`` (arc
     lengths ``arc``) whose steps have the roles ``step_roles``; with ``named`` (the skeleton's side and digit), a
     joint where a role begins moves to that role's named joint when it is within reach, and the path ends where the
     role after the chain's begins (the torso at the neck's named joint). Roles the skeleton lacks are noted, on the
-    metarig's ``side``."""
+    metarig's ``side``; the mesh they go on into is not that nearer the skeleton's ``others`` bones (another part's:
+    a hip a hand rests on)."""
     after = body.joints.get((_next_role(groups[-1][-1]), *named)) if named is not None else None
     if after is not None and 0 < (end := arc_nearest(points, arc, after)) < arc[-1]:
         kept = int(np.searchsorted(arc, end, side="left"))
@@ -585,7 +590,9 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None, 
             arc = arc_lengths(points)
             spans[missing] = (arc[-3], arc[-1])
         else:
-            reach = mesh_reach(body.vertices, points[-1], direction, tuning.extend_most * wanted, body.size)
+            bones = (body.skeleton.heads[others], body.skeleton.tails[others]) if len(others) else None
+            reach = mesh_reach(body.vertices, points[-1], direction, tuning.extend_most * wanted, body.size, bones,
+                               RoleTuning().other_part * body.size)
             extended = reach >= tuning.extend * wanted
             if extended:
                 points = np.vstack([points, points[-1] + reach * direction])
@@ -842,7 +849,7 @@ def _across(vector, axis):
 
 def _within_body(fit, name, parent, body, tuning):
     """Pull the ends of derived bone ``name`` towards its ``parent`` bone to at most ``helper_depth`` of the mesh's
-    half-thickness there (the distance from the parent's nearest point to the nearest vertex): a thin body's
+    half-thickness there (the distance from the parent's nearest point to the nearest mesh vertex): a thin body's
     pelvis and breast would stand out of it in the metarig's proportions."""
     start, span = fit.heads[parent], fit.tails[parent] - fit.heads[parent]
     for ends in (fit.heads, fit.tails):
@@ -852,7 +859,7 @@ def _within_body(fit, name, parent, body, tuning):
         depth = float(np.linalg.norm(body.vertices - anchor @ body.frame.T, axis=1).min())  # in the mesh's frame
         off = point - anchor
         reach = float(np.linalg.norm(off))
-        if reach > tuning.helper_depth * depth:
+        if reach > tuning.helper_depth * depth and depth >= tuning.shortest * body.size:  # none: on the surface
             ends[name] = anchor + off * (tuning.helper_depth * depth / reach)
 
 

@@ -127,6 +127,8 @@ class RoleTuning(TuningTable):
                                    "the crown, not for a neck")
     spine_fall: float = tuned(0.02, "... on its spine up to where it falls this share of the height (a hunched "
                                     "figure's head hanging forward)")
+    other_part: float = tuned(0.01, "a share of the size: the mesh beyond a limb's end lying more than this nearer "
+                                    "another part's bone than that end is the other part's (a hip the hand rests on)")
     named_reach: float = tuned(0.75, "a target's joint moves to its named joint only within this share of its "
                                      "shortest bone (none shrinks below a quarter); farther off is another chain's")
 
@@ -169,7 +171,7 @@ def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
     for k, limb in enumerate(body.limbs):
         side = _limb_side(skeleton, graph, limb, left)
         part = layout.parts[k]
-        path = _TwinPath(body, limb)
+        path = _TwinPath(body, limb, tuning)
         if part == "leg":
             _leg(body, limb, path.points, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
         elif part == "arm":
@@ -246,9 +248,10 @@ class _TwinPath:
     ``reach`` beyond the last (:func:`_reach`), averaged with its twin's mirror image when both have as many joints:
     twins get their roles cut, and their joints placed, alike though the mesh mirrors only nearly."""
 
-    def __init__(self, body, limb):
+    def __init__(self, body, limb, tuning):
         nodes = list(limb.main)
         self.body, self.limb, self.points, self.radius = body, limb, body.graph.points[nodes], body.radius[nodes]
+        self.margin = tuning.other_part * body.size
         self.twin = twin = body.limbs[limb.twin] if limb.twin >= 0 else None
         self.mirrored = twin is not None and len(twin.main) == len(nodes) and body.plane is not None
         if self.mirrored:
@@ -257,10 +260,10 @@ class _TwinPath:
 
     @cached_property
     def reach(self):
-        reach = _reach(self.body, self.points, self.limb)
+        reach = _reach(self.body, self.points, self.limb, self.margin)
         if not self.mirrored:
             return reach
-        return 0.5 * (reach + _reach(self.body, self.body.plane.reflect(self.points), self.twin))
+        return 0.5 * (reach + _reach(self.body, self.body.plane.reflect(self.points), self.twin, self.margin))
 
 
 def _paths(limb):
@@ -427,9 +430,10 @@ def _shoulder(radius, arc, total, tuning):
     return int(np.searchsorted(middle, tuning.shoulder_at * total))
 
 
-def _reach(body, points, limb=None):
+def _reach(body, points, limb=None, margin=0.0):
     """How far the mesh goes on beyond the last of ``points``, along the last bone's direction (``mesh_reach``, up to
-    a quarter of the size); with the ``limb`` they run along, not the mesh nearer a bone off that limb."""
+    a quarter of the size); with the ``limb`` they run along, not the mesh nearer a bone off that limb by ``margin``
+    than to their end."""
     direction = points[-1] - points[-2]
     norm = np.linalg.norm(direction)
     if not norm > 0:
@@ -440,13 +444,13 @@ def _reach(body, points, limb=None):
         off = [bone for bone, (head, tail) in enumerate(zip(graph.head_node, graph.tail_node))
                if not (head in own and tail in own)]
         others = (graph.points[graph.head_node[off]], graph.points[graph.tail_node[off]]) if off else None
-    return mesh_reach(body.vertices, points[-1], direction / norm, 0.25 * body.size, body.size, others)
+    return mesh_reach(body.vertices, points[-1], direction / norm, 0.25 * body.size, body.size, others, margin)
 
 
-def mesh_reach(vertices, point, direction, limit, size, bones=None):
+def mesh_reach(vertices, point, direction, limit, size, bones=None, margin=0.0):
     """How far the mesh (its ``vertices``) goes on beyond ``point`` along ``direction`` (unit), up to ``limit``: its
     vertices within a tube as thick as the mesh is at ``point`` (at least 0.02 of the ``size``). With ``bones``
-    ((B, 3) heads and tails), not those nearer one of them than ``point`` by 0.01 of the size: that mesh is another
+    ((B, 3) heads and tails), not those nearer one of them than ``point`` by ``margin``: that mesh is another
     part's, which the limb's end touches (a hand resting on the hip)."""
     offsets = vertices - point
     along = offsets @ direction
@@ -455,7 +459,7 @@ def mesh_reach(vertices, point, direction, limit, size, bones=None):
     inside = (along > 0) & (across <= tube) & (along <= limit)
     if bones is not None and inside.any():
         nearest = segment_distances(vertices[inside], *bones).min(axis=1)
-        inside[inside] = np.linalg.norm(offsets[inside], axis=1) <= nearest + 0.01 * size
+        inside[inside] = np.linalg.norm(offsets[inside], axis=1) <= nearest + margin
     beyond = along[inside]
     return float(beyond.max()) if len(beyond) else 0.0
 
@@ -666,7 +670,7 @@ def joint_places(skeleton, body, layout, tuning=RoleTuning()):
         if part not in ("leg", "arm") or len(limb.main) < 2:
             continue
         side = _limb_side(skeleton, graph, limb, left)
-        path = _TwinPath(body, limb)
+        path = _TwinPath(body, limb, tuning)
         arc = arc_lengths(path.points)
         found = _leg_places(body, path, arc, layout.front[k], tuning) if part == "leg" else \
             _arm_places(body, limb, path, arc, tuning)
@@ -773,7 +777,7 @@ def _leg_places(body, path, arc, front, tuning):
     hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
     hip = _down_to(heights, arc, hip_height)
     thigh_from = float(arc[_thigh_start(body, points, tuning)])  # above, the path runs in the body
-    if front:  # a shoulder joint no higher than where the upper arm's bones begin (a bear's run along its blade)
+    if front and thigh_from < ankle:  # no higher than where the upper arm's bones begin (a bear's blade)
         hip = max(hip, thigh_from)
         hip_height = float(np.interp(hip, arc, heights))
     knee = _bent(points, arc, max(hip, thigh_from), hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
