@@ -8,6 +8,7 @@ from ...core.mirror import mirror_chain_pairs, mirror_completed
 from ...core.naming import bone_names
 from ...core.polyline import arc_lengths, nearest_on_segments, point_at, segment_distances
 from .depth import is_across
+from .outline import loop_edges
 
 
 class BoneBuilder:
@@ -337,11 +338,8 @@ def _body_line(sil, root_point, along, radius):
     reach = max(1, int(radius / sil.cell))  # a part's bumps are no bends of the body: smoothed over its disc
     padded = np.pad(np.array(depths), reach, mode="edge")
     depths = np.r_[depth[0], np.convolve(padded, np.full(2 * reach + 1, 1.0 / (2 * reach + 1)), mode="valid")[1:]]
-    flat = np.c_[line2d, np.zeros(len(line2d))]
-    outline = [np.c_[loop, np.zeros(len(loop))] for loop in sil.loops]
-    starts = np.concatenate(outline)
-    ends = np.concatenate([np.roll(loop, -1, axis=0) for loop in outline])
-    widths = np.concatenate([segment_distances(flat[k:k + 64], starts, ends).min(axis=1)
-                             for k in range(0, len(flat), 64)])  # in blocks: a fine outline has many segments
+    outline = loop_edges(sil.loops)
+    widths = np.concatenate([segment_distances(line2d[k:k + 64], *outline).min(axis=1)
+                             for k in range(0, len(line2d), 64)])  # in blocks: a fine outline has many segments
     widths[0] = radius
     return sil.lift(line2d, depths), widths
