@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from rigger.core import bvh, objfile
+from rigger.core.accessories import barycentric, boneless_parts, surface_entries
 from rigger.core.mesh import Mesh, triangulate_polygons
 from rigger.core.params import Param, resolve
 from rigger.core.skeleton import Skeleton
@@ -439,3 +440,36 @@ def test_the_character_is_the_main_mesh_and_what_reaches_it_not_a_floor_or_a_mes
     assert character_parts(parts) == expected
     turn = np.array([[0.6, -0.64, 0.48], [0.8, 0.48, -0.36], [0.0, 0.6, 0.8]])  # a rotation
     assert character_parts([(name, points @ turn.T) for name, points in parts]) == expected
+
+
+def cube(centre, half):
+    """A closed box's 8 corners and 12 triangles."""
+    corners = np.array([(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half + np.array(centre)
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6), (0, 2, 6),
+             (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    return corners, np.array(faces)
+
+
+def test_accessories_are_the_loose_parts_no_bone_runs_through_the_body_never_one():
+    parts = [cube((0, 0, 0), 1.0), cube((0, 0, 3), 0.2), cube((3, 0, 0), 0.2), cube((0, 0, 9), 0.1)]
+    points = np.concatenate([corners for corners, _ in parts])
+    triangles = np.concatenate([faces + 8 * k for k, (_, faces) in enumerate(parts)])
+    points = np.vstack([points, [(5.0, 5.0, 5.0)]])  # a point in no triangle: a part of its own
+    heads, tails = np.array([(0, 0, -0.5), (0, 0, 2.5)]), np.array([(0, 0, 2.5), (0, 0, 3.5)])  # into the 2nd box
+    part_of, boneless = boneless_parts(points, triangles, heads, tails)
+    assert part_of.tolist() == [0] * 8 + [1] * 8 + [2] * 8 + [3] * 8 + [4]
+    assert boneless.tolist() == [False, False, True, True, True]
+    _, boneless = boneless_parts(points, triangles, heads + 10, tails + 10)  # no bone anywhere near
+    assert boneless.tolist() == [False, True, True, True, True]  # the largest part stays the body
+
+
+def test_points_on_a_surface_take_the_blend_of_their_triangles_corner_weights():
+    a, b, c = np.eye(3)
+    points = np.array([(a + b + c) / 3, a, 0.5 * (b + c)])
+    coordinates = barycentric(points, np.tile(a, (3, 1)), np.tile(b, (3, 1)), np.tile(c, (3, 1)))
+    np.testing.assert_allclose(coordinates, [(1 / 3, 1 / 3, 1 / 3), (1, 0, 0), (0, 0.5, 0.5)], atol=1e-12)
+    donors = (np.array([0, 1, 1, 2]), np.array([0, 0, 1, 1]), np.array([1.0, 0.5, 0.5, 1.0]))  # vertex, bone, weight
+    point, bone, weight = surface_entries(np.tile([0, 1, 2], (3, 1)), coordinates, donors)
+    dense = np.zeros((3, 2))
+    dense[point, bone] = weight
+    np.testing.assert_allclose(dense, [(0.5, 0.5), (1.0, 0.0), (0.25, 0.75)], atol=1e-12)

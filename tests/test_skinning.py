@@ -17,6 +17,9 @@ from conftest import shared_path
 
 bpy = pytest.importorskip("bpy")
 import bmesh  # noqa: E402  (Blender's own module, importable once bpy is)
+from mathutils import Vector  # noqa: E402
+from mathutils.bvhtree import BVHTree  # noqa: E402
+from mathutils.interpolate import poly_3d_calc  # noqa: E402
 
 from rigger import samples  # noqa: E402
 from rigger.blender import skinning  # noqa: E402
@@ -262,53 +265,121 @@ def test_a_uv_split_skirt_is_weighted_by_bone_heat_on_the_welded_mesh(scene):
     assert report.level == "INFO"
 
 
-def add_loose_parts(obj):
+def add_accessories(obj):
     """Armour plates around the humanoid's waist (each its own loose part, hidden behind the body from every bone),
-    an eye inside the head (an inner shell), and two kinds of debris exported meshes carry: a sliver (a face whose
-    corners lie on one line) and a speck (faces collapsed to one point). Returns the speck's vertex indices."""
+    an eye inside the head, a tooth inside its lower front, and two kinds of debris exported meshes carry: a sliver
+    (a face whose corners lie on one line) and a speck (faces collapsed to one point). No bone runs through any of
+    them. Returns the vertex indices of each, by name."""
     segments = 6
+    first = len(obj.data.vertices)
     work, faces = surface_of_revolution(obj.data, [(0.2, 1.0), (0.3, 0.75)], segments)
     bmesh.ops.split_edges(work, edges=list({edge for face in faces for edge in face.edges}))
     for face in faces:  # shrink each plate so that no welding joins it to the next
         centre = face.calc_center_median()
         for vertex in face.verts:
             vertex.co = centre + 0.9 * (vertex.co - centre)
-    eye = bmesh.ops.create_icosphere(work, subdivisions=1, radius=0.02)["verts"]
-    bmesh.ops.translate(work, verts=eye, vec=(0.03, -0.06, 1.68))
+    work.verts.index_update()
+    parts = {"plates": np.arange(first, len(work.verts))}
+    for name, centre in (("eye", (0.03, -0.06, 1.68)), ("tooth", (0.0, -0.07, 1.61))):
+        sphere = bmesh.ops.create_icosphere(work, subdivisions=1, radius=0.02)["verts"]
+        bmesh.ops.translate(work, verts=sphere, vec=centre)
+        work.verts.index_update()
+        parts[name] = np.array([vertex.index for vertex in sphere])
     work.faces.new([work.verts.new((-0.5, 0.5, 0.5 + 0.01 * k)) for k in range(3)])
     speck = [work.verts.new((0.5, 0.5, 0.5)) for _ in range(4)]
     work.faces.new(speck[:3])
     work.faces.new(speck[1:])
     work.verts.index_update()
-    speck_indices = np.array([vertex.index for vertex in speck])
+    parts["speck"] = np.array([vertex.index for vertex in speck])
     work.to_mesh(obj.data)
     work.free()
-    return speck_indices
+    return parts
 
 
-def test_loose_parts_and_inner_shells_are_repaired_part_by_part_then_by_distance(scene):
+def surface_blend(obj, table, body, points):
+    """Weights at the point of ``obj``'s faces among vertices ``body`` nearest to each of ``points``: its face's
+    corner weights (rows of ``table``) blended by Blender's own barycentric interpolation."""
+    positions = mesh_vertices(obj.data)
+    inside = np.zeros(len(positions), dtype=bool)
+    inside[body] = True
+    obj.data.calc_loop_triangles()
+    faces = [list(triangle.vertices) for triangle in obj.data.loop_triangles if inside[list(triangle.vertices)].all()]
+    tree = BVHTree.FromPolygons(positions.tolist(), faces)
+    blended = []
+    for point in points:
+        location, _, face, _ = tree.find_nearest(Vector(point))
+        corners = faces[face]
+        shares = poly_3d_calc([Vector(positions[corner]) for corner in corners], location)
+        blended.append(np.array(shares) @ table[corners])
+    return np.array(blended)
+
+
+def test_accessories_take_the_weights_of_the_surface_they_sit_on(scene):
+    """Bone heat on an ogre's tongue, which sees the throat, gave it the neck: turning the head pushed it out through
+    the cheek. A loose part no bone runs through now takes the weights of the body's surface nearest to it, and is
+    left out of bone heat: the hidden plates, which made the heat system singular, no longer do."""
     obj, armature = character_with_rig("humanoid")
-    speck = add_loose_parts(obj)
+    body = len(obj.data.vertices)
+    parts = add_accessories(obj)
+    report = skinning.skin(obj, armature)
+    assert not report.messages and report.level == "INFO"
+    assert stage_names(report) == ["bone heat", "surface weights"]
+    assert report.stages[0].weighted == body and report.stages[1].weighted == report.vertices - body
+    assert report.stages[1].note == "10 loose parts no bone runs through"  # 6 plates, eye, tooth, sliver, speck
+    assert f"{report.vertices - body} vertices of 10 loose parts" in report.summary()
+    assert_skinned(obj, armature, report, checked=slice(body))
+    table = rigdata.vertex_weights(obj, bone_names(armature))
+    accessories = np.arange(body, report.vertices)
+    points = mesh_vertices(obj.data)[accessories]
+    np.testing.assert_allclose(table[accessories], surface_blend(obj, table, np.arange(body), points), atol=1e-5)
+    names = bone_names(armature)
+    for part, bone in (("eye", "head_top"), ("tooth", "head")):  # above and below the head's joint (bones are
+        # named after the joint they end at)
+        assert names[table[parts[part]].sum(axis=0).argmax()] == bone
+    assert len({tuple(row) for row in table[parts["speck"]]}) == 1  # the coincident vertices get the same weights
+
+
+def add_hidden_halves(obj):
+    """Two half-bands around the humanoid's waist, out of the body (the back one a little wider, so that no welding
+    joins them): the spine and the hips run through the box of each, but the body hides them from every bone, so
+    Blender's heat system is singular."""
+    work = bmesh.new()
+    work.from_mesh(obj.data)
+    for half in (0, 1):
+        widen = 1.0 + 0.05 * half
+        rings = [[work.verts.new((widen * radius * math.cos(math.pi * (half + step / 2)),
+                                  widen * radius * math.sin(math.pi * (half + step / 2)), height)) for step in range(3)]
+                 for radius, height in ((0.2, 1.0), (0.3, 0.75))]
+        for step in range(2):
+            work.faces.new((rings[0][step], rings[1][step], rings[1][step + 1], rings[0][step + 1]))
+    work.to_mesh(obj.data)
+    work.free()
+
+
+def test_loose_parts_hidden_from_every_bone_are_repaired_part_by_part_then_by_distance(scene):
+    obj, armature = character_with_rig("humanoid")
+    add_hidden_halves(obj)
+    bead = add_bead(obj, samples.ground_truth_bones("humanoid").heads[0])  # on a bone: one point no heat reaches
     report = skinning.skin(obj, armature)
     assert any(skinning.FAILURE_MESSAGE in message for message in report.stages[0].messages)
     assert stage_names(report) == ["bone heat", "island bone heat", "nearest bones"]
     heat, islands, nearest = report.stages
-    assert heat.weighted == 0  # the hidden plates make the heat system singular
-    assert islands.weighted == report.vertices - len(speck) and nearest.weighted == len(speck)
-    assert islands.note == "9 of 10 loose parts tried"  # a speck has no faces left
+    assert heat.weighted == 0  # the hidden halves make the heat system singular
+    assert islands.weighted == report.vertices - len(bead) and nearest.weighted == len(bead)
+    assert islands.note == "3 of 4 loose parts tried"  # the bead has no faces left
     assert_skinned(obj, armature, report)
-    assert report.level == "WARNING" and "nearest bones 4" in report.summary()
+    assert report.level == "WARNING" and f"nearest bones {len(bead)}" in report.summary()
     table = rigdata.vertex_weights(obj, bone_names(armature))
-    assert len({tuple(row) for row in table[speck]}) == 1  # the four coincident vertices get the same weights
+    assert len({tuple(row) for row in table[bead]}) == 1  # the coincident vertices get the same weights
 
 
 def add_bead(obj, centre, size=2e-6):
     """A flat-shaded bead of debris, far smaller than the weld distance: a tetrahedron whose faces each have their
-    own corners (12 vertices at 4 places, 4 normals). Welded, it is one vertex without a face, which only the
-    nearest-bones fallback weights. Returns its vertex indices."""
+    own corners (12 vertices at 4 places, 4 normals), the first at ``centre``. Welded, it is one vertex there without
+    a face, which only the nearest-bones fallback weights when a bone runs through it. Returns its vertex indices."""
     work = bmesh.new()
     work.from_mesh(obj.data)
-    corners = np.array([(1, 1, 1), (1, -1, -1), (-1, 1, -1), (-1, -1, 1)]) * size + np.array(centre)
+    corners = np.array([(0, 0, 0), (2, 0, 0), (0, 2, 0), (0, 0, 2)]) * size + np.array(centre)
     first = len(work.verts)
     for face in ((0, 1, 2), (0, 3, 1), (0, 2, 3), (1, 3, 2)):
         work.faces.new([work.verts.new(corners[corner]) for corner in face])
@@ -318,16 +389,16 @@ def add_bead(obj, centre, size=2e-6):
 
 
 def test_every_repair_stage_weights_a_seams_copies_alike(scene):
-    """A seam-split body among loose parts: bone heat fails on the whole, each part is weighted alone (the split body
-    welded), and the bead between the knees goes to the nearest bones. The fallback's facing penalty took each copy's
-    own face normal: the bead's copies were up to 0.74 of a bone's weight apart, for one point in space."""
+    """A seam-split body beside hidden half-bands: bone heat fails on the whole, each part is weighted alone (the split
+    body welded), and the bead on a bone goes to the nearest bones. The fallback's facing penalty took each
+    copy's own face normal: a bead's copies were up to 0.74 of a bone's weight apart, for one point in space."""
     obj, armature = character_with_rig("humanoid")
     split_between_bones(obj, samples.ground_truth_bones("humanoid"))
-    speck = add_loose_parts(obj)
-    bead = add_bead(obj, (0.0, 0.0, 0.3))
+    add_hidden_halves(obj)
+    bead = add_bead(obj, samples.ground_truth_bones("humanoid").heads[0])
     report = skinning.skin(obj, armature)
     assert stage_names(report) == ["bone heat", "island bone heat", "nearest bones"]
-    assert report.stages[0].weighted == 0 and report.stages[2].weighted == len(speck) + len(bead)
+    assert report.stages[0].weighted == 0 and report.stages[2].weighted == len(bead)
     assert_skinned(obj, armature, report, nearest_share=0.8)
     assert_seams_weighted_alike(obj, armature)
     table = rigdata.vertex_weights(obj, bone_names(armature))
@@ -356,7 +427,9 @@ def test_a_real_model_on_which_bone_heat_fails_unwelded_is_weighted_welded(scene
     obj, armature, head_joint, rig = shared_model("Quaternius_Fox")
     report = skinning.skin(obj, armature)
     assert not report.messages and report.welded > 0
-    assert stage_names(report) == ["bone heat"] and report.stages[0].weighted == report.vertices
+    assert stage_names(report) == ["bone heat", "surface weights"]  # its eyes and nose tip sit on the head
+    assert report.stages[1].note == "3 loose parts no bone runs through"
+    assert sum(stage.weighted for stage in report.stages) == report.vertices
     assert_skinned(obj, armature, report, nearest_share=0.8)
     assert_seams_weighted_alike(obj, armature)
     # the weights mostly agree with the artist's: the dominant bone starts at the artist's dominant joint

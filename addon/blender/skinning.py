@@ -13,11 +13,16 @@ leave vertices unweighted with no message. In bpy 4.2 and 5.0 the message goes t
 (measured: nothing reaches file descriptor 1), so it is captured with ``contextlib.redirect_stdout``; unweighted
 vertices are counted directly.
 
-:func:`skin` runs bone heat on a temporary welded copy of the mesh, then repairs only what is still unweighted:
+:func:`skin` runs bone heat on a temporary welded copy of the mesh, its accessories left out (below), then repairs
+only what is still unweighted:
 
 1. bone heat on each loose part of the welded mesh alone, for the parts still unweighted;
 2. ``rigger.weights.bone_weights``: the nearest few bones by distance, which always succeeds (its facing penalty
    takes area-weighted normals of the welded mesh, so a seam's copies face alike).
+
+Last, the accessories, the loose parts no bone runs through (``rigger.core.accessories``: eyes, teeth, nails,
+plates), take the weights of the nearest point on the other parts' surface, so they move with what they sit on. Left
+out of bone heat, they neither hide the body's bones from it nor, hidden themselves, make its heat system singular.
 
 Every stage uses the mesh's own vertex positions (before modifiers) in world space, as Blender's bone heat does when
 parenting, except that with a Subsurf modifier Blender's bone heat takes each vertex's place on the limit surface:
@@ -33,7 +38,10 @@ from dataclasses import asdict, dataclass, field
 import bpy
 import bmesh
 import numpy as np
+from mathutils import Vector
+from mathutils.bvhtree import BVHTree
 
+from ..core.accessories import barycentric, boneless_parts, surface_entries
 from ..core.arrays import column_bounds, concatenated_ranges
 from ..core.graphs import components
 from ..weights import bone_weights, vertex_normals
@@ -44,6 +52,7 @@ GROUPS_PROPERTY = "rigger_vertex_groups"  # mesh object property: JSON list of t
 FAILURE_MESSAGE = "Bone Heat Weighting: failed to find solution"
 WELD_DISTANCE = 1e-5  # fraction of the mesh's largest extent under which two vertices are one (UV-seam duplicates)
 TEMPORARY_NAME = "Rigger skinning"
+SURFACE_STAGE = "surface weights"  # the accessories' stage (core.accessories)
 
 
 @dataclass
@@ -62,7 +71,8 @@ class SkinReport:
     """What :func:`skin` did.
 
     ``stages`` lists the stages that ran, first ``"bone heat"`` on the welded mesh (``weighted`` = the vertices it
-    weighted), then any of ``"island bone heat"`` and ``"nearest bones"`` (``weighted`` = the vertices each fixed).
+    weighted), then any of ``"island bone heat"`` and ``"nearest bones"`` (``weighted`` = the vertices each fixed),
+    and last ``"surface weights"`` when the mesh has accessories (``weighted`` = their vertices).
     ``welded`` counts the vertices merged into another at the same place before weighting (they share its weights),
     ``bone_heat_result`` is the operator's return value, ``unweighted`` the vertices left without any deforming
     weight at the end (always 0), ``warnings`` human-readable sentences about anything that went wrong.
@@ -95,14 +105,19 @@ class SkinReport:
                f"{self.seconds:.2f} s"
         if self.welded:
             head += f", {self.welded} seam vertices welded"
+        surface = next((stage for stage in self.stages if stage.name == SURFACE_STAGE), None)
+        if surface is not None:
+            head += f", {surface.weighted} vertices of {surface.note} weighted as the surface they sit on"
         if not self.warnings:
-            return f"{head}, bone heat weighted every vertex"
+            return f"{head}, bone heat weighted every other vertex" if surface else \
+                f"{head}, bone heat weighted every vertex"
         parts = []
         if any(FAILURE_MESSAGE in message for message in self.messages):
             parts.append("bone heat failed")
-        unweighted = self.vertices - self.stages[0].weighted
+        repairs = [stage for stage in self.stages[1:] if stage is not surface]
+        unweighted = sum(stage.weighted for stage in repairs)
         if unweighted:
-            fixes = ", ".join(f"{stage.name} {stage.weighted}" for stage in self.stages[1:] if stage.weighted)
+            fixes = ", ".join(f"{stage.name} {stage.weighted}" for stage in repairs if stage.weighted)
             parts.append(f"{unweighted} vertices repaired ({fixes})")
         if self.unweighted:
             parts.append(f"{self.unweighted} STILL UNWEIGHTED")
@@ -133,22 +148,26 @@ def skin(mesh_obj, armature_obj):
 
     weld = _welded(mesh_obj)
     report.welded = report.vertices - len(weld.positions)
+    accessories = _Accessories.of(weld, *_world_bones(armature_obj, bone_names))
+    body = accessories.body
     stage = SkinStage("bone heat", note=f"{report.welded} seam vertices welded" if report.welded else "")
-    result, entries, stage.messages = _bone_heat_weights(weld.positions, weld.triangles, armature_obj, bone_names,
+    result, entries, stage.messages = _bone_heat_weights(body.positions, body.triangles, armature_obj, bone_names,
                                                          weld.subsurf)
     report.bone_heat_result = ",".join(sorted(result))
-    weighted = np.zeros(report.vertices, dtype=bool)
-    stage.weighted = _transfer(mesh_obj, bone_names, entries, np.arange(report.vertices), weld.map, weighted)
+    weighted = accessories.on_original.copy()  # weighted last, from the surface they sit on
+    targets = np.flatnonzero(~weighted)
+    stage.weighted = _transfer(mesh_obj, bone_names, entries, targets, body.map[targets], weighted)
     stage.seconds = time.perf_counter() - started
     report.stages.append(stage)
     for message in stage.messages:
         report.warnings.append(f"Bone heat printed: {message}")
     if not weighted.all():
-        report.warnings.append(f"Bone heat left {report.vertices - stage.weighted} of {report.vertices} vertices "
-                               f"unweighted")
-        _repair_islands(mesh_obj, armature_obj, bone_names, weighted, weld, report)
+        report.warnings.append(f"Bone heat left {int((~weighted).sum())} of {len(targets)} vertices unweighted")
+        _repair_islands(mesh_obj, armature_obj, bone_names, weighted, body, report)
         if not weighted.all():
-            _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report)
+            _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, body, report)
+    if accessories.parts:
+        _weigh_accessories(mesh_obj, bone_names, weld, accessories, report)
 
     report.unweighted = int((~weighted).sum())
     if report.unweighted:
@@ -240,15 +259,17 @@ def _bind(mesh_obj, armature_obj, bone_names):
     mesh_obj[GROUPS_PROPERTY] = json.dumps(bone_names)
 
 
-def weight_entries(obj, bone_names):
-    """Every positive deforming weight of ``obj`` as (vertex, bone index into ``bone_names``, weight) arrays."""
+def weight_entries(obj, bone_names, vertices=None):
+    """Every positive deforming weight of ``obj`` (of its ``vertices`` only, given indices) as (vertex, bone index
+    into ``bone_names``, weight) arrays."""
     column = {}
     for index, name in enumerate(bone_names):
         group = obj.vertex_groups.get(name)
         if group is not None:
             column[group.index] = index
+    chosen = obj.data.vertices if vertices is None else [obj.data.vertices[i] for i in vertices]
     vertices, bones, weights = [], [], []
-    for vertex in obj.data.vertices:
+    for vertex in chosen:
         for element in vertex.groups:
             bone = column.get(element.group)
             if bone is not None and element.weight > 0:
@@ -311,6 +332,33 @@ def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report):
                   f"The remaining {len(targets)} vertices were weighted by their nearest bones (distance fallback)")
 
 
+def _weigh_accessories(mesh_obj, bone_names, weld, accessories, report):
+    """Last stage: each vertex of an accessory takes the weights of the nearest point on the body's surface, blended
+    from its triangle's corners as the stages before weighted them."""
+    started = time.perf_counter()
+    body = accessories.body
+    tree = BVHTree.FromPolygons(body.positions.tolist(), body.triangles.tolist(), all_triangles=True)
+    nearest = [tree.find_nearest(Vector(point)) for point in weld.positions[accessories.welded].tolist()]
+    corners = body.triangles[[hit[2] for hit in nearest]]
+    coordinates = barycentric(np.array([hit[0] for hit in nearest]),
+                              *(body.positions[corners[:, k]] for k in range(3)))
+    originals = np.flatnonzero(body.map >= 0)
+    first_copy = np.empty(len(body.positions), dtype=np.int64)
+    first_copy[body.map[originals[::-1]]] = originals[::-1]
+    vertices, bones, weights = weight_entries(mesh_obj, bone_names, first_copy[np.unique(corners)].tolist())
+    points, bones, weights = surface_entries(corners, coordinates, (body.map[vertices], bones, weights))
+    local = np.full(len(weld.positions), -1)
+    local[accessories.welded] = np.arange(len(accessories.welded))
+    targets = np.flatnonzero(accessories.on_original)
+    for name in bone_names:  # bone heat may have weighted them, with the whole mesh, before
+        mesh_obj.vertex_groups[name].remove(targets.tolist())
+    stage = SkinStage(SURFACE_STAGE, note=f"{accessories.parts} loose parts no bone runs through")
+    stage.weighted = _transfer(mesh_obj, bone_names, (points, bones, weights), targets, local[weld.map[targets]],
+                               np.zeros(report.vertices, dtype=bool))
+    stage.seconds = time.perf_counter() - started
+    report.stages.append(stage)
+
+
 def _finish_stage(stage, started, report, sentence):
     stage.seconds = time.perf_counter() - started
     report.stages.append(stage)
@@ -337,6 +385,30 @@ class Weld:
     positions: np.ndarray
     triangles: np.ndarray
     subsurf: bool
+
+
+@dataclass
+class _Accessories:
+    """The welded mesh split into its accessories (``core.accessories``) and the body they sit on: ``body`` a
+    :class:`Weld` of the other parts, whose map sends each original vertex to its body vertex (-1 on an accessory);
+    ``on_original`` (N,) which original vertices lie on an accessory, ``welded`` the accessories' welded vertices,
+    ``parts`` how many accessories there are."""
+
+    body: Weld
+    on_original: np.ndarray
+    welded: np.ndarray
+    parts: int
+
+    @classmethod
+    def of(cls, weld, heads, tails):
+        part_of, boneless = boneless_parts(weld.positions, weld.triangles, heads, tails)
+        accessory = boneless[part_of]
+        kept = np.flatnonzero(~accessory)
+        local = np.full(len(weld.positions), -1)
+        local[kept] = np.arange(len(kept))
+        body = Weld(local[weld.map], weld.positions[kept], local[weld.triangles[~accessory[weld.triangles[:, 0]]]],
+                    weld.subsurf)
+        return cls(body, accessory[weld.map], np.flatnonzero(accessory), int(boneless.sum()))
 
 
 def _welded(mesh_obj):

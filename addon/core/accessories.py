@@ -1,0 +1,85 @@
+"""Accessories: the loose parts of a mesh that no bone runs through (an eye, a tooth, a nail, a button, a plate).
+
+Such a part has no bone of its own, so any bone's weight on it is a guess: bone heat on an ogre's tongue, which
+sees the throat, gave it the neck, and turning the head pushed the tongue out through the cheek. An accessory
+instead takes the weights of the nearest surface of the parts bones do run through (``rigger.blender.skinning``),
+so it moves with what it sits on or in and cannot poke through it.
+"""
+import numpy as np
+
+from .arrays import concatenated_ranges
+from .graphs import components
+
+
+def boneless_parts(positions, triangles, heads, tails):
+    """(part of each point (N,), boneless (P,) bool) for a mesh (its seams welded) and its bones: the loose parts
+    (points joined by triangles; a point in none is a part of its own) and which of them are accessories, the
+    parts whose bounding box no bone segment (``heads`` to ``tails``, (B, 3)) crosses. The largest part is never
+    one: it is the body the others sit on."""
+    positions = np.asarray(positions, dtype=np.float64)
+    triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    part_of = components(len(positions), np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]]]))
+    count = int(part_of.max()) + 1 if len(part_of) else 0
+    low = np.full((count, 3), np.inf)
+    high = np.full((count, 3), -np.inf)
+    np.minimum.at(low, part_of, positions)
+    np.maximum.at(high, part_of, positions)
+    crossed = np.zeros(count, dtype=bool)
+    for head, tail in zip(np.asarray(heads, dtype=np.float64), np.asarray(tails, dtype=np.float64)):
+        crossed |= _segment_crosses(head, tail, low, high)
+    boneless = ~crossed
+    if count:
+        boneless[np.argmax(np.bincount(part_of, minlength=count))] = False
+    return part_of, boneless
+
+
+def _segment_crosses(head, tail, low, high):
+    """(P,) bool: the segment from ``head`` to ``tail`` meets the boxes ``low``..``high`` ((P, 3) corners); the slab
+    test, clipping the segment's parameter range to each axis's slab in turn."""
+    enter = np.zeros(len(low))
+    leave = np.ones(len(low))
+    for axis in range(3):
+        start, step = head[axis], tail[axis] - head[axis]
+        if step == 0:
+            outside = (start < low[:, axis]) | (start > high[:, axis])
+            leave = np.where(outside, -1.0, leave)
+            continue
+        first, second = (low[:, axis] - start) / step, (high[:, axis] - start) / step
+        enter = np.maximum(enter, np.minimum(first, second))
+        leave = np.minimum(leave, np.maximum(first, second))
+    return enter <= leave
+
+
+def surface_entries(corners, barycentric, donor_entries):
+    """The weights at points on a weighted surface: (point, bone, weight) arrays, each point's weights summing to
+    those of its triangle's corners blended by ``barycentric``. ``corners`` (A, 3) are the vertices of the triangle
+    each point lies on, ``barycentric`` (A, 3) its coordinates there, ``donor_entries`` the surface's (vertex, bone,
+    weight) arrays."""
+    vertices, bones, weights = (np.asarray(array) for array in donor_entries)
+    order = np.argsort(vertices, kind="stable")
+    vertices, bones, weights = vertices[order], bones[order], weights[order]
+    flat = np.asarray(corners, dtype=np.int64).ravel()
+    starts = np.searchsorted(vertices, flat, side="left")
+    counts = np.searchsorted(vertices, flat, side="right") - starts
+    picked = concatenated_ranges(starts, counts)
+    points = np.repeat(np.arange(len(flat)) // 3, counts)
+    share = np.repeat(np.asarray(barycentric, dtype=np.float64).ravel(), counts) * weights[picked]
+    bone_count = int(bones.max()) + 1 if len(bones) else 1
+    keys, summed = np.unique(points * bone_count + bones[picked], return_inverse=True)
+    totals = np.bincount(summed.ravel(), share, minlength=len(keys))
+    kept = totals > 0
+    return keys[kept] // bone_count, keys[kept] % bone_count, totals[kept]
+
+
+def barycentric(points, a, b, c):
+    """(A, 3) barycentric coordinates of ``points`` (A, 3) in triangles ``a``, ``b``, ``c`` (A, 3 each), the points
+    lying on them; a degenerate triangle gives its first corner everything."""
+    ab, ac, ap = b - a, c - a, points - a
+    d00, d01, d11 = (ab * ab).sum(1), (ab * ac).sum(1), (ac * ac).sum(1)
+    d20, d21 = (ap * ab).sum(1), (ap * ac).sum(1)
+    area = d00 * d11 - d01 * d01
+    safe = np.where(area > 0, area, 1.0)
+    v = np.where(area > 0, (d11 * d20 - d01 * d21) / safe, 0.0)
+    w = np.where(area > 0, (d00 * d21 - d01 * d20) / safe, 0.0)
+    result = np.clip(np.stack([1.0 - v - w, v, w], axis=1), 0.0, None)  # rounding may put a point just outside
+    return result / result.sum(1, keepdims=True)
