@@ -3,10 +3,11 @@ of a vertex that seams split weighted alike.
 
 The generated characters are skinned with their own true skeletons. Seams are made as UV unwrapping and flat shading
 make them: the body split where its parts meet, a flat-shaded (UV-split) skirt whose faces, each its own piece, would
-hide behind the body and make bone heat fail on the split mesh. Bone heat's failures are forced with real geometry:
-loose parts (plates hidden behind the body, an eye inside the head, a sliver and a speck of collapsed faces, a
-flat-shaded bead of debris) that need every stage of the repair ladder. Quaternius' fox from ../shared fails in
-Blender as the skirt would; CesiumMan and rignet_smith cracked open at their seams.
+hide behind the body and make bone heat fail on the split mesh. Accessories (plates around the waist, an eye and a
+tooth inside the head, a sliver and a speck of collapsed faces) sit on the body. Bone heat's failures are forced with
+real geometry: half-bands the body hides from the bones running through them, and a flat-shaded bead of debris on a
+bone, which need every stage of the repair ladder. Quaternius' fox from ../shared fails in Blender as the skirt
+would; CesiumMan and rignet_smith cracked open at their seams.
 """
 import math
 
@@ -337,6 +338,17 @@ def test_accessories_take_the_weights_of_the_surface_they_sit_on(scene):
         # named after the joint they end at)
         assert names[table[parts[part]].sum(axis=0).argmax()] == bone
     assert len({tuple(row) for row in table[parts["speck"]]}) == 1  # the coincident vertices get the same weights
+
+
+def test_a_mesh_without_faces_has_no_accessories(scene):
+    """Each point its own part, no bone through most: they would sit on a body without a face."""
+    obj, armature = character_with_rig("humanoid")
+    points = mesh_vertices(obj.data)[::7]
+    cloud = mesh_object("cloud", points, np.zeros((0, 3), dtype=np.int64))
+    cloud.matrix_world = obj.matrix_world
+    report = skinning.skin(cloud, armature)
+    assert skinning.SURFACE_STAGE not in stage_names(report) and report.unweighted == 0
+    assert_skinned(cloud, armature, report)
 
 
 def add_hidden_halves(obj):

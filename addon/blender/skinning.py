@@ -350,8 +350,6 @@ def _weigh_accessories(mesh_obj, bone_names, weld, accessories, report):
     local = np.full(len(weld.positions), -1)
     local[accessories.welded] = np.arange(len(accessories.welded))
     targets = np.flatnonzero(accessories.on_original)
-    for name in bone_names:  # bone heat may have weighted them, with the whole mesh, before
-        mesh_obj.vertex_groups[name].remove(targets.tolist())
     stage = SkinStage(SURFACE_STAGE, note=f"{accessories.parts} loose parts no bone runs through")
     stage.weighted = _transfer(mesh_obj, bone_names, (points, bones, weights), targets, local[weld.map[targets]],
                                np.zeros(report.vertices, dtype=bool))
@@ -392,7 +390,7 @@ class _Accessories:
     """The welded mesh split into its accessories (``core.accessories``) and the body they sit on: ``body`` a
     :class:`Weld` of the other parts, whose map sends each original vertex to its body vertex (-1 on an accessory);
     ``on_original`` (N,) which original vertices lie on an accessory, ``welded`` the accessories' welded vertices,
-    ``parts`` how many accessories there are."""
+    ``parts`` how many accessories there are. A mesh whose body would have no faces has none: nothing to sit on."""
 
     body: Weld
     on_original: np.ndarray
@@ -402,6 +400,8 @@ class _Accessories:
     @classmethod
     def of(cls, weld, heads, tails):
         part_of, boneless = boneless_parts(weld.positions, weld.triangles, heads, tails)
+        if boneless[part_of[weld.triangles[:, 0]]].all():
+            boneless[:] = False
         accessory = boneless[part_of]
         kept = np.flatnonzero(~accessory)
         local = np.full(len(weld.positions), -1)
