@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from rigger.core import bvh, objfile
-from rigger.core.accessories import barycentric, boneless_parts, surface_entries
+from rigger.core.accessories import barycentric, boneless_parts, part_means, surface_entries
 from rigger.core.mesh import Mesh, triangulate_polygons
 from rigger.core.params import Param, resolve
 from rigger.core.skeleton import Skeleton
@@ -463,7 +463,7 @@ def test_accessories_are_the_loose_parts_no_bone_runs_through_the_body_never_one
     assert boneless.tolist() == [False, True, True, True, True]  # the largest part stays the body
 
 
-def test_points_on_a_surface_take_the_blend_of_their_triangles_corner_weights():
+def test_points_on_a_surface_take_the_blend_of_their_corners_and_a_part_their_mean():
     a, b, c = np.eye(3)
     points = np.array([(a + b + c) / 3, a, 0.5 * (b + c)])
     coordinates = barycentric(points, np.tile(a, (3, 1)), np.tile(b, (3, 1)), np.tile(c, (3, 1)))
@@ -473,3 +473,8 @@ def test_points_on_a_surface_take_the_blend_of_their_triangles_corner_weights():
     dense = np.zeros((3, 2))
     dense[point, bone] = weight
     np.testing.assert_allclose(dense, [(0.5, 0.5), (1.0, 0.0), (0.25, 0.75)], atol=1e-12)
+
+    part, bone, weight = part_means(np.array([0, 1, 1]), (point, bone, weight))
+    dense = np.zeros((2, 2))
+    dense[part, bone] = weight
+    np.testing.assert_allclose(dense, [(0.5, 0.5), (0.625, 0.375)], atol=1e-12)

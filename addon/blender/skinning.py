@@ -21,7 +21,7 @@ only what is still unweighted:
    takes area-weighted normals of the welded mesh, so a seam's copies face alike).
 
 Last, the accessories, the loose parts no bone runs through (``rigger.core.accessories``: eyes, teeth, nails,
-plates), take the weights of the nearest point on the other parts' surface, so they move with what they sit on. Left
+plates), move as one piece with the other parts' surface nearest to them, so they stay with what they sit on. Left
 out of bone heat, they neither hide the body's bones from it nor, hidden themselves, make its heat system singular.
 
 Every stage uses the mesh's own vertex positions (before modifiers) in world space, as Blender's bone heat does when
@@ -41,7 +41,7 @@ import numpy as np
 from mathutils import Vector
 from mathutils.bvhtree import BVHTree
 
-from ..core.accessories import barycentric, boneless_parts, surface_entries
+from ..core.accessories import barycentric, boneless_parts, part_means, surface_entries
 from ..core.arrays import column_bounds, concatenated_ranges
 from ..core.graphs import components
 from ..weights import bone_weights, vertex_normals
@@ -333,8 +333,8 @@ def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report):
 
 
 def _weigh_accessories(mesh_obj, bone_names, weld, accessories, report):
-    """Last stage: each vertex of an accessory takes the weights of the nearest point on the body's surface, blended
-    from its triangle's corners as the stages before weighted them."""
+    """Last stage: each accessory takes the mean of the weights at its vertices' nearest points on the body's
+    surface, each blended from its triangle's corners as the stages before weighted them."""
     started = time.perf_counter()
     body = accessories.body
     tree = BVHTree.FromPolygons(body.positions.tolist(), body.triangles.tolist(), all_triangles=True)
@@ -346,12 +346,13 @@ def _weigh_accessories(mesh_obj, bone_names, weld, accessories, report):
     first_copy = np.empty(len(body.positions), dtype=np.int64)
     first_copy[body.map[originals[::-1]]] = originals[::-1]
     vertices, bones, weights = weight_entries(mesh_obj, bone_names, first_copy[np.unique(corners)].tolist())
-    points, bones, weights = surface_entries(corners, coordinates, (body.map[vertices], bones, weights))
-    local = np.full(len(weld.positions), -1)
-    local[accessories.welded] = np.arange(len(accessories.welded))
+    entries = part_means(accessories.part_of, surface_entries(corners, coordinates,
+                                                               (body.map[vertices], bones, weights)))
+    part = np.full(len(weld.positions), -1)
+    part[accessories.welded] = accessories.part_of
     targets = np.flatnonzero(accessories.on_original)
     stage = SkinStage(SURFACE_STAGE, note=f"{accessories.parts} loose parts no bone runs through")
-    stage.weighted = _transfer(mesh_obj, bone_names, (points, bones, weights), targets, local[weld.map[targets]],
+    stage.weighted = _transfer(mesh_obj, bone_names, entries, targets, part[weld.map[targets]],
                                np.zeros(report.vertices, dtype=bool))
     stage.seconds = time.perf_counter() - started
     report.stages.append(stage)
@@ -390,11 +391,13 @@ class _Accessories:
     """The welded mesh split into its accessories (``core.accessories``) and the body they sit on: ``body`` a
     :class:`Weld` of the other parts, whose map sends each original vertex to its body vertex (-1 on an accessory);
     ``on_original`` (N,) which original vertices lie on an accessory, ``welded`` the accessories' welded vertices,
-    ``parts`` how many accessories there are. A mesh whose body would have no faces has none: nothing to sit on."""
+    ``part_of`` the accessory (0 .. ``parts`` - 1) of each of them. A mesh whose body would have no faces has no
+    accessories: nothing to sit on."""
 
     body: Weld
     on_original: np.ndarray
     welded: np.ndarray
+    part_of: np.ndarray
     parts: int
 
     @classmethod
@@ -408,7 +411,9 @@ class _Accessories:
         local[kept] = np.arange(len(kept))
         body = Weld(local[weld.map], weld.positions[kept], local[weld.triangles[~accessory[weld.triangles[:, 0]]]],
                     weld.subsurf)
-        return cls(body, accessory[weld.map], np.flatnonzero(accessory), int(boneless.sum()))
+        welded = np.flatnonzero(accessory)
+        _, part = np.unique(part_of[welded], return_inverse=True)
+        return cls(body, accessory[weld.map], welded, part.ravel(), int(boneless.sum()))
 
 
 def _welded(mesh_obj):

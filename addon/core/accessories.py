@@ -2,8 +2,11 @@
 
 Such a part has no bone of its own, so any bone's weight on it is a guess: bone heat on an ogre's tongue, which
 sees the throat, gave it the neck, and turning the head pushed the tongue out through the cheek. An accessory
-instead takes the weights of the nearest surface of the parts bones do run through (``rigger.blender.skinning``),
-so it moves with what it sits on or in and cannot poke through it.
+instead moves as one piece with the surface nearest to it, on the parts bones do run through
+(``rigger.blender.skinning``): every vertex of it takes the mean, over the part, of the weights at each vertex's
+nearest point of that surface. It cannot poke through what it sits on or in, and a rigid piece (a plate, a claw, an
+eye) stays rigid: over the development set this posed closer to the artists' rigs than each vertex taking its own
+nearest point's weights.
 """
 import numpy as np
 
@@ -69,6 +72,18 @@ def surface_entries(corners, barycentric, donor_entries):
     totals = np.bincount(summed.ravel(), share, minlength=len(keys))
     kept = totals > 0
     return keys[kept] // bone_count, keys[kept] % bone_count, totals[kept]
+
+
+def part_means(part_of, entries):
+    """(part, bone, weight) arrays: each part's mean of its points' weights, given the part of each point
+    (``part_of`` (A,), 0 .. P - 1) and the points' (point, bone, weight) ``entries``."""
+    points, bones, weights = (np.asarray(array) for array in entries)
+    sizes = np.bincount(part_of)
+    bone_count = int(bones.max()) + 1 if len(bones) else 1
+    keys, summed = np.unique(np.asarray(part_of)[points] * bone_count + bones, return_inverse=True)
+    totals = np.bincount(summed.ravel(), weights, minlength=len(keys))
+    parts = keys // bone_count
+    return parts, keys % bone_count, totals / sizes[parts]
 
 
 def barycentric(points, a, b, c):
