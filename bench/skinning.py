@@ -99,7 +99,7 @@ def dominant_bones(obj, names):
 def skin_model(model, kind):
     """Skin one model to one kind of skeleton in a fresh scene; a record of what happened (errors included)."""
     import rigger
-    from rigger.blender.skinning import FAILURE_MESSAGE
+    from rigger.blender.skinning import FAILURE_MESSAGE, SURFACE_STAGE
 
     record = {"model": model.name, "skeleton": kind, "vertices": len(model.vertices),
               "seam_vertices": int((np.bincount(model.place)[model.place] > 1).sum())}
@@ -120,7 +120,9 @@ def skin_model(model, kind):
             bones=len(names), welded=report.welded, unweighted=report.unweighted,
             recounted_unweighted=int((dominant < 0).sum()),
             failed=any(FAILURE_MESSAGE in message for message in report.stages[0].messages),
-            left_by_bone_heat=report.vertices - report.stages[0].weighted,
+            accessories=sum(stage.weighted for stage in report.stages if stage.name == SURFACE_STAGE),
+            left_by_bone_heat=report.vertices - report.stages[0].weighted
+            - sum(stage.weighted for stage in report.stages if stage.name == SURFACE_STAGE),
             stages={stage.name: stage.weighted for stage in report.stages[1:]},
             notes={stage.name: stage.note for stage in report.stages[1:] if stage.note},
             agreement=agreement(joint_of_bone, dominant, model.artist_joint), summary=report.summary())
@@ -223,13 +225,14 @@ def summary_rows(records, alone):
             ran = [r for r in good if stage in r["stages"]]
             cells.append(f"{len(ran)} / {sum(r['stages'][stage] > 0 for r in ran)} / "
                          f"{sum(r['stages'][stage] for r in ran)}")
+        cells.append(f"{sum(r['accessories'] > 0 for r in good)} / {sum(r['accessories'] for r in good)}")
         seconds = [r["seconds"] for r in good]
         cells.append(f"{sum(r['seam_gap'] > 0 for r in good)} / {max((r['seam_gap'] for r in good), default=0):.3f}")
         cells += [format_seconds(statistics.median(seconds)) if seconds else "–",
                   format_seconds(max(seconds)) if seconds else "–",
                   percent(np.nanmean([r["agreement"] for r in good]) if good else None)]
         rows.append(cells)
-    rows.append(["artist, nearest bones alone", str(len(alone)), "", "0", "", "", "", "", "", "", "",
+    rows.append(["artist, nearest bones alone", str(len(alone)), "", "0", "", "", "", "", "", "", "", "",
                  percent(np.nanmean(list(alone.values())) if alone else None)])
     return rows
 
@@ -262,7 +265,9 @@ def markdown(records, alone, speed, run):
         "- *Nearest bones alone*: `rigger.weights.bone_weights` (the last repair stage) on every vertex with the "
         "artist skeleton and the area-weighted vertex normals of the mesh with its seams welded (vertices at one "
         "position merged), no bone heat: what the fallback is worth on its own.",
-        "- Repair columns: models where the stage ran / where it weighted vertices / vertices it weighted.",
+        "- Repair columns: models where the stage ran / where it weighted vertices / vertices it weighted. "
+        "*Accessories*: the loose parts no bone runs through, left out of bone heat and moved as one piece with "
+        "the surface nearest to them (`rigger.core.accessories`): models that have any / their vertices.",
         "- Seams: *seam vertices* share their exact position with another vertex (the file split them for UVs or "
         "normals); the *seam gap* is the largest difference of one bone's weight between two such copies (0: the "
         "posed mesh cannot crack there). *Seams cracked* counts the models whose gap is above 0.",
@@ -276,24 +281,25 @@ def markdown(records, alone, speed, run):
     ]
     out += markdown_table(["skeleton", "models", "errors", "unweighted vertices", "bone heat failed (message)",
                   "bone heat left vertices silently", "island bone heat", "nearest bones",
-                  "seams cracked / largest gap", "time (median)", "time (max)", "top-1 agreement (mean)"],
+                  "accessories (models / vertices)", "seams cracked / largest gap", "time (median)", "time (max)", "top-1 agreement (mean)"],
                          summary_rows(records, alone))
     out += ["", "![agreement per model, skinning time, fallback speed](skinning.png)", "", "## Per model", ""]
     rows = []
     for record in sorted(records, key=lambda r: (r["model"], SKELETONS.index(r["skeleton"]))):
         if "error" in record:
-            rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}"] + [""] * 9
+            rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}"] + [""] * 10
                         + [f"error: {table_cell(record['error'])}"])
             continue
         rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}", str(record["bones"]),
                      f"{record['seam_vertices']:,}", f"{record['welded']:,}", bone_heat_cell(record),
-                     *(stage_cell(record, stage) for stage in REPAIR_STAGES), str(unweighted_count(record)),
+                     *(stage_cell(record, stage) for stage in REPAIR_STAGES),
+                     str(record["accessories"]) if record["accessories"] else "", str(unweighted_count(record)),
                      f"{record['seam_gap']:.3f}",
                      format_seconds(record["seconds"]),
                      percent(record["agreement"]),
                      percent(alone.get(record["model"])) if record["skeleton"] == "artist" else ""])
     out += markdown_table(["model", "skeleton", "vertices", "bones", "seam vertices", "welded", "bone heat",
-                  "islands", "nearest", "unweighted", "seam gap", "skin time", "top-1 agreement", "nearest bones alone"], rows)
+                  "islands", "nearest", "accessories", "unweighted", "seam gap", "skin time", "top-1 agreement", "nearest bones alone"], rows)
     if speed:
         out += ["", "## The compiled nearest-bones weighting alone", "",
                 "`rigger.weights.bone_weights(points, heads, tails, normals)` (4 bones per point), random bone "
@@ -331,7 +337,8 @@ def plot(records, alone, speed, path):
     bars.set_title("Dominant bone vs the artist's")
     for kind, colour in zip(SKELETONS, ("tab:blue", "tab:red")):
         for repaired, marker in ((False, "o"), (True, "x")):
-            own = [r for r in good if r["skeleton"] == kind and bool(r["stages"]) == repaired]
+            own = [r for r in good if r["skeleton"] == kind
+                   and any(stage in r["stages"] for stage in REPAIR_STAGES) == repaired]
             times.scatter([r["vertices"] for r in own], [r["seconds"] for r in own], marker=marker, color=colour,
                           label=f"{kind} skeleton" + (", repaired" if repaired else ""))
     times.set_xscale("log")
