@@ -13,16 +13,16 @@ leave vertices unweighted with no message. In bpy 4.2 and 5.0 the message goes t
 (measured: nothing reaches file descriptor 1), so it is captured with ``contextlib.redirect_stdout``; unweighted
 vertices are counted directly.
 
-:func:`skin` runs bone heat on a temporary welded copy of the mesh, its accessories left out (below), then repairs
-only what is still unweighted:
+:func:`skin` runs bone heat on a temporary welded copy of the mesh, then repairs only what is still unweighted:
 
 1. bone heat on each loose part of the welded mesh alone, for the parts still unweighted;
 2. ``rigger.weights.bone_weights``: the nearest few bones by distance, which always succeeds (its facing penalty
    takes area-weighted normals of the welded mesh, so a seam's copies face alike).
 
 Last, the accessories, the loose parts no bone runs through (``rigger.core.accessories``: eyes, teeth, nails,
-plates), move as one piece with the other parts' surface nearest to them, so they stay with what they sit on. Left
-out of bone heat, they neither hide the body's bones from it nor, hidden themselves, make its heat system singular.
+plates), move as one piece with the other parts' surface nearest to them, so they stay with what they sit on. They
+stay in the mesh bone heat weights: taking them out changes the body's weights (on a robot built of many loose
+parts, bone heat on the whole then succeeds where each part alone did better).
 
 Every stage uses the mesh's own vertex positions (before modifiers) in world space, as Blender's bone heat does when
 parenting, except that with a Subsurf modifier Blender's bone heat takes each vertex's place on the limit surface:
@@ -107,15 +107,14 @@ class SkinReport:
             head += f", {self.welded} seam vertices welded"
         surface = next((stage for stage in self.stages if stage.name == SURFACE_STAGE), None)
         if surface is not None:
-            head += f", {surface.weighted} vertices of {surface.note} weighted as the surface they sit on"
+            head += f", {surface.weighted} vertices of {surface.note} moved with the surface they sit on"
         if not self.warnings:
-            return f"{head}, bone heat weighted every other vertex" if surface else \
-                f"{head}, bone heat weighted every vertex"
+            return f"{head}, bone heat weighted every vertex"
         parts = []
         if any(FAILURE_MESSAGE in message for message in self.messages):
             parts.append("bone heat failed")
         repairs = [stage for stage in self.stages[1:] if stage is not surface]
-        unweighted = sum(stage.weighted for stage in repairs)
+        unweighted = self.vertices - self.stages[0].weighted
         if unweighted:
             fixes = ", ".join(f"{stage.name} {stage.weighted}" for stage in repairs if stage.weighted)
             parts.append(f"{unweighted} vertices repaired ({fixes})")
@@ -148,24 +147,23 @@ def skin(mesh_obj, armature_obj):
 
     weld = _welded(mesh_obj)
     report.welded = report.vertices - len(weld.positions)
-    accessories = _Accessories.of(weld, *_world_bones(armature_obj, bone_names))
-    body = accessories.body
     stage = SkinStage("bone heat", note=f"{report.welded} seam vertices welded" if report.welded else "")
-    result, entries, stage.messages = _bone_heat_weights(body.positions, body.triangles, armature_obj, bone_names,
+    result, entries, stage.messages = _bone_heat_weights(weld.positions, weld.triangles, armature_obj, bone_names,
                                                          weld.subsurf)
     report.bone_heat_result = ",".join(sorted(result))
-    weighted = accessories.on_original.copy()  # weighted last, from the surface they sit on
-    targets = np.flatnonzero(~weighted)
-    stage.weighted = _transfer(mesh_obj, bone_names, entries, targets, body.map[targets], weighted)
+    weighted = np.zeros(report.vertices, dtype=bool)
+    stage.weighted = _transfer(mesh_obj, bone_names, entries, np.arange(report.vertices), weld.map, weighted)
     stage.seconds = time.perf_counter() - started
     report.stages.append(stage)
     for message in stage.messages:
         report.warnings.append(f"Bone heat printed: {message}")
     if not weighted.all():
-        report.warnings.append(f"Bone heat left {int((~weighted).sum())} of {len(targets)} vertices unweighted")
-        _repair_islands(mesh_obj, armature_obj, bone_names, weighted, body, report)
+        report.warnings.append(f"Bone heat left {report.vertices - stage.weighted} of {report.vertices} vertices "
+                               f"unweighted")
+        _repair_islands(mesh_obj, armature_obj, bone_names, weighted, weld, report)
         if not weighted.all():
-            _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, body, report)
+            _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report)
+    accessories = _Accessories.of(weld, *_world_bones(armature_obj, bone_names))
     if accessories.parts:
         _weigh_accessories(mesh_obj, bone_names, weld, accessories, report)
 
@@ -351,6 +349,8 @@ def _weigh_accessories(mesh_obj, bone_names, weld, accessories, report):
     part = np.full(len(weld.positions), -1)
     part[accessories.welded] = accessories.part_of
     targets = np.flatnonzero(accessories.on_original)
+    for name in bone_names:  # the weights the stages before gave them
+        mesh_obj.vertex_groups[name].remove(targets.tolist())
     stage = SkinStage(SURFACE_STAGE, note=f"{accessories.parts} loose parts no bone runs through")
     stage.weighted = _transfer(mesh_obj, bone_names, entries, targets, part[weld.map[targets]],
                                np.zeros(report.vertices, dtype=bool))
