@@ -474,7 +474,8 @@ def test_points_on_a_surface_take_the_blend_of_their_corners_and_a_part_their_me
     dense[point, bone] = weight
     np.testing.assert_allclose(dense, [(0.5, 0.5), (1.0, 0.0), (0.25, 0.75)], atol=1e-12)
 
-    part, bone, weight = part_means(np.array([0, 1, 1]), (point, bone, weight))
+    touching = np.array([0.0, 0.0, 0.05])  # the third point lies its part's extent x CONTACT (0.05) off: half as much
+    part, bone, weight = part_means(np.array([0, 1, 1]), np.eye(3), touching, (point, bone, weight))
     dense = np.zeros((2, 2))
     dense[part, bone] = weight
-    np.testing.assert_allclose(dense, [(0.5, 0.5), (0.625, 0.375)], atol=1e-12)
+    np.testing.assert_allclose(dense, [(0.5, 0.5), (2 / 3 * 1.0 + 1 / 3 * 0.25, 1 / 3 * 0.75)], atol=1e-12)

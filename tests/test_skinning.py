@@ -27,6 +27,7 @@ from rigger.blender import skinning  # noqa: E402
 from rigger.blender.armature import build_armature  # noqa: E402
 from rigger.blender.meshdata import mesh_vertices, world_points  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
+from rigger.core.accessories import CONTACT  # noqa: E402
 from rigger.core.polyline import segment_distances  # noqa: E402
 
 import rigdata  # noqa: E402
@@ -298,21 +299,22 @@ def add_accessories(obj):
 
 
 def surface_blend(obj, table, body, points):
-    """Weights at the point of ``obj``'s faces among vertices ``body`` nearest to each of ``points``: its face's
-    corner weights (rows of ``table``) blended by Blender's own barycentric interpolation."""
+    """Weights at the point of ``obj``'s faces among vertices ``body`` nearest to each of ``points`` (its face's
+    corner weights, rows of ``table``, blended by Blender's own barycentric interpolation), and how far it is."""
     positions = mesh_vertices(obj.data)
     inside = np.zeros(len(positions), dtype=bool)
     inside[body] = True
     obj.data.calc_loop_triangles()
     faces = [list(triangle.vertices) for triangle in obj.data.loop_triangles if inside[list(triangle.vertices)].all()]
     tree = BVHTree.FromPolygons(positions.tolist(), faces)
-    blended = []
+    blended, distances = [], []
     for point in points:
-        location, _, face, _ = tree.find_nearest(Vector(point))
+        location, _, face, distance = tree.find_nearest(Vector(point))
         corners = faces[face]
         shares = poly_3d_calc([Vector(positions[corner]) for corner in corners], location)
         blended.append(np.array(shares) @ table[corners])
-    return np.array(blended)
+        distances.append(distance)
+    return np.array(blended), np.array(distances)
 
 
 def test_accessories_move_as_one_piece_with_the_surface_they_sit_on(scene):
@@ -335,8 +337,9 @@ def test_accessories_move_as_one_piece_with_the_surface_they_sit_on(scene):
         # named after the joint they end at)
         rows = table[parts[part]]
         assert len({tuple(row) for row in rows}) == 1  # one piece
-        blended = surface_blend(obj, table, np.arange(body), positions[parts[part]]).mean(axis=0)
-        np.testing.assert_allclose(rows[0], blended, atol=1e-5)
+        blended, distances = surface_blend(obj, table, np.arange(body), positions[parts[part]])
+        closeness = 1 / (distances + CONTACT * np.ptp(positions[parts[part]], axis=0).max())  # the contact counts most
+        np.testing.assert_allclose(rows[0], closeness @ blended / closeness.sum(), atol=1e-5)
         assert names[rows[0].argmax()] == bone
     assert len({tuple(row) for row in table[parts["speck"]]}) == 1  # the coincident vertices get the same weights
 

@@ -332,7 +332,8 @@ def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report):
 
 def _weigh_accessories(mesh_obj, bone_names, weld, accessories, report):
     """Last stage: each accessory takes the mean of the weights at its vertices' nearest points on the body's
-    surface, each blended from its triangle's corners as the stages before weighted them."""
+    surface (``core.accessories.part_means``), each blended from its triangle's corners as the stages before
+    weighted them."""
     started = time.perf_counter()
     body = accessories.body
     tree = BVHTree.FromPolygons(body.positions.tolist(), body.triangles.tolist(), all_triangles=True)
@@ -344,8 +345,8 @@ def _weigh_accessories(mesh_obj, bone_names, weld, accessories, report):
     first_copy = np.empty(len(body.positions), dtype=np.int64)
     first_copy[body.map[originals[::-1]]] = originals[::-1]
     vertices, bones, weights = weight_entries(mesh_obj, bone_names, first_copy[np.unique(corners)].tolist())
-    entries = part_means(accessories.part_of, surface_entries(corners, coordinates,
-                                                               (body.map[vertices], bones, weights)))
+    entries = part_means(accessories.part_of, weld.positions[accessories.welded], [hit[3] for hit in nearest],
+                         surface_entries(corners, coordinates, (body.map[vertices], bones, weights)))
     part = np.full(len(weld.positions), -1)
     part[accessories.welded] = accessories.part_of
     targets = np.flatnonzero(accessories.on_original)

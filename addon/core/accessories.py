@@ -4,14 +4,16 @@ Such a part has no bone of its own, so any bone's weight on it is a guess: bone 
 sees the throat, gave it the neck, and turning the head pushed the tongue out through the cheek. An accessory
 instead moves as one piece with the surface nearest to it, on the parts bones do run through
 (``rigger.blender.skinning``): every vertex of it takes the mean, over the part, of the weights at each vertex's
-nearest point of that surface. It cannot poke through what it sits on or in, and a rigid piece (a plate, a claw, an
-eye) stays rigid: over the development set this posed closer to the artists' rigs than each vertex taking its own
-nearest point's weights.
+nearest point of that surface, the points where it touches counting most (:func:`part_means`). It cannot poke
+through what it sits on or in, and a rigid piece (a plate, a claw, an eye) stays rigid: over the development set
+this posed closer to the artists' rigs than each vertex taking its own nearest point's weights, or an even mean.
 """
 import numpy as np
 
 from .arrays import concatenated_ranges
 from .graphs import components
+
+CONTACT = 0.05  # a point this share of its part's extent from the surface counts half as much as one touching it
 
 
 def boneless_parts(positions, triangles, heads, tails):
@@ -74,16 +76,25 @@ def surface_entries(corners, barycentric, donor_entries):
     return keys[kept] // bone_count, keys[kept] % bone_count, totals[kept]
 
 
-def part_means(part_of, entries):
-    """(part, bone, weight) arrays: each part's mean of its points' weights, given the part of each point
-    (``part_of`` (A,), 0 .. P - 1) and the points' (point, bone, weight) ``entries``."""
-    points, bones, weights = (np.asarray(array) for array in entries)
-    sizes = np.bincount(part_of)
+def part_means(part_of, points, distances, entries):
+    """(part, bone, weight) arrays: each part's weighted mean of its points' weights. ``part_of`` (A,) is the part of
+    each point (0 .. P - 1), ``points`` (A, 3) where they are, ``distances`` (A,) how far each lies from the surface
+    its weights come from, ``entries`` the points' (point, bone, weight) arrays. A point counts by how close it lies,
+    1 / (distance + ``CONTACT`` x its part's extent): where a part touches the surface (a claw's root, a tooth's)
+    outweighs its far side, which may lie nearer another limb."""
+    part_of = np.asarray(part_of)
+    count = int(part_of.max()) + 1 if len(part_of) else 0
+    low, high = np.full((count, 3), np.inf), np.full((count, 3), -np.inf)
+    np.minimum.at(low, part_of, points)
+    np.maximum.at(high, part_of, points)
+    extent = (high - low).max(axis=1)
+    closeness = 1.0 / (np.asarray(distances, dtype=np.float64) + CONTACT * extent[part_of] + 1e-300)
+    share = closeness / np.bincount(part_of, closeness, minlength=count)[part_of]
+    point, bones, weights = (np.asarray(array) for array in entries)
     bone_count = int(bones.max()) + 1 if len(bones) else 1
-    keys, summed = np.unique(np.asarray(part_of)[points] * bone_count + bones, return_inverse=True)
-    totals = np.bincount(summed.ravel(), weights, minlength=len(keys))
-    parts = keys // bone_count
-    return parts, keys % bone_count, totals / sizes[parts]
+    keys, summed = np.unique(part_of[point] * bone_count + bones, return_inverse=True)
+    totals = np.bincount(summed.ravel(), weights * share[point], minlength=len(keys))
+    return keys // bone_count, keys % bone_count, totals
 
 
 def barycentric(points, a, b, c):
