@@ -20,9 +20,10 @@ vertices are counted directly.
    takes area-weighted normals of the welded mesh, so a seam's copies face alike).
 
 Last, the accessories, the loose parts no bone runs through (``rigger.core.accessories``: eyes, teeth, nails,
-plates), move as one piece with the other parts' surface nearest to them, so they stay with what they sit on. They
-stay in the mesh bone heat weights: taking them out changes the body's weights (on a robot built of many loose
-parts, bone heat on the whole then succeeds where each part alone did better).
+plates), move as one piece with the other parts' surface nearest to them, so they stay with what they sit on. Bone
+heat still weighs the whole mesh, accessories included, and their weights are replaced afterwards: leaving them out
+changed the body's weights (on a robot built of many loose parts, bone heat on the whole then succeeded where each
+part alone had done better).
 
 Every stage uses the mesh's own vertex positions (before modifiers) in world space, as Blender's bone heat does when
 parenting, except that with a Subsurf modifier Blender's bone heat takes each vertex's place on the limit surface:

@@ -69,11 +69,9 @@ def surface_entries(corners, barycentric, donor_entries):
     picked = concatenated_ranges(starts, counts)
     points = np.repeat(np.arange(len(flat)) // 3, counts)
     share = np.repeat(np.asarray(barycentric, dtype=np.float64).ravel(), counts) * weights[picked]
-    bone_count = int(bones.max()) + 1 if len(bones) else 1
-    keys, summed = np.unique(points * bone_count + bones[picked], return_inverse=True)
-    totals = np.bincount(summed.ravel(), share, minlength=len(keys))
+    points, bones, totals = _summed(points, bones[picked], share)
     kept = totals > 0
-    return keys[kept] // bone_count, keys[kept] % bone_count, totals[kept]
+    return points[kept], bones[kept], totals[kept]
 
 
 def part_means(part_of, points, distances, entries):
@@ -91,10 +89,14 @@ def part_means(part_of, points, distances, entries):
     closeness = 1.0 / (np.asarray(distances, dtype=np.float64) + CONTACT * extent[part_of] + 1e-300)
     share = closeness / np.bincount(part_of, closeness, minlength=count)[part_of]
     point, bones, weights = (np.asarray(array) for array in entries)
+    return _summed(part_of[point], bones, weights * share[point])
+
+
+def _summed(rows, bones, weights):
+    """(row, bone, weight) arrays, the weights of each (row, bone) pair summed, in order of row, then bone."""
     bone_count = int(bones.max()) + 1 if len(bones) else 1
-    keys, summed = np.unique(part_of[point] * bone_count + bones, return_inverse=True)
-    totals = np.bincount(summed.ravel(), weights * share[point], minlength=len(keys))
-    return keys // bone_count, keys % bone_count, totals
+    keys, pair = np.unique(rows * bone_count + bones, return_inverse=True)
+    return keys // bone_count, keys % bone_count, np.bincount(pair.ravel(), weights, minlength=len(keys))
 
 
 def barycentric(points, a, b, c):
