@@ -78,7 +78,7 @@ def mesh_object(source, name):
 def measure(source, name):
     """Everything measured on one model (errors become the record's ``error``)."""
     from rigger.blender import rigify
-    from rigger.blender.meshdata import combined_arrays
+    from rigger.blender.meshdata import combined_arrays, evaluated_vertices
     from rigger.blender.pipeline import rig_object, skin_meshes
 
     record = {"model": name, "source": source}
@@ -98,7 +98,7 @@ def measure(source, name):
         record["fit_seconds"] = fit_seconds(result.skeleton, mesh, metarig_name)
         record["def_bones"] = len(result.bones)
         record["helpers_inside"] = helpers_inside(result.bones, mesh)
-        rest = np.array([tuple(vertex.co) for vertex in obj.data.vertices])
+        rest = evaluated_vertices(obj)
         outcomes, _ = skin_meshes([obj], rig)
         record["skin_seconds"] = outcomes[obj.name].seconds
         record.update(weights(obj))
@@ -160,16 +160,11 @@ def helpers_inside(bones, mesh):
 
 
 def rest_error(obj, rest):
-    """How far the skinned mesh, its rig at rest, lies from the mesh as it was (``rest``): the largest vertex
-    distance in units of the mesh's size (0: the rig deforms nothing until posed)."""
-    import bpy
+    """How far the skinned mesh, its rig at rest, lies from the mesh as it was (``rest``, world space): the largest
+    vertex distance in units of the mesh's size (0: the rig deforms nothing until posed)."""
+    from rigger.blender.meshdata import evaluated_vertices
 
-    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-    mesh = evaluated.to_mesh()
-    try:
-        posed = np.array([tuple(vertex.co) for vertex in mesh.vertices])
-    finally:
-        evaluated.to_mesh_clear()
+    posed = evaluated_vertices(obj)
     return float(np.linalg.norm(posed - rest, axis=1).max() / max(float(np.ptp(rest, axis=0).max()), 1e-300))
 
 

@@ -25,10 +25,7 @@ def boneless_parts(positions, triangles, heads, tails):
     triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
     part_of = components(len(positions), np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]]]))
     count = int(part_of.max()) + 1 if len(part_of) else 0
-    low = np.full((count, 3), np.inf)
-    high = np.full((count, 3), -np.inf)
-    np.minimum.at(low, part_of, positions)
-    np.maximum.at(high, part_of, positions)
+    low, high = _bounds(part_of, positions, count)
     crossed = np.zeros(count, dtype=bool)
     for head, tail in zip(np.asarray(heads, dtype=np.float64), np.asarray(tails, dtype=np.float64)):
         crossed |= _segment_crosses(head, tail, low, high)
@@ -36,6 +33,14 @@ def boneless_parts(positions, triangles, heads, tails):
     if count:
         boneless[np.argmax(np.bincount(part_of, minlength=count))] = False
     return part_of, boneless
+
+
+def _bounds(part_of, points, count):
+    """(low, high) (count, 3): the corners of each part's bounding box, given the part of each of ``points``."""
+    low, high = np.full((count, 3), np.inf), np.full((count, 3), -np.inf)
+    np.minimum.at(low, part_of, points)
+    np.maximum.at(high, part_of, points)
+    return low, high
 
 
 def _segment_crosses(head, tail, low, high):
@@ -82,9 +87,7 @@ def part_means(part_of, points, distances, entries):
     outweighs its far side, which may lie nearer another limb."""
     part_of = np.asarray(part_of)
     count = int(part_of.max()) + 1 if len(part_of) else 0
-    low, high = np.full((count, 3), np.inf), np.full((count, 3), -np.inf)
-    np.minimum.at(low, part_of, points)
-    np.maximum.at(high, part_of, points)
+    low, high = _bounds(part_of, points, count)
     extent = (high - low).max(axis=1)
     closeness = 1.0 / (np.asarray(distances, dtype=np.float64) + CONTACT * extent[part_of] + 1e-300)
     share = closeness / np.bincount(part_of, closeness, minlength=count)[part_of]
