@@ -242,6 +242,21 @@ def test_a_humanoid_game_rig_has_hands_and_feet_though_its_limbs_end_without(pat
         assert all(names[bones.parents[k]] == f"{side}Hand" for k in fingers)
 
 
+@pytest.mark.parametrize("name", ["ogre", "woody"])
+def test_a_thigh_starts_at_the_hip_joint_above_where_the_skeleton_s_leg_began(name):
+    """The ogre's loincloth hides the top of its legs and woody's legs slant in from its crotch: Rigger's leg chains
+    run in from the pelvis down to where the thighs show, far below the hip joints, and the thigh bones are short.
+    The game's UpLeg began there, the Hips holding the top of the thigh. It begins at the hip joint."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", f"{name}.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    joints, bones = named_joints(skeleton), game_skeleton(skeleton, vertices).skeleton
+    size = float(np.ptp(vertices, axis=0).max())
+    for side, word in (("L", "Left"), ("R", "Right")):
+        thigh = bones.names.index(f"{word}UpLeg")  # twins mirrored after
+        assert np.linalg.norm(bones.heads[thigh] - joints[("thigh", side, None)]) < 1e-3 * size
+        assert bones.tails[thigh] == pytest.approx(bones.heads[bones.names.index(f"{word}Leg")])
+
+
 def test_a_missing_foot_is_the_mesh_ahead_of_its_own_ankle():
     """``foot_ahead`` on points: ankle at the origin, front +Y, up +Z, a foot 1 long expected. A paw of another leg
     1.6 ahead with nothing between is no foot (the sample quadruped's hind foot ran to its front paw). A foot whose

@@ -229,6 +229,20 @@ def test_a_limb_end_the_skeleton_lacks_is_placed_on_the_mesh_and_the_fit_says_so
         assert ankle[2] - tip[2] <= 0.1 * size  # ... rather than down
 
 
+@pytest.mark.parametrize("name", ["ogre", "woody"])
+def test_a_thigh_starts_at_the_hip_joint_above_where_the_skeleton_s_leg_began(metarigs, name):
+    """The ogre's loincloth hides the top of its legs and woody's legs slant in from its crotch: Rigger's leg chains
+    run in from the pelvis to where the thighs show, far below the hip joints. Rigify's thighs began there, a
+    quarter of the ogre's leg long, and posing one left the top of the thigh with the torso."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", f"{name}.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    fit = fit_metarig(skeleton, (vertices, triangles), "basic_human", metarigs["basic_human"])
+    joints, size = named_joints(skeleton), float(np.ptp(vertices, axis=0).max())
+    for side in ("L", "R"):  # twins mirrored after
+        hip = joints[("thigh", fit.roles[f"thigh.{side}"].side, None)]
+        assert np.linalg.norm(fit.frame @ fit.heads[f"thigh.{side}"] - hip) < 1e-3 * size
+
+
 def test_a_hind_leg_bends_at_its_hock_where_the_skeleton_does(metarigs):
     """The fox's hind leg bends back at its hock, high above the paw, but its roles start the foot near the ground:
     Rigify's shin ran straight from the knee to the paw, most of it outside the leg, and a paw lifted by IK moved

@@ -27,8 +27,8 @@ The naming scheme (one for every body plan; the README says the same for users):
   are numbered from the highest start down.
 
 Each bone with a Mixamo name begins at its role's named joint (``core.roles.named_joints``: a knee where the artists'
-rigs have it, which may lie inside a bone of Rigger's) when it lies near (``core.roles.within_reach``), the bones
-ending there moved with it.
+rigs have it, which may lie inside a bone of Rigger's) when it lies near (``core.roles.within_reach``; a thigh's or
+upper arm's up the Rigger bone the limb hangs from counts as near), the bones ending there moved with it.
 
 The hierarchy is Rigger's read from the hips outwards (Rigger may root a quadruped at its neck): a chain hangs from the
 game bone that holds the joint it starts from, else the nearest joint on its way to the hips. Twins hang from one bone
@@ -41,7 +41,7 @@ import numpy as np
 
 from .facing import facing, foot_ahead
 from .polyline import arc_lengths, arc_nearest, point_at, segment_distances
-from .roles import BoneRole, landmarks, named_joints, within_reach
+from .roles import LIMB_STARTS, BoneRole, landmarks, named_joints, within_reach
 from .skeleton import Skeleton
 
 ROOT = "root"
@@ -416,7 +416,12 @@ class _Bones:
                 continue
             old, new = bone["head"].copy(), np.asarray(self.joints[key], float)
             ending = [other for other in self.bones if np.linalg.norm(other["tail"] - old) <= tolerance]
-            if not within_reach(old, new, [bone["tail"]] + [other["head"] for other in ending]):
+            ends = [bone["tail"]] + [other["head"] for other in ending]
+            limb_start = role.role in LIMB_STARTS
+            start = bone["start"]
+            if limb_start and start is not None and np.linalg.norm(self.graph.points[start] - old) <= tolerance:
+                ends += [self.graph.points[node] for node, _ in self.graph.neighbours[start]]  # Rigger's bones there
+            if not within_reach(old, new, ends, limb_start=limb_start):
                 continue
             bone["head"] = new.copy()
             for other in ending:

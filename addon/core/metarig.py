@@ -22,9 +22,10 @@ How the bones are placed, in order:
 - On that path, a metarig joint between bones of two roles sits where the skeleton's next role begins (a knee where
   the shin begins), or where the one before ends when the next is missing; where the role has a named joint
   (``core.roles.named_joints``) the joint sits at the path's point nearest it, and on it when that is within reach
-  (``core.roles.within_reach``: a hip joint beside the path); the other joints divide the stretch
-  between such joints in the metarig's own proportions and move onto a skeleton joint near them (the skeleton's
-  joints sit where the mesh bends): a skeleton without a toe gets its foot split at the metarig's ball. A chain
+  (``core.roles.within_reach``: a hip joint beside the path, or up the skeleton's bone the leg hangs from); the
+  other joints divide the stretch between such joints in the metarig's own proportions and move onto a skeleton
+  joint near them (the skeleton's joints sit where the mesh bends): a skeleton without a toe gets its foot split at
+  the metarig's ball. A chain
   whose last roles the skeleton lacks goes on to where the mesh ends ahead of it, when the mesh goes on there (an arm
   ending at the wrist gets its hand; a skeleton whose spine ends at the chest gets a neck and a head; a leg ending at
   the ankle gets its foot forward along the ground, ``core.facing.foot_ahead``), else they share
@@ -58,7 +59,7 @@ import numpy as np
 
 from .facing import TORSO, bones_middle, facing, foot_ahead, role_bones
 from .polyline import arc_lengths, arc_nearest, point_at
-from .roles import CHAINS, BoneRole, RoleTuning, mesh_reach, named_joints, within_reach
+from .roles import CHAINS, LIMB_STARTS, BoneRole, RoleTuning, mesh_reach, named_joints, within_reach
 from .rotations import about, between
 from .tuning import TuningTable, tuned
 
@@ -368,6 +369,12 @@ class _Body:
         self.frame = np.column_stack([faced.left, -faced.front, faced.up])
         self.side_map = {"L": faced.side("L"), "R": faced.side("R"), None: None}
 
+    def meeting(self, point):
+        """The far ends of the skeleton's bones with an end at ``point`` (none when no joint lies there)."""
+        at = np.linalg.norm(self.points[self.node] - point, axis=1) <= self.tuning.merge * self.size
+        count = len(self.skeleton)
+        return self.points[self.node[np.r_[np.flatnonzero(at[count:]), count + np.flatnonzero(at[:count])]]]
+
     def local(self, points):
         """World points in the metarig's frame."""
         return np.asarray(points) @ self.frame
@@ -606,7 +613,10 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None, 
     ends = {0: starts.get(0), len(groups): after}  # the chain's ends exactly there (a hip joint beside the path)
     for k, joint in ends.items():
         beside = placed[[i for i in (k - 1, k + 1) if 0 <= i < len(placed)]]
-        if joint is not None and within_reach(placed[k], joint, beside):
+        limb_start = k == 0 and groups[0][0] in LIMB_STARTS
+        if limb_start:  # the skeleton's bones meeting there count (a leg's hips bone above its thigh)
+            beside = np.vstack([beside, body.meeting(placed[k])])
+        if joint is not None and within_reach(placed[k], joint, beside, limb_start=limb_start):
             placed[k] = joint
     return body.local(placed)
 

@@ -544,16 +544,23 @@ def _limb_side(skeleton, graph, limb, left):
     return "L" if limb.side * left > 0 else "R"
 
 
+LIMB_STARTS = ("thigh", "upper_arm")  # roles that begin where a limb leaves the body
 CHAINS = (("hips", "spine", "chest", "neck", "head"), ("shoulder", "upper_arm", "forearm", "hand"),
           ("hips", "thigh", "shin", "foot", "toe"))  # roles that follow each other along a chain
 
 
-def within_reach(joint, named, ends, tuning=RoleTuning()):
-    """Whether a target's joint at ``joint`` may move to its role's named joint ``named``: only within ``named_reach``
-    of the shortest bone from it to the other ``ends`` of the bones meeting there; a named joint farther off is
-    another chain's (a second pair of arms) or a guess."""
-    shortest = min((np.linalg.norm(np.subtract(end, joint)) for end in ends), default=0.0)
-    return float(np.linalg.norm(np.subtract(named, joint))) <= tuning.named_reach * shortest
+def within_reach(joint, named, ends, tuning=RoleTuning(), limb_start=False):
+    """Whether a target's joint at ``joint`` may move to its role's named joint ``named``, the bones meeting there
+    running to ``ends``: only within ``named_reach`` of the shortest of them (of the longest at a ``limb_start``, a
+    hip or shoulder joint, which the roles place where the limb leaves the body: up the bone the skeleton's leg
+    hangs from when a skirt hid its top), no bone shrinking below 1 - ``named_reach`` of its length. A named joint
+    farther off is another chain's (a second pair of arms) or a guess."""
+    lengths = [float(np.linalg.norm(np.subtract(end, joint))) for end in ends]
+    reach = (max if limb_start else min)(lengths, default=0.0)
+    if float(np.linalg.norm(np.subtract(named, joint))) > tuning.named_reach * reach:
+        return False
+    return all(np.linalg.norm(np.subtract(named, end)) >= (1.0 - tuning.named_reach) * length
+               for end, length in zip(ends, lengths))
 
 
 def named_joints(skeleton, roles=None):
