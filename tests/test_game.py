@@ -6,7 +6,7 @@ import rigger
 from characters import load_character
 from conftest import shared_path
 from rigdata import load_obj
-from rigger.core.game import game_skeleton
+from rigger.core.game import game_skeleton, missing_humanoid_bones
 from rigger.core.retarget import Clip, RetargetError, aliases, captured, map_joints, normalised, sole_points
 from rigger.core.roles import landmarks, named_joints
 from rigger.core.targets import choose_target
@@ -255,6 +255,25 @@ def test_a_thigh_starts_at_the_hip_joint_above_where_the_skeleton_s_leg_began(na
         thigh = bones.names.index(f"{word}UpLeg")  # twins mirrored after
         assert np.linalg.norm(bones.heads[thigh] - joints[("thigh", side, None)]) < 1e-3 * size
         assert bones.tails[thigh] == pytest.approx(bones.heads[bones.names.index(f"{word}Leg")])
+
+
+def test_a_leg_too_short_to_bend_gets_a_shin_from_its_knee():
+    """cheburashka's stubby legs are one thigh bone each down to the ankle: the game rig had an UpLeg and nothing
+    below, warned of the missing Leg and Foot, and no motion could walk it. The thigh is split at the named knee;
+    the shin runs on to the ankle and gets its foot."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "cheburashka.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert not any(role.role == "shin" for role in skeleton.roles)
+    joints, bones = named_joints(skeleton), game_skeleton(skeleton, vertices).skeleton
+    names = list(bones.names)
+    assert missing_humanoid_bones(names) == []
+    size = float(np.ptp(vertices, axis=0).max())
+    for side, word in (("L", "Left"), ("R", "Right")):
+        thigh, shin, foot = (names.index(f"{word}{bone}") for bone in ("UpLeg", "Leg", "Foot"))
+        assert bones.parents[shin] == thigh and bones.parents[foot] == shin
+        assert np.linalg.norm(bones.heads[shin] - joints[("shin", side, None)]) < 1e-3 * size  # twins mirrored
+        assert bones.tails[thigh] == pytest.approx(bones.heads[shin])
+        assert bones.tails[shin] == pytest.approx(bones.heads[foot])
 
 
 def test_a_missing_foot_is_the_mesh_ahead_of_its_own_ankle():

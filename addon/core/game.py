@@ -16,7 +16,8 @@ The naming scheme (one for every body plan; the README says the same for users):
   right, and its ``Left`` bones on its left). A quadruped's front legs have the roles, so the names, of arms and its
   hind legs those of legs. A leg's ``hips`` bones (from the body's middle to the hip joint) are the pelvis: they
   merge into ``Hips``.
-- A humanoid's forearm (shin, neck) that ends without a hand (foot, head) gets one: ``_completed_ends``.
+- A humanoid's forearm (shin, neck) that ends without a hand (foot, head) gets one: ``_completed_ends``; an upper
+  arm (thigh) without a forearm (shin) after it is split at the elbow (knee): ``_split_middles``.
 - Fingers: ``LeftHandThumb1``..``3``, ``Index``, ``Middle``, ``Ring``, ``Pinky``, at most three bones each (Rigger's
   bones merged at the joints nearest the thirds); a finger without a digit is ``LeftHandFinger1``..``3``.
 - Parts without a Mixamo name keep one bone per Rigger bone, numbered from 1 along the chain: ``Tail1``, ``Tail2``,
@@ -64,6 +65,9 @@ ENDS = (("ForeArm", "Hand", ("hand",), ("hand_tip",), ("finger",)),
         ("Leg", "Foot", ("foot",), ("toe", "toe_tip"), ("toe",)),
         ("Neck", "Head", ("head",), ("head_top",), ("jaw", "ear")))
 END_SHARE = 0.5  # an end bone with nowhere to end goes on along its limb bone for this share of that bone's length
+# a limb bone, the bone after it it may lack, the named joint that begins at, the roles that bone carries
+MIDDLES = (("UpLeg", "Leg", "shin", ("foot", "toe")), ("Arm", "ForeArm", "forearm", ("hand", "finger")))
+SPLIT_SHARES = (0.2, 0.8)  # a limb bone is split where the missing bone begins only this far along it
 HUMANOID = ("Hips", "Spine", "Spine1", "Spine2", "Neck", "Head",
             *(f"{side}{word}" for side in ("Left", "Right")
               for word in ("Shoulder", "Arm", "ForeArm", "Hand", "UpLeg", "Leg", "Foot")))  # what engines expect
@@ -109,6 +113,7 @@ def game_skeleton(skeleton, vertices):
     names, heads, tails, parents, roles = bones.finished(arriving)
     faced = facing(skeleton)
     if skeleton.body_plan.kind == "humanoid":
+        names, heads, tails, parents, roles = _split_middles(names, heads, tails, parents, roles, joints)
         names, heads, tails, parents, roles = _completed_ends(names, heads, tails, parents, roles,
                                                               {**joints, **landmarks(skeleton)}, vertices, faced)
     parents = _twin_parents(names, heads, tails, parents)
@@ -485,6 +490,43 @@ def _finger_spans(points, real):
         cuts.append(min(max(best, cuts[-1] + 1), count - (FINGER_BONES - len(cuts))))
     cuts.append(count)
     return list(zip(cuts, cuts[1:]))
+
+
+def _split_middles(names, heads, tails, parents, roles, places):
+    """A humanoid's ``UpLeg`` (``Arm``) without a ``Leg`` (``ForeArm``) after it, a leg too short for the skeleton to
+    bend it (a plush toy's stubby legs), split at the named knee (elbow) in ``places`` when that lies well along it
+    (``SPLIT_SHARES``, within a quarter of its length of it), as ``MIDDLES`` says: the new bone runs on to the old
+    end and carries what hung there (a foot; a hand and its fingers). ``_completed_ends`` then adds what it lacks."""
+    names, heads, tails, parents, roles = list(names), heads.copy(), tails.copy(), list(parents), list(roles)
+    for limb in range(len(names)):
+        stem, _, suffix = names[limb].partition("_")
+        for word, next_word, joint, carried in MIDDLES:
+            side_word = stem[:-len(word)]
+            next_name = f"{side_word}{next_word}{'_' + suffix if suffix else ''}"
+            if not stem.endswith(word) or side_word not in ("Left", "Right") or next_name in names:
+                continue
+            letter = side_word[0]
+            point = places.get((joint, letter, None))
+            head, tail = heads[limb], tails[limb]
+            along = tail - head
+            length = float(np.linalg.norm(along))
+            if point is None or not length > 0:
+                continue
+            share = float((point - head) @ along) / length ** 2
+            if not SPLIT_SHARES[0] < share < SPLIT_SHARES[1] or \
+                    segment_distances(point[None], head[None], tail[None])[0, 0] > 0.25 * length:
+                continue
+            point = np.asarray(point, dtype=np.float64)
+            names.append(next_name)
+            heads, tails = np.vstack([heads, point]), np.vstack([tails, tail])
+            tails[limb] = point
+            parents.append(limb)
+            roles.append(BoneRole(joint, letter))
+            added = len(names) - 1
+            for child in range(added):
+                if parents[child] == limb and roles[child].role in carried:
+                    parents[child] = added
+    return names, heads, tails, parents, roles
 
 
 def _completed_ends(names, heads, tails, parents, roles, places, vertices, faced):
