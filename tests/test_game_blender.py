@@ -297,3 +297,30 @@ def test_a_character_whose_legs_end_without_feet_still_walks_on_its_soles(scene,
             posed = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.vertices
             lowest = min((obj.matrix_world @ posed[i].co)[2] for i in carried)
             assert abs(lowest - ground) < 0.005 * size, (side, frame)
+
+
+def test_a_retargeted_motion_poses_a_character_alike_at_any_size(scene, tmp_path):
+    """The knee's two-bone IK aimed at a point one unit ahead of the knee: on a character hundreds of units tall (a
+    model in centimetres, woody) that point lay on the knee, so the knee kept whatever way the mocap's turns put it,
+    on splayed legs backwards. The sample humanoid made 100 times larger is posed as the small one, scaled."""
+    from rigger.blender.animate import animate
+
+    bvh = short_bvh(tmp_path / "step.bvh")
+    posed = []
+    for scale in (1.0, 100.0):
+        bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+        rigger.register()
+        obj = build_character("humanoid", subdivisions=0)
+        obj.data.transform(np.diag([scale, scale, scale, 1.0]).tolist())
+        result = rig_object(obj, "silhouette", target="game")
+        skin_meshes([obj], result.armature)
+        animate(result.armature, bvh)
+        scene = bpy.context.scene
+        heads = []
+        for frame in range(scene.frame_start + 1, scene.frame_end + 1):
+            scene.frame_set(frame)
+            pose = result.armature.pose.bones
+            heads.append([np.array(result.armature.matrix_world @ pose[name].head) / scale
+                          for name in ("LeftUpLeg", "LeftLeg", "LeftFoot", "RightLeg")])
+        posed.append(np.array(heads))
+    assert posed[1] == pytest.approx(posed[0], abs=1e-3)

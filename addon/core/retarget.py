@@ -560,8 +560,8 @@ def _reach_ankles(clip, rig, mapping, index, world, hips_at, up, forward, scale,
             ankle = _ankle(rig, world, heads, shin, foot)
             upper, lower = np.linalg.norm(rest[shin] - rest[thigh]), np.linalg.norm(rest_ankle - rest[shin])
             hip, knee = heads[:, thigh], heads[:, shin]
-            for frame in range(len(world)):  # knees bend forward: towards the thigh's turned rest forward
-                pole = knee[frame] + world[frame, thigh] @ forward
+            for frame in range(len(world)):  # knees bend forward: towards the thigh's turned rest forward,
+                pole = knee[frame] + (upper + lower) * (world[frame, thigh] @ forward)  # a leg's length ahead
                 new_knee = _two_bone(hip[frame], pole, target[frame], upper, lower)
                 world[frame, thigh] = between(knee[frame] - hip[frame], new_knee - hip[frame]) @ world[frame, thigh]
                 world[frame, shin] = between(ankle[frame] - knee[frame], target[frame] - new_knee) @ world[frame, shin]
