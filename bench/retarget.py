@@ -36,9 +36,11 @@ ANIM = SHARED_MODELS.parent / "anim"
 CLIPS = {"walk": "cmu_07_01_walk.bvh", "jump": "cmu_141_05_jump_sideways.bvh"}
 SAMPLES = ("humanoid", "humanoid_hips", "humanoid_a_pose", "humanoid_knees", "humanoid_handmade", "head_with_nose",
            "four_arms")
-SHARED = ("gt/CesiumMan/CesiumMan.obj", "gt/magicarticulate_0a59c5ff/magicarticulate_0a59c5ff.obj",
-          "gt/rignet_8210/rignet_8210.obj", "gt/rignet_17364/rignet_17364.obj", "nogt/homer.obj")
-Z_UP = ("CesiumMan", "magicarticulate_0a59c5ff")  # OBJ files written Z up (the others Y up, Blender's default)
+SHARED = (*(f"gt/{name}/{name}.obj" for name in ("BrainStem", "CesiumMan", "magicarticulate_0a59c5ff", "rignet_1347",
+                                                 "rignet_15930", "rignet_17364", "rignet_8210", "rignet_8330",
+                                                 "rignet_8333", "rignet_9477", "rignet_smith")),
+          *(f"nogt/{name}.obj" for name in ("cheburashka", "homer", "ogre", "woody")))  # bench/bodyplan's humanoids
+Z_UP = ("BrainStem", "CesiumMan", "magicarticulate_0a59c5ff")  # OBJ files written Z up (the others Y up)
 FEET = 0.02  # the target: planted feet within this share of the size of the ground
 BENT = 5.0  # degrees: a knee or elbow bent less is straight, whichever way
 SEAM = 1e-6  # vertices this close at rest (a share of the size) are one place
