@@ -9,9 +9,11 @@ the first (CMU's frame 1 is a reference pose, not motion: ``../shared/anim/READM
   character's posed foot (its vertices weighted more than half to Foot or ToeBase; for a leg without a foot bone, to
   its Leg) lies within 0.02 of the model's size of the ground (the mesh's lowest point at rest); measured: the
   largest distance and the share within;
-- knees bend forward and elbows backwards in every frame: a knee (elbow) bent more than ``BENT`` degrees whose
-  joint lies behind (in front of) the line from the hip to the ankle (shoulder to wrist), seen along the
-  character's posed facing (the Hips' rest forward turned with the Hips), is a wrong frame;
+- knees bend forward and elbows backwards in every frame: an elbow bent more than ``BENT`` degrees whose joint lies
+  in front of the line from the shoulder to the wrist, seen along the character's posed facing (the Hips' rest
+  forward turned with the Hips), is a wrong frame; so is a knee bent that far the other way about its hinge than a
+  knee bends (the rest left turned with the thigh: its sense does not depend on where the leg points, as ahead
+  does not for a heel kicked up behind);
 - every vertex weighted, at most 4 influences, and seams: vertices at one place at rest (within 1e-6 of the size)
   stay together (the largest distance between them over every frame, a share of the size: 0 is no crack).
 
@@ -147,8 +149,7 @@ def _posed_measures(obj, armature, rig, motion, clip, outcome, contact_frames):
         pose = armature.pose.bones
         hips = np.array(pose["Hips"].matrix)[:3, :3] @ rig.rest[rig.names.index("Hips"), :3, :3].T
         facing = hips @ forward
-        wrong_knees += any(_bend(pose, f"{side}UpLeg", f"{side}Leg", f"{side}Foot", facing) < 0
-                           for side in ("Left", "Right"))
+        wrong_knees += any(_knee(pose, rig, side, left / np.linalg.norm(left)) < 0 for side in ("Left", "Right"))
         wrong_elbows += any(_bend(pose, f"{side}Arm", f"{side}ForeArm", f"{side}Hand", facing) > 0
                             for side in ("Left", "Right"))
     errors = np.array(errors)
@@ -161,6 +162,21 @@ def _posed_measures(obj, armature, rig, motion, clip, outcome, contact_frames):
     trace = {"lows": {side: np.array(values) / size for side, values in lows.items()},
              "planted": {side: planted[side][1:] for side in planted}}
     return row, trace
+
+
+def _knee(pose, rig, side, left):
+    """+1 when the knee on ``side`` bends the way a knee bends about its hinge (the rest ``left`` turned with the
+    thigh), -1 the other way, 0 within ``BENT`` degrees of straight (or without a thigh, shin and foot)."""
+    names = [f"{side}{word}" for word in ("UpLeg", "Leg", "Foot")]
+    if any(name not in pose for name in names):
+        return 0
+    a, b, c = (np.array(pose[name].head) for name in names)
+    upper, lower = b - a, c - b
+    angle = np.degrees(np.arccos(np.clip(upper @ lower / (np.linalg.norm(upper) * np.linalg.norm(lower)), -1, 1)))
+    if angle < BENT:
+        return 0
+    turn = np.array(pose[names[0]].matrix)[:3, :3] @ rig.rest[rig.names.index(names[0]), :3, :3].T
+    return 1 if np.cross(upper, lower) @ (turn @ left) > 0 else -1
 
 
 def _bend(pose, first, middle, last, facing):
