@@ -6,9 +6,11 @@ import rigger
 from characters import load_character
 from conftest import shared_path
 from rigdata import load_obj
+from rigger.core.bodyplan import recognise
 from rigger.core.game import game_skeleton, missing_humanoid_bones
 from rigger.core.retarget import Clip, RetargetError, aliases, captured, map_joints, normalised, sole_points
 from rigger.core.roles import landmarks, named_joints
+from rigger.core.skeleton import Skeleton
 from rigger.core.targets import choose_target
 
 MIXAMO = {"Hips", "Spine", "Spine1", "Spine2", "Neck", "Head"} | {
@@ -274,6 +276,21 @@ def test_a_leg_too_short_to_bend_gets_a_shin_from_its_knee():
         assert np.linalg.norm(bones.heads[shin] - joints[("shin", side, None)]) < 1e-3 * size  # twins mirrored
         assert bones.tails[thigh] == pytest.approx(bones.heads[shin])
         assert bones.tails[shin] == pytest.approx(bones.heads[foot])
+
+
+def test_a_spine_along_a_chain_named_for_a_side_stays_the_body_s_middle():
+    """A mesh with every other face deleted rigged into a skeleton whose spine runs along a chain named ``.L``: its
+    spine and chest bones took the side from the names, and the game target, which names a trunk only on the
+    middle, crashed. The spine stays unsided, and the game skeleton has its Spine."""
+    vertices, triangles = load_character("humanoid")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    names = [f"{name}.L" if role.role in ("spine", "chest") else name
+             for name, role in zip(skeleton.names, skeleton.roles)]
+    renamed = Skeleton(names, skeleton.heads, skeleton.tails, skeleton.parents, skeleton.stages)
+    renamed.body_plan, renamed.roles = recognise(renamed, (vertices, triangles),
+                                                 plane=skeleton.stages.get("mirror_plane"))
+    assert all(role.side is None for role in renamed.roles if role.role in ("spine", "chest"))
+    assert {"Hips", "Spine", "Spine1", "Spine2"} <= set(game_skeleton(renamed, vertices).skeleton.names)
 
 
 def test_a_missing_foot_is_the_mesh_ahead_of_its_own_ankle():

@@ -357,6 +357,8 @@ class _Bones:
                     self.node_owner[node] = owner
                 return
             role_name = "hips"
+        if role_name not in WORDS:  # a role the scheme has no word for (the trunk's, off the middle)
+            role_name = "other"
         bones = [graph.edges[edge][2] for edge in chain.edges]
         first = graph.skeleton.roles[next((bone for bone in bones if bone >= 0), bones[0])]
         if role_name == "finger":

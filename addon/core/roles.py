@@ -184,9 +184,10 @@ def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
 
 def _named_sides(roles, names):
     """``roles`` with a side wherever the bone's name has one and its role none: a chain named ``.R`` that the
-    body's path runs through (one ear of a figure without a mirror plane) is on the right like its ``.L`` twin."""
-    return tuple(replace(role, side=name[-1]) if role.side is None and name[-2:] in (".L", ".R") else role
-                 for role, name in zip(roles, names))
+    body's path runs through (one ear of a figure without a mirror plane) is on the right like its ``.L`` twin. The
+    spine and chest stay the body's middle, whatever chain the spine runs along (a broken mesh's)."""
+    return tuple(replace(role, side=name[-1]) if role.side is None and name[-2:] in (".L", ".R")
+                 and role.role not in ("spine", "chest") else role for role, name in zip(roles, names))
 
 
 def _mirror_twin_roles(roles, body, segment_bone):
