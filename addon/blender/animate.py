@@ -1,6 +1,9 @@
 """``--animate``: a BVH motion retargeted onto a game armature (``rigger.core.retarget`` does the mapping and the
 arithmetic) and baked as the armature's action."""
+import codecs
 import pathlib
+import shutil
+import tempfile
 
 import bpy
 import numpy as np
@@ -51,12 +54,16 @@ def read_clip(path, armature):
 
 
 def _imported(path):
-    """Import the BVH (frame rate and range into the scene) and return its armature object."""
+    """Import the BVH (frame rate and range into the scene) and return its armature object. A file that starts with
+    a byte-order mark, which Blender's importer reads as part of its first keyword, is imported from a copy
+    without it."""
     before = set(bpy.data.objects)
-    try:
-        bpy.ops.import_anim.bvh(filepath=str(path), update_scene_fps=True, update_scene_duration=True)
-    except RuntimeError as error:
-        raise ValueError(f"{path}: Blender could not read it as BVH: {blender_message(error)}") from None
+    with tempfile.TemporaryDirectory(prefix="rigger-bvh-") as folder:
+        readable = _without_bom(pathlib.Path(path), pathlib.Path(folder))
+        try:
+            bpy.ops.import_anim.bvh(filepath=str(readable), update_scene_fps=True, update_scene_duration=True)
+        except RuntimeError as error:
+            raise ValueError(f"{path}: Blender could not read it as BVH: {blender_message(error)}") from None
     made = [obj for obj in bpy.data.objects if obj not in before and obj.type == 'ARMATURE']
     if not made:
         raise ValueError(f"{path}: the BVH file holds no skeleton")
@@ -64,6 +71,17 @@ def _imported(path):
         if obj not in before and obj not in made[:1]:
             bpy.data.objects.remove(obj)
     return made[0]
+
+
+def _without_bom(path, folder):
+    """``path``, or a copy of it in ``folder`` (same name) without the UTF-8 byte-order mark it starts with."""
+    with open(path, "rb") as file:
+        if file.read(len(codecs.BOM_UTF8)) != codecs.BOM_UTF8:
+            return path
+        copy = folder / path.name
+        with open(copy, "wb") as out:
+            shutil.copyfileobj(file, out)
+    return copy
 
 
 def _remove(source):

@@ -21,8 +21,8 @@ class BvhSummary:
 
 def check(path):
     """The :class:`BvhSummary` of the BVH file at ``path``; :class:`BvhError` when it cannot be read, is no BVH (a
-    HIERARCHY of joints with OFFSET and CHANNELS, then MOTION with ``Frames:`` and ``Frame Time:``), holds no frame,
-    or holds fewer frame lines (or fewer numbers on one) than it announces."""
+    HIERARCHY of joints with OFFSET and CHANNELS, then MOTION with ``Frames:`` and ``Frame Time:``), holds fewer than
+    two frames (a pose, no motion), or holds fewer frame lines (or fewer numbers on one) than it announces."""
     path = pathlib.Path(path)
     try:
         lines = path.read_text(encoding="utf-8-sig", errors="replace").splitlines()  # a BOM is no keyword
@@ -39,8 +39,9 @@ def check(path):
         raise BvhError(f"{path}: MOTION is not followed by 'Frames:' and 'Frame Time:' lines")
     frames, frame_time = _number(path, header[0][1:], int, "Frames:"), _number(path, header[1][2:], float,
                                                                              "Frame Time:")
-    if frames < 1:
-        raise BvhError(f"{path}: the BVH file holds no frames")
+    if frames < 2:
+        raise BvhError(f"{path}: the BVH file holds {'no frames' if frames < 1 else 'one frame'}: a motion needs two "
+                       f"or more")
     if not frame_time > 0:
         raise BvhError(f"{path}: 'Frame Time:' must be a positive number of seconds, not {frame_time:g}")
     rows = after[2:]
