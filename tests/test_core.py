@@ -393,18 +393,20 @@ def test_a_file_that_is_no_readable_bvh_says_why_in_one_line(tmp_path, text, mes
     assert message in str(error.value) and "\n" not in str(error.value)
 
 
-@pytest.mark.parametrize("coordinate", ["nan", "-NaN", "inf", "-Infinity", "1e999", "-1E+400"])
+@pytest.mark.parametrize("coordinate", ["nan", "-NaN", "inf", "-Infinity", "1e999", "-1E+400", "1e39", "-4E+038",
+                                        "abc", "2x"])
 def test_an_obj_vertex_that_is_no_finite_number_is_named_by_its_line(tmp_path, monkeypatch, coordinate):
-    """Blender's OBJ importer reads these as 0 without a word: a spike to the origin. Lines are counted across the
-    chunks the file is read in."""
+    """Blender's OBJ importer reads these as 0 without a word (its coordinates are 32-bit floats; "2x" it reads as
+    2): a spike to the origin. Lines are counted across the chunks the file is read in."""
     monkeypatch.setattr(objfile, "CHUNK_BYTES", 7)
     path = tmp_path / "bad.obj"
-    path.write_text(f"mtllib info.mtl\no Infantry\nv 0 0 0\nv 1e300 1e-400 0\nv 0 {coordinate} 0\nf 1 2 3\n")
+    path.write_text(f"mtllib info.mtl\no Infantry\nv 0 0 0\nv 3e38 1e-400 0\nv 0 {coordinate} 0\nf 1 2 3\n")
     with pytest.raises(objfile.ObjError) as error:
         objfile.check(path)
     assert f"line 5: vertex coordinate {coordinate!r} is not a finite number" in str(error.value)
-    path.write_text("mtllib info.mtl\no Infantry\nusemtl nan\nv 0 0 0\r\nv 1e300 1e-400 0\nvt 0.5 0.5\nf 1 2 1\n")
-    objfile.check(path)  # words elsewhere, a large but finite number and an underflow to 0 are sound
+    path.write_text("mtllib info.mtl\no Infantry\nusemtl nan\nv 0 0 0\r\nv 3E+38 1e-400 0 # far\nvt 0.5 0.5\n"
+                    "f 1 2 1\n")
+    objfile.check(path)  # words elsewhere, the largest 32-bit floats, an underflow to 0 and a comment are sound
 
 
 def test_a_blender_operator_error_is_one_clause():

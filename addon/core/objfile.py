@@ -1,12 +1,15 @@
 """What Blender's OBJ importer reads silently wrong: a vertex coordinate that is no finite number ("nan", "inf", an
-exponent past the float range) becomes 0, a spike to the origin that rigs and skins without a warning."""
+exponent past the range of Blender's 32-bit floats, a word) becomes 0, a spike to the origin that rigs and skins
+without a warning."""
 import math
 import pathlib
 import re
 
 CHUNK_BYTES = 1 << 24  # read this much at a time (and on to the end of its line): a large file is never held whole
 _WORDS = (b"nan", b"inf")  # in lowered text, with a three-digit exponent: what could spell a non-finite number
-_EXPONENT = re.compile(rb"e\+?\d{3}")  # begins with a literal: searched as fast as bytes.find
+_EXPONENT = re.compile(rb"e\+?0*(?:3[89]|[4-9]\d|[1-9]\d\d)")  # may pass FLOAT_MAX (a literal first: fast)
+_WORD = re.compile(rb"^v[ \t][-+0-9.e \t\r]*+[^-+0-9.e \t\r\n]", re.MULTILINE)  # a v line with more than numbers
+FLOAT_MAX = 3.4028234663852886e38  # Blender's coordinates are 32-bit floats: beyond this the importer reads 0
 
 
 class ObjError(ValueError):
@@ -14,9 +17,9 @@ class ObjError(ValueError):
 
 
 def check(path):
-    """ObjError naming the first ``v`` line of the OBJ file at ``path`` whose coordinates are not all finite
-    numbers. Only lines holding "nan", "inf" or a three-digit exponent are parsed, so a sound file costs one pass
-    of a byte search."""
+    """ObjError naming the first ``v`` line of the OBJ file at ``path`` whose coordinates are not all numbers within
+    ``FLOAT_MAX``. Only lines holding "nan", "inf", an exponent of 38 or more or a character no number has are parsed,
+    so a sound file costs a pass of a byte search and one of a regular expression."""
     path = pathlib.Path(path)
     try:
         with open(path, "rb") as file:
@@ -30,13 +33,15 @@ def check(path):
 
 
 def _suspects(lowered):
-    """Where "nan", "inf" or a three-digit exponent occur in ``lowered`` text."""
+    """Where "nan", "inf", an exponent of 38 or more or a ``v`` line with a character no number has occur in
+    ``lowered`` text."""
     for word in _WORDS:
         at = lowered.find(word)
         while at >= 0:
             yield at
             at = lowered.find(word, at + 1)
     yield from (match.start() for match in _EXPONENT.finditer(lowered))
+    yield from (match.start() for match in _WORD.finditer(lowered))
 
 
 def _check_chunk(path, chunk, lines_before):
@@ -48,10 +53,10 @@ def _check_chunk(path, chunk, lines_before):
             continue
         for word in words[1:4]:
             try:
-                finite = math.isfinite(float(word))
+                finite = math.isfinite(float(word)) and abs(float(word)) <= FLOAT_MAX
             except ValueError:
                 finite = False
             if not finite:
                 line = lines_before + chunk.count(b"\n", 0, start) + 1
                 raise ObjError(f"{path}: line {line}: vertex coordinate {word.decode(errors='replace')!r} is not a "
-                               f"finite number (Blender's importer would read it as 0)")
+                               f"finite number Blender can hold (its importer would read it as 0)")
