@@ -28,7 +28,7 @@ from rigger.core.facing import TORSO  # noqa: E402
 from rigger.core.metarig import METARIGS, MetarigTuning, choose_metarig, fit_metarig  # noqa: E402
 from rigger.core.roles import BoneRole, named_joints  # noqa: E402
 from rigger.core.skeleton import Skeleton  # noqa: E402
-from rigger.core.targets import choose_target  # noqa: E402
+from rigger.core.targets import TargetFailed, choose_target  # noqa: E402
 
 Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # Blender's OBJ import: x, -z, y
 
@@ -469,6 +469,24 @@ def test_a_snake_falls_back_to_the_game_rig_with_a_message(registered):
     assert any("rigify target needs a humanoid or quadruped or bird body plan" in warning and "fish" in warning
                for warning in result.warnings)
     assert not any(obj.name.endswith("metarig") for obj in bpy.data.objects)
+
+
+def test_a_rig_rigify_refuses_falls_back_to_the_game_rig_with_rigifys_reason(registered, monkeypatch):
+    """Rigify may refuse a metarig fitted to a broken mesh's skeleton ("Incorrect armature for type 'chain_rigs'",
+    seen on a character with every other face deleted): the command failed. The game rig is built instead, the
+    warning gives Rigify's reason, and nothing of the failed attempt stays."""
+    def refuse(metarig, rig):
+        raise TargetFailed("Rigify could not generate the rig: Incorrect armature for type 'chain_rigs'")
+
+    empty_scene()
+    before = set(bpy.data.objects)
+    monkeypatch.setattr(rigify, "generate", refuse)
+    obj = build_character("humanoid", subdivisions=0)
+    result = rig_object(obj, "silhouette", target="rigify")
+    assert result.target.name == "game" and "LeftUpLeg" in result.bones.names
+    assert result.warnings[0] == ("Rigify could not generate the rig: Incorrect armature for type 'chain_rigs': "
+                                  "built the game target instead")
+    assert set(bpy.data.objects) - before == {obj, result.armature}
 
 
 def test_a_quadruped_gets_rigifys_quadruped_with_paws_tail_and_neck(registered):

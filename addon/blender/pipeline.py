@@ -9,7 +9,7 @@ import numpy as np
 
 from ..api import rig_mesh
 from ..core.scene import character_parts
-from ..core.targets import check_target, choose_target
+from ..core.targets import TargetFailed, check_target, choose_target
 from ..core.timing import StageClock
 from . import overlays, skinning, targets
 from .armature import actions_of, delete_armature
@@ -54,8 +54,9 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     (deleting) the armatures Rigger made for them before. ``show_overlays`` maps stage names to whether their
     overlays start shown (None: build none; a stage it does not name starts as its type says);
     ``progress(fraction)`` is called between steps. A target the skeleton's body plan cannot fill falls back
-    (``core.targets.choose_target``) with a warning. ValueError for bad meshes, methods, parameters or targets;
-    nothing is created when rigging fails.
+    (``core.targets.choose_target``) with a warning, and so does one whose builder fails on it
+    (``core.targets.TargetFailed``: Rigify refusing the fitted metarig). ValueError for bad meshes, methods,
+    parameters or targets; nothing is created when rigging fails.
     """
     check_target(target)
     report = progress or (lambda fraction: None)
@@ -74,7 +75,14 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     replaced = any([remove_rig(mesh) for mesh in meshes])
     collection = shown_collection(obj, bpy.context.view_layer)
     frame = np.array(obj.matrix_world, dtype=np.float64)[:3, :3]
-    built = targets.build(chosen, skeleton, f"{obj.name}_rig", collection, frame, mesh=(vertices, triangles))
+    while True:
+        try:
+            built = targets.build(chosen, skeleton, f"{obj.name}_rig", collection, frame, mesh=(vertices, triangles))
+            break
+        except TargetFailed as error:  # nothing of it is left behind: the target it falls back to instead
+            chosen, further = choose_target(chosen.fallback, skeleton.body_plan)
+            fell_back = "; ".join(filter(None, [fell_back, f"{error}: built the {chosen.name} target instead",
+                                                further]))
     armature = built.armature
     if parent is not None:  # skinning makes the mesh the armature's child: the rig keeps following what moved it
         armature.parent = parent

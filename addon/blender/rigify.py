@@ -23,6 +23,7 @@ from mathutils import Matrix, Vector
 from ..core.metarig import METARIGS, MetaBone, choose_metarig, fit_metarig
 from ..core.roles import BoneRole
 from ..core.skeleton import Skeleton
+from ..core.targets import TargetFailed
 from .headless import blender_message
 from .meshdata import world_points
 
@@ -186,8 +187,8 @@ def place_bones(metarig, fit, scale=1.0):
 
 
 def generate(metarig, rig):
-    """Rigify's Generate Rig from ``metarig`` into armature object ``rig``; ValueError with Rigify's message when it
-    fails."""
+    """Rigify's Generate Rig from ``metarig`` into armature object ``rig``; ``core.targets.TargetFailed`` with
+    Rigify's message when it fails."""
     metarig.data.rigify_target_rig = rig
     view_layer = bpy.context.view_layer
     for other in view_layer.objects.selected:
@@ -200,12 +201,12 @@ def generate(metarig, rig):
         with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(printed):
             result = bpy.ops.pose.rigify_generate()
     except RuntimeError as error:
-        raise ValueError(f"Rigify could not generate the rig: {blender_message(error)}") from None
+        raise TargetFailed(f"Rigify could not generate the rig: {blender_message(error)}") from None
     finally:  # the copy of the metarig's armature Rigify generates from, left unused
         for data in [data for data in bpy.data.armatures if data not in before and data.users == 0]:
             bpy.data.armatures.remove(data)
     if 'FINISHED' not in result:
-        raise ValueError(f"Rigify could not generate the rig: {printed.getvalue().strip()[-300:]}")
+        raise TargetFailed(f"Rigify could not generate the rig: {printed.getvalue().strip()[-300:]}")
     _object_mode()
 
 

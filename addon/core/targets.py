@@ -43,6 +43,11 @@ TARGETS = {target.name: target for target in (
 )}
 
 
+class TargetFailed(ValueError):
+    """A target's builder could not make this skeleton's armature (Rigify refused the metarig fitted to it): the
+    target it falls back to is built instead."""
+
+
 def _check_fallbacks(targets):
     """ValueError unless every target that does not fill every plan falls back, without a cycle, to one that does."""
     for target in targets.values():
