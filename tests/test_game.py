@@ -293,6 +293,14 @@ def test_a_spine_along_a_chain_named_for_a_side_stays_the_body_s_middle():
     assert {"Hips", "Spine", "Spine1", "Spine2"} <= set(game_skeleton(renamed, vertices).skeleton.names)
 
 
+@pytest.mark.parametrize("vertices, message", [(np.full((5, 3), np.nan), "NaN or infinite coordinates"),
+                                               (np.zeros((0, 3)), "mesh has no vertices")])
+def test_the_game_skeleton_of_a_mesh_with_bad_vertices_is_a_clear_error(vertices, message):
+    skeleton, _, _ = rigged("humanoid")
+    with pytest.raises(ValueError, match=message):
+        game_skeleton(skeleton, vertices)
+
+
 def test_a_missing_foot_is_the_mesh_ahead_of_its_own_ankle():
     """``foot_ahead`` on points: ankle at the origin, front +Y, up +Z, a foot 1 long expected. A paw of another leg
     1.6 ahead with nothing between is no foot (the sample quadruped's hind foot ran to its front paw). A foot whose

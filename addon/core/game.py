@@ -41,6 +41,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .facing import facing, foot_ahead
+from .mesh import validated_vertices
 from .polyline import arc_lengths, arc_nearest, point_at, segment_distances
 from .roles import LIMB_STARTS, BoneRole, landmarks, named_joints, within_reach
 from .skeleton import Skeleton
@@ -89,13 +90,14 @@ class GameSkeleton:
 
 def game_skeleton(skeleton, vertices):
     """The :class:`GameSkeleton` of ``skeleton`` (with its roles and body plan, as ``rigger.rig_mesh`` returns it)
-    rigging a mesh with ``vertices`` (N, 3), by the scheme of this module's docstring. ValueError without roles."""
+    rigging a mesh with ``vertices`` (N, 3), by the scheme of this module's docstring. ValueError without roles, or
+    for vertices that are no (N, 3) finite numbers."""
     if skeleton.roles is None or skeleton.body_plan is None:
         raise ValueError("the game skeleton needs a skeleton with roles and a body plan (from rigger.rig_mesh)")
-    vertices = np.asarray(vertices, dtype=np.float64)
+    vertices = validated_vertices(vertices)
     up = np.asarray(skeleton.body_plan.up, dtype=np.float64)
     up /= np.linalg.norm(up)
-    size = float(np.ptp(vertices, axis=0).max()) if len(vertices) else 1.0
+    size = float(np.ptp(vertices, axis=0).max())
     graph = _Graph(skeleton, size)
     start = graph.hips_node()
     order, arriving = graph.oriented(start)
@@ -119,7 +121,7 @@ def game_skeleton(skeleton, vertices):
     parents = _twin_parents(names, heads, tails, parents)
     heads, tails = _mirrored_twins(names, heads, tails, skeleton.stages.get("mirror_plane"), size)
     hips = heads[bones.hips] if bones.hips is not None else graph.points[start]
-    ground = float((vertices @ up).min()) if len(vertices) else float(hips @ up)
+    ground = float((vertices @ up).min())
     foot = hips - (hips @ up - ground) * up
     names = [ROOT, *names]
     heads = np.vstack([foot, heads])

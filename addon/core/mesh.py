@@ -28,7 +28,7 @@ class Mesh:
     """
 
     def __init__(self, vertices, triangles):
-        self.vertices = _validated_vertices(vertices)
+        self.vertices = validated_vertices(vertices)
         self.triangles, self.degenerate_count = _validated_triangles(triangles, len(self.vertices))
         self._reject_line()
 
@@ -214,7 +214,9 @@ def _rows_of_three(values, what, kinds, kind_text, count_letter):
     return array
 
 
-def _validated_vertices(values):
+def validated_vertices(values):
+    """``values`` as a read-only (N, 3) float64 array; ValueError unless they are N >= 1 rows of three finite real
+    numbers."""
     array = np.array(_rows_of_three(values, "vertices", "iuf", "real numbers", "N"), dtype=np.float64)
     bad = nonfinite_rows(array)
     if bad.size:
