@@ -25,12 +25,11 @@ How the bones are placed, in order:
   (``core.roles.within_reach``: a hip joint beside the path, or up the skeleton's bone the leg hangs from); the
   other joints divide the stretch between such joints in the metarig's own proportions and move onto a skeleton
   joint near them (the skeleton's joints sit where the mesh bends): a skeleton without a toe gets its foot split at
-  the metarig's ball. A chain
-  whose last roles the skeleton lacks goes on to where the mesh ends ahead of it, when the mesh goes on there (an arm
-  ending at the wrist gets its hand; a skeleton whose spine ends at the chest gets a neck and a head; a leg ending at
-  the ankle gets its foot forward along the ground, ``core.facing.foot_ahead``), else they share
-  the stretch of the last role (a leg whose shin reaches the ground gets its foot and toe from the shin's lower part);
-  either way the fit says so.
+  the metarig's ball. A chain whose last roles the skeleton lacks goes on to where the mesh ends ahead of it, when
+  the mesh goes on there (an arm ending at the wrist gets its hand; a skeleton whose spine ends at the chest gets a
+  neck and a head; a leg ending at the ankle gets its foot forward along the ground, ``core.facing.foot_ahead``),
+  else they share the stretch of the last role (a leg whose shin reaches the ground gets its foot and toe from the
+  shin's lower part); either way the fit says so.
 - Limbs that Rigify bends with IK (legs, arms, paws): the joint between their first two bones is moved, when it does
   not already bend that way by ``bend`` of the limb's reach, so that knees bend forward and elbows backward (Rigify
   takes the bend direction from the chain); a limb bent sideways leans at most ``tilt`` from that. An animal's hind

@@ -6,7 +6,7 @@ import pathlib
 import re
 
 CHUNK_BYTES = 1 << 24  # read this much at a time (and on to the end of its line): a large file is never held whole
-_WORDS = (b"nan", b"inf")  # in lowered text, with a three-digit exponent: what could spell a non-finite number
+_WORDS = (b"nan", b"inf")  # in lowered text, with a large exponent: what could spell a non-finite number
 _EXPONENT = re.compile(rb"e\+?0*(?:3[89]|[4-9]\d|[1-9]\d\d)")  # may pass FLOAT_MAX (a literal first: fast)
 _WORD = re.compile(rb"^v[ \t][-+0-9.e \t\r]*+[^-+0-9.e \t\r\n]", re.MULTILINE)  # a v line with more than numbers
 FLOAT_MAX = 3.4028234663852886e38  # Blender's coordinates are 32-bit floats: beyond this the importer reads 0
