@@ -497,6 +497,23 @@ def test_an_unknown_target_is_refused_before_anything_is_made(scene):
     assert set(bpy.data.objects) == before
 
 
+def test_a_mesh_far_from_the_origin_fails_saying_why(scene):
+    """Ten million units from the origin Blender's 32-bit coordinates are a unit apart: a character two metres tall
+    collapses onto a few slices and was rigged as such without a word (a character a metre tall failed as "mesh is a
+    line"). The error says where the mesh lies, and to move it."""
+    from mathutils import Matrix
+
+    from rigger.blender.pipeline import rig_object
+
+    obj = build_character("humanoid", subdivisions=0)
+    obj.data.transform(Matrix.Translation((1e7, 0.0, 0.0)))
+    before = set(bpy.data.objects)
+    with pytest.raises(ValueError, match=r"^the mesh lies 1e\+07 from the origin, where Blender's coordinates are "
+                                         r"1.19 apart: too coarse for a mesh .* across; move it near the origin$"):
+        rig_object(obj)
+    assert set(bpy.data.objects) == before
+
+
 def test_operators_are_undoable_and_scriptable_by_name(registered):
     from rigger.blender.operators import CLASSES
     assert sorted(cls.bl_idname for cls in CLASSES) == [

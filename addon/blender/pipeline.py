@@ -21,6 +21,7 @@ METHOD_PROPERTY = "rigger_method"  # custom property on the armature: the method
 TARGET_PROPERTY = "rigger_target"  # ... and the output target it was built as
 BONE_PATH = re.compile(r'pose\.bones\["(.+?)"\]')  # an animation curve's path to the pose bone it keys
 OVERLAYS_PROPERTY = "rigger_overlays"  # ... and the owner its overlays were drawn for (its mesh's name then)
+FAR_SPACING = 0.01  # a mesh whose 32-bit coordinates are this coarse (a share of its size) is too far to rig
 
 
 @dataclass
@@ -55,8 +56,9 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     overlays start shown (None: build none; a stage it does not name starts as its type says);
     ``progress(fraction)`` is called between steps. A target the skeleton's body plan cannot fill falls back
     (``core.targets.choose_target``) with a warning, and so does one whose builder fails on it
-    (``core.targets.TargetFailed``: Rigify refusing the fitted metarig). ValueError for bad meshes, methods,
-    parameters or targets; nothing is created when rigging fails.
+    (``core.targets.TargetFailed``: Rigify refusing the fitted metarig). ValueError for bad meshes (one too far from
+    the origin for Blender's coordinates among them), methods, parameters or targets; nothing is created when
+    rigging fails.
     """
     check_target(target)
     report = progress or (lambda fraction: None)
@@ -66,6 +68,7 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
         vertices, triangles = combined_arrays(meshes)
     clock.lap("read_mesh")
     report(0.1)
+    _check_near_origin(vertices)
     skeleton = rig_mesh(vertices, triangles, method, axes=own_axes(obj), **(params or {}))
     chosen, fell_back = choose_target(target, skeleton.body_plan)
     clock.lap("rig")
@@ -103,6 +106,20 @@ def rig_object(obj, method="silhouette", params=None, *, target="plain", parts=(
     warnings = [fell_back] if fell_back else []
     return RigResult(armature, meshes, skeleton, chosen, built.bones, replaced, clock.laps, drawn,
                      warnings + built.warnings, carried)
+
+
+def _check_near_origin(vertices):
+    """ValueError when the mesh lies so far from the origin that Blender's 32-bit coordinates there are coarser than
+    ``FAR_SPACING`` of its size: its shape is lost (vertices collapse onto a few points) and a rig's bones would be
+    too."""
+    if not len(vertices):
+        return
+    far = float(np.abs(vertices).max())
+    spacing = far * 2.0 ** -23  # between neighbouring 32-bit floats that large
+    size = float(np.ptp(vertices, axis=0).max())
+    if spacing > FAR_SPACING * size:
+        raise ValueError(f"the mesh lies {far:.3g} from the origin, where Blender's coordinates are {spacing:.3g} "
+                         f"apart: too coarse for a mesh {size:.3g} across; move it near the origin")
 
 
 def _previous_motion(meshes):
