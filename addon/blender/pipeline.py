@@ -117,7 +117,7 @@ def _check_near_origin(vertices):
     far = float(np.abs(vertices).max())
     spacing = far * 2.0 ** -23  # between neighbouring 32-bit floats that large
     size = float(np.ptp(vertices, axis=0).max())
-    if spacing > FAR_SPACING * size:
+    if 0 < FAR_SPACING * size < spacing:  # a mesh of no size is rig_mesh's to refuse
         raise ValueError(f"the mesh lies {far:.3g} from the origin, where Blender's coordinates are {spacing:.3g} "
                          f"apart: too coarse for a mesh {size:.3g} across; move it near the origin")
 
