@@ -149,6 +149,22 @@ def test_outputs_never_overwrite_the_input_or_each_other(rigged_glb, tmp_path):
     assert sorted(files_below(tmp_path)) == ["a_file", "model.glb", "taken.glb"]
 
 
+def test_faces_blenders_obj_importer_drops_are_a_warning(humanoid_obj, tmp_path):
+    """Blender's OBJ importer drops a face naming a vertex the file lacks (or one vertex twice) without a word: a
+    mesh with holes rigged as if whole. The warning counts them."""
+    source = tmp_path / "holes.obj"
+    source.write_text(humanoid_obj[0].read_text() + "f 1 2 99999\nf 1 1 2\n")
+    report = tmp_path / "holes.json"
+    result = run("rig", source, "-o", tmp_path / "holes.glb", "--report", report, "--no-skin")
+    assert result.returncode == 0, result.stderr
+    faces = len(humanoid_obj[2])
+    warning = (f"Blender's OBJ importer kept {faces} of the file's {faces + 2} faces: it drops those it cannot read "
+               f"(naming a vertex the file lacks, or one vertex twice)")
+    assert warning in json.loads(report.read_text())["warnings"] and f"warning: {warning}" in result.stderr
+    result = run("rig", humanoid_obj[0], "-o", tmp_path / "whole.glb", "--no-skin")
+    assert "OBJ importer" not in result.stderr
+
+
 def test_no_skin_and_fbx_output(humanoid_obj, tmp_path):
     result = run("rig", humanoid_obj[0], "-o", tmp_path / "out.fbx", "--no-skin", "--report", tmp_path / "r.json")
     assert result.returncode == 0, result.stderr

@@ -406,7 +406,10 @@ def test_an_obj_vertex_that_is_no_finite_number_is_named_by_its_line(tmp_path, m
     assert f"line 5: vertex coordinate {coordinate!r} is not a finite number" in str(error.value)
     path.write_text("mtllib info.mtl\no Infantry\nusemtl nan\nv 0 0 0\r\nv 3E+38 1e-400 0 # far\nvt 0.5 0.5\n"
                     "f 1 2 1\n")
-    objfile.check(path)  # words elsewhere, the largest 32-bit floats, an underflow to 0 and a comment are sound
+    # words elsewhere, the largest 32-bit floats, an underflow to 0 and a comment are sound; its faces are counted
+    assert objfile.check(path) == 1
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf\t3 2 1\nfo 1 2 3\n")
+    assert objfile.check(path) == 2
 
 
 def test_a_blender_operator_error_is_one_clause():

@@ -37,7 +37,7 @@ def rig_file(source, output, method, params, *, target="plain", skin=True, up=No
     axes = file_axes(source.suffix, up, forward)
     empty_scene()
     try:
-        frame = _import(source, axes)
+        *frame, faces = _import(source, axes)
     except RuntimeError as error:
         raise ValueError(f"{source}: Blender could not import it: {blender_message(error)}") from None
     meshes = shown_meshes(bpy.context.view_layer)
@@ -46,6 +46,10 @@ def rig_file(source, output, method, params, *, target="plain", skin=True, up=No
     meshes.sort(key=lambda obj: -len(obj.data.vertices))
     character, left_out = character_meshes(meshes)
     warnings = [f"left out {mesh.name!r} ({why}): it is saved as it was, unrigged" for mesh, why in left_out]
+    imported = sum(len(obj.data.polygons) for obj in bpy.data.objects if obj.type == 'MESH')
+    if faces is not None and imported < faces:
+        warnings.append(f"Blender's OBJ importer kept {imported} of the file's {faces} faces: it drops those it cannot "
+                        f"read (naming a vertex the file lacks, or one vertex twice)")
     warnings += release_from_armatures(character)
     result = rig_object(character[0], method, params, target=target, parts=character[1:])
     warnings += ["replaced the armature Rigger made for the file before"] if result.replaced else []
@@ -152,28 +156,28 @@ def rig_report(result, outcomes, to_world=np.eye(3), frame="blender world", warn
 
 def _import(source, axes):
     """Import ``source`` into the empty scene, read with ``axes`` (``rigger.axes.file_axes``); (3x3 matrix from the
-    file's frame to Blender's world, the frame's name)."""
+    file's frame to Blender's world, the frame's name, the number of faces the file holds for an OBJ, else None)."""
     suffix = source.suffix.lower()
     path = str(source)
     if suffix == ".obj":
-        objfile.check(source)  # what the importer would read as 0
+        faces = objfile.check(source)  # what the importer would read as 0
         up, forward = axes
         bpy.ops.wm.obj_import(filepath=path, up_axis=_enum(up), forward_axis=_enum(forward))
-        return to_blender(up, forward), f"file (the OBJ's v coordinates, read with up {up}, forward {forward})"
+        return to_blender(up, forward), f"file (the OBJ's v coordinates, read with up {up}, forward {forward})", faces
     if suffix in (".glb", ".gltf"):
         bpy.ops.import_scene.gltf(filepath=path)
-        return to_blender(*axes), "file (glTF, Y up)"
+        return to_blender(*axes), "file (glTF, Y up)", None
     if suffix == ".fbx":
         if axes is None:
             bpy.ops.import_scene.fbx(filepath=path)
-            return np.eye(3), "blender world (FBX axes and units converted by Blender's importer)"
+            return np.eye(3), "blender world (FBX axes and units converted by Blender's importer)", None
         up, forward = axes
         bpy.ops.import_scene.fbx(filepath=path, use_manual_orientation=True, axis_up=up, axis_forward=forward)
         return np.eye(3), f"blender world (FBX read with up {up}, forward {forward}, units converted by Blender's " \
-                          f"importer)"
+                          f"importer)", None
     if suffix == ".blend":
         bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
-        return np.eye(3), "blender world"
+        return np.eye(3), "blender world", None
     raise ValueError(f"{source}: unsupported file type {suffix!r}")
 
 
