@@ -160,7 +160,7 @@ def _import(source, axes):
     suffix = source.suffix.lower()
     path = str(source)
     if suffix == ".obj":
-        faces = objfile.check(source)  # what the importer would read as 0
+        faces = objfile.check(source)  # refuses what the importer would read as 0; counts the faces it may drop
         up, forward = axes
         bpy.ops.wm.obj_import(filepath=path, up_axis=_enum(up), forward_axis=_enum(forward))
         return to_blender(up, forward), f"file (the OBJ's v coordinates, read with up {up}, forward {forward})", faces

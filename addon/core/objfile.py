@@ -1,6 +1,6 @@
 """What Blender's OBJ importer reads silently wrong: a vertex coordinate that is no finite number ("nan", "inf", an
 exponent past the range of Blender's 32-bit floats, a word) becomes 0, a spike to the origin that rigs and skins
-without a warning."""
+without a warning; and a face it cannot read is dropped, which the file's count of faces shows."""
 import math
 import pathlib
 import re
