@@ -168,13 +168,10 @@ def _knee(pose, rig, side, left):
     """+1 when the knee on ``side`` bends the way a knee bends about its hinge (the rest ``left`` turned with the
     thigh), -1 the other way, 0 within ``BENT`` degrees of straight (or without a thigh, shin and foot)."""
     names = [f"{side}{word}" for word in ("UpLeg", "Leg", "Foot")]
-    if any(name not in pose for name in names):
+    limb = _bent_limb(pose, names)
+    if limb is None:
         return 0
-    a, b, c = (np.array(pose[name].head) for name in names)
-    upper, lower = b - a, c - b
-    angle = np.degrees(np.arccos(np.clip(upper @ lower / (np.linalg.norm(upper) * np.linalg.norm(lower)), -1, 1)))
-    if angle < BENT:
-        return 0
+    upper, lower = limb
     turn = np.array(pose[names[0]].matrix)[:3, :3] @ rig.rest[rig.names.index(names[0]), :3, :3].T
     return 1 if np.cross(upper, lower) @ (turn @ left) > 0 else -1
 
@@ -182,16 +179,24 @@ def _knee(pose, rig, side, left):
 def _bend(pose, first, middle, last, facing):
     """+1 when the joint at ``middle`` lies in front of the line from ``first``'s head to ``last``'s head (along
     ``facing``), -1 behind, 0 when the limb is within ``BENT`` degrees of straight (or the rig lacks one of them)."""
-    if any(name not in pose for name in (first, middle, last)):
+    limb = _bent_limb(pose, (first, middle, last))
+    if limb is None:
         return 0
-    a, b, c = (np.array(pose[name].head) for name in (first, middle, last))
-    upper, lower = b - a, c - b
-    angle = np.degrees(np.arccos(np.clip(upper @ lower / (np.linalg.norm(upper) * np.linalg.norm(lower)), -1, 1)))
-    if angle < BENT:
-        return 0
-    line = (c - a) / np.linalg.norm(c - a)
+    upper, lower = limb
+    line = (upper + lower) / np.linalg.norm(upper + lower)
     offset = upper - (upper @ line) * line
     return 1 if offset @ facing > 0 else -1
+
+
+def _bent_limb(pose, names):
+    """(upper, lower): the vectors from the first of the three posed bones' heads ``names`` to the second and from
+    the second to the third; None when the pose lacks one or they lie within ``BENT`` degrees of straight."""
+    if any(name not in pose for name in names):
+        return None
+    a, b, c = (np.array(pose[name].head) for name in names)
+    upper, lower = b - a, c - b
+    angle = np.degrees(np.arccos(np.clip(upper @ lower / (np.linalg.norm(upper) * np.linalg.norm(lower)), -1, 1)))
+    return None if angle < BENT else (upper, lower)
 
 
 def _world_vertices(obj, depsgraph, rest=False):

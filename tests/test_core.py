@@ -6,6 +6,7 @@ import pytest
 
 from rigger.core import bvh, objfile
 from rigger.core.accessories import barycentric, boneless_parts, part_means, surface_entries
+from rigger.core.graphs import loose_parts
 from rigger.core.mesh import Mesh, triangulate_polygons
 from rigger.core.params import Param, resolve
 from rigger.core.skeleton import Skeleton
@@ -462,10 +463,11 @@ def test_accessories_are_the_loose_parts_no_bone_runs_through_the_body_never_one
     triangles = np.concatenate([faces + 8 * k for k, (_, faces) in enumerate(parts)])
     points = np.vstack([points, [(5.0, 5.0, 5.0)]])  # a point in no triangle: a part of its own
     heads, tails = np.array([(0, 0, -0.5), (0, 0, 2.5)]), np.array([(0, 0, 2.5), (0, 0, 3.5)])  # into the 2nd box
-    part_of, boneless = boneless_parts(points, triangles, heads, tails)
+    part_of = loose_parts(len(points), triangles)
+    boneless = boneless_parts(part_of, points, heads, tails)
     assert part_of.tolist() == [0] * 8 + [1] * 8 + [2] * 8 + [3] * 8 + [4]
     assert boneless.tolist() == [False, False, True, True, True]
-    _, boneless = boneless_parts(points, triangles, heads + 10, tails + 10)  # no bone anywhere near
+    boneless = boneless_parts(part_of, points, heads + 10, tails + 10)  # no bone anywhere near
     assert boneless.tolist() == [False, True, True, True, True]  # the largest part stays the body
 
 

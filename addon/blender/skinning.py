@@ -35,6 +35,7 @@ import io
 import json
 import time
 from dataclasses import asdict, dataclass, field
+from functools import cached_property
 
 import bpy
 import bmesh
@@ -44,7 +45,7 @@ from mathutils.bvhtree import BVHTree
 
 from ..core.accessories import barycentric, boneless_parts, part_means, surface_entries
 from ..core.arrays import column_bounds, concatenated_ranges
-from ..core.graphs import components
+from ..core.graphs import loose_parts
 from ..weights import bone_weights, vertex_normals
 from .meshdata import mesh_arrays, world_points
 
@@ -283,8 +284,7 @@ def _repair_islands(mesh_obj, armature_obj, bone_names, weighted, weld, report):
     other part hides its bones, no other part makes its heat system singular)."""
     started = time.perf_counter()
     weld_map, welded_positions, welded_triangles = weld.map, weld.positions, weld.triangles
-    edges = np.concatenate([welded_triangles[:, [0, 1]], welded_triangles[:, [1, 2]]])
-    island_of = components(len(welded_positions), edges)
+    island_of = weld.parts
     parts = int(island_of.max()) + 1
     if parts == 1:  # the whole mesh was tried already
         return
@@ -387,6 +387,11 @@ class Weld:
     triangles: np.ndarray
     subsurf: bool
 
+    @cached_property
+    def parts(self):
+        """(welded vertices,) the loose part of each welded vertex (``core.graphs.loose_parts``)."""
+        return loose_parts(len(self.positions), self.triangles)
+
 
 @dataclass
 class _Accessories:
@@ -404,7 +409,8 @@ class _Accessories:
 
     @classmethod
     def of(cls, weld, heads, tails):
-        part_of, boneless = boneless_parts(weld.positions, weld.triangles, heads, tails)
+        part_of = weld.parts
+        boneless = boneless_parts(part_of, weld.positions, heads, tails)
         if boneless[part_of[weld.triangles[:, 0]]].all():
             boneless[:] = False
         accessory = boneless[part_of]

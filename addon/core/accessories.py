@@ -11,28 +11,24 @@ this posed closer to the artists' rigs than each vertex taking its own nearest p
 import numpy as np
 
 from .arrays import concatenated_ranges
-from .graphs import components
 
 CONTACT = 0.05  # a point this share of its part's extent from the surface counts half as much as one touching it
 
 
-def boneless_parts(positions, triangles, heads, tails):
-    """(part of each point (N,), boneless (P,) bool) for a mesh (its seams welded) and its bones: the loose parts
-    (points joined by triangles; a point in none is a part of its own) and which of them are accessories, the
-    parts whose bounding box no bone segment (``heads`` to ``tails``, (B, 3)) crosses. The largest part is never
-    one: it is the body the others sit on."""
-    positions = np.asarray(positions, dtype=np.float64)
-    triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
-    part_of = components(len(positions), np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]]]))
+def boneless_parts(part_of, positions, heads, tails):
+    """(P,) bool: which loose parts of a mesh (its seams welded; ``part_of`` the part of each of its ``positions``,
+    ``core.graphs.loose_parts``) are accessories, the parts whose bounding box no bone segment (``heads`` to
+    ``tails``, (B, 3)) crosses. The largest part is never one: it is the body the others sit on."""
+    part_of = np.asarray(part_of)
     count = int(part_of.max()) + 1 if len(part_of) else 0
-    low, high = _bounds(part_of, positions, count)
+    low, high = _bounds(part_of, np.asarray(positions, dtype=np.float64), count)
     crossed = np.zeros(count, dtype=bool)
     for head, tail in zip(np.asarray(heads, dtype=np.float64), np.asarray(tails, dtype=np.float64)):
         crossed |= _segment_crosses(head, tail, low, high)
     boneless = ~crossed
     if count:
         boneless[np.argmax(np.bincount(part_of, minlength=count))] = False
-    return part_of, boneless
+    return boneless
 
 
 def _bounds(part_of, points, count):

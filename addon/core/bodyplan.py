@@ -31,7 +31,7 @@ import numpy as np
 
 from .body import AXES, BodyTuning, read_body, spreads_across
 from .polyline import arc_lengths, length, nearest_on_segments
-from .roles import RoleTuning, assign_roles, joint_places
+from .roles import RoleTuning, assign_roles, joint_places, twin_paths
 from .stages import MirrorPlane
 from .tuning import tuned
 
@@ -154,8 +154,9 @@ def recognise(skeleton, mesh, *, plane=None, prefer_up=AXES[2], tuning=BodyPlanT
         plane = MirrorPlane(plane.axis, plane.offset * factor, plane.normal)
     body = read_body(at_unit_size, mesh.at_unit_size(), tuning, plane, prefer_up / np.linalg.norm(prefer_up))
     layout = lay_out(body, tuning)
-    roles = assign_roles(skeleton, body, layout, tuning)
-    return replace(layout.plan, joints=joint_places(at_unit_size, body, layout, tuning)), roles
+    paths = twin_paths(body, tuning)
+    roles = assign_roles(skeleton, body, layout, paths, tuning)
+    return replace(layout.plan, joints=joint_places(at_unit_size, body, layout, paths, tuning)), roles
 
 
 def lay_out(body, tuning=BodyPlanTuning()):

@@ -29,6 +29,12 @@ def components(count, links):
     return np.unique(parent, return_inverse=True)[1]
 
 
+def loose_parts(count, triangles):
+    """The loose part (``components``) of each of ``count`` mesh vertices joined by ``triangles`` ((T, 3))."""
+    triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    return components(count, np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]]]))
+
+
 def neighbour_lists(count, links):
     """For each of ``count`` nodes, the list of nodes ``links`` ((L, 2) node indices) join it to, in link order."""
     neighbours = [[] for _ in range(count)]

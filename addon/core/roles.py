@@ -133,9 +133,9 @@ class RoleTuning(TuningTable):
                                      "shortest bone (none shrinks below a quarter); farther off is another chain's")
 
 
-def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
+def assign_roles(skeleton, body, layout, paths, tuning=RoleTuning()):
     """One :class:`BoneRole` per bone of ``skeleton`` (see the module docstring), from its ``body``
-    (``core.body.Body``) and ``layout`` (``core.bodyplan.Layout``)."""
+    (``core.body.Body``), ``layout`` (``core.bodyplan.Layout``) and its limbs' ``paths`` (:func:`twin_paths`)."""
     graph = body.graph
     segment_bone = {}
     for a, links in enumerate(graph.neighbours):
@@ -171,7 +171,7 @@ def assign_roles(skeleton, body, layout, tuning=RoleTuning()):
     for k, limb in enumerate(body.limbs):
         side = _limb_side(skeleton, graph, limb, left)
         part = layout.parts[k]
-        path = _TwinPath(body, limb, tuning)
+        path = paths[k]
         if part == "leg":
             _leg(body, limb, path.points, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
         elif part == "arm":
@@ -244,7 +244,13 @@ def _filled(roles, skeleton, kind):
     return tuple(roles)
 
 
-class _TwinPath:
+def twin_paths(body, tuning=RoleTuning()):
+    """A :class:`TwinPath` per limb of ``body``: read once for its roles and its joints (the mesh's reach beyond an
+    arm is a search of the whole mesh)."""
+    return [TwinPath(body, limb, tuning) for limb in body.limbs]
+
+
+class TwinPath:
     """A limb's main path read for its roles and joints: the joints' ``points``, the mesh's ``radius`` at them and its
     ``reach`` beyond the last (:func:`_reach`), averaged with its twin's mirror image when both have as many joints:
     twins get their roles cut, and their joints placed, alike though the mesh mirrors only nearly."""
@@ -659,11 +665,12 @@ def _boundaries(skeleton, roles):
 
 # Places of named joints along the bones.
 
-def joint_places(skeleton, body, layout, tuning=RoleTuning()):
+def joint_places(skeleton, body, layout, paths, tuning=RoleTuning()):
     """{(name, side, digit): place} of the named joints (a role's name) and landmarks (``LANDMARKS``) the body's
-    geometry places between bone ends (see the module docstring): on legs and arms, on an upright humanoid's spine,
-    and the head's top. ``skeleton`` is the one ``body`` was read from. A place is ``((bone, share, weight), ...)``:
-    the weighted sum (weights summing to 1) of the points ``share`` of the way along those bones."""
+    geometry places between bone ends (see the module docstring): on legs and arms (their ``paths``,
+    :func:`twin_paths`), on an upright humanoid's spine, and the head's top. ``skeleton`` is the one ``body`` was read
+    from. A place is ``((bone, share, weight), ...)``: the weighted sum (weights summing to 1) of the points ``share``
+    of the way along those bones."""
     if layout.plan.kind == "other":
         return {}
     graph = body.graph
@@ -678,7 +685,7 @@ def joint_places(skeleton, body, layout, tuning=RoleTuning()):
         if part not in ("leg", "arm") or len(limb.main) < 2:
             continue
         side = _limb_side(skeleton, graph, limb, left)
-        path = _TwinPath(body, limb, tuning)
+        path = paths[k]
         arc = arc_lengths(path.points)
         found = _leg_places(body, path, arc, layout.front[k], tuning) if part == "leg" else \
             _arm_places(body, limb, path, arc, tuning)
