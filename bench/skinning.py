@@ -120,9 +120,8 @@ def skin_model(model, kind):
             bones=len(names), welded=report.welded, unweighted=report.unweighted,
             recounted_unweighted=int((dominant < 0).sum()),
             failed=any(FAILURE_MESSAGE in message for message in report.stages[0].messages),
+            left_by_bone_heat=report.vertices - report.stages[0].weighted,  # accessories are in bone heat too
             accessories=sum(stage.weighted for stage in report.stages if stage.name == SURFACE_STAGE),
-            left_by_bone_heat=report.vertices - report.stages[0].weighted
-            - sum(stage.weighted for stage in report.stages if stage.name == SURFACE_STAGE),
             stages={stage.name: stage.weighted for stage in report.stages[1:]},
             notes={stage.name: stage.note for stage in report.stages[1:] if stage.note},
             agreement=agreement(joint_of_bone, dominant, model.artist_joint), summary=report.summary())
@@ -266,8 +265,9 @@ def markdown(records, alone, speed, run):
         "artist skeleton and the area-weighted vertex normals of the mesh with its seams welded (vertices at one "
         "position merged), no bone heat: what the fallback is worth on its own.",
         "- Repair columns: models where the stage ran / where it weighted vertices / vertices it weighted. "
-        "*Accessories*: the loose parts no bone runs through, left out of bone heat and moved as one piece with "
-        "the surface nearest to them (`rigger.core.accessories`): models that have any / their vertices.",
+        "*Accessories*: the loose parts no bone runs through, weighted by bone heat with the rest, then moved as "
+        "one piece with the surface nearest to them (`rigger.core.accessories`): models that have any / their "
+        "vertices.",
         "- Seams: *seam vertices* share their exact position with another vertex (the file split them for UVs or "
         "normals); the *seam gap* is the largest difference of one bone's weight between two such copies (0: the "
         "posed mesh cannot crack there). *Seams cracked* counts the models whose gap is above 0.",
@@ -281,7 +281,8 @@ def markdown(records, alone, speed, run):
     ]
     out += markdown_table(["skeleton", "models", "errors", "unweighted vertices", "bone heat failed (message)",
                   "bone heat left vertices silently", "island bone heat", "nearest bones",
-                  "accessories (models / vertices)", "seams cracked / largest gap", "time (median)", "time (max)", "top-1 agreement (mean)"],
+                  "accessories (models / vertices)", "seams cracked / largest gap", "time (median)", "time (max)",
+                  "top-1 agreement (mean)"],
                          summary_rows(records, alone))
     out += ["", "![agreement per model, skinning time, fallback speed](skinning.png)", "", "## Per model", ""]
     rows = []
@@ -299,7 +300,8 @@ def markdown(records, alone, speed, run):
                      percent(record["agreement"]),
                      percent(alone.get(record["model"])) if record["skeleton"] == "artist" else ""])
     out += markdown_table(["model", "skeleton", "vertices", "bones", "seam vertices", "welded", "bone heat",
-                  "islands", "nearest", "accessories", "unweighted", "seam gap", "skin time", "top-1 agreement", "nearest bones alone"], rows)
+                  "islands", "nearest", "accessories", "unweighted", "seam gap", "skin time", "top-1 agreement",
+                  "nearest bones alone"], rows)
     if speed:
         out += ["", "## The compiled nearest-bones weighting alone", "",
                 "`rigger.weights.bone_weights(points, heads, tails, normals)` (4 bones per point), random bone "
