@@ -10,7 +10,7 @@ from rigger.core.arrays import column_bounds
 from rigger.core.graphs import chains_of
 from rigger.core.joints import Cutting, chain_joints, symmetric_joints
 from rigger.core.mirror import (Symmetry, mirror_chain_pairs, mirror_completed, mirror_plane, mirrored,
-                                 sided_symmetry)
+                                 sided_symmetry, symmetric_planes)
 from rigger.core.naming import bone_names
 from rigger.core.polyline import arc_lengths, segment_distances
 from rigger.methods.silhouette import depth
@@ -665,6 +665,22 @@ def test_a_flat_mesh_is_not_mirrored_across_its_own_plane():
     axis, offset = plane(t_shape)
     assert axis == 0 and offset == pytest.approx(0.005)
     assert plane(l_shape) is None
+
+
+def test_mirror_planes_are_found_alike_at_any_tolerance():
+    """A cloud mirrored across x = 0.25 fits that plane and no other, whether the tolerance makes a grid small
+    enough to flag every cell or so fine (a millionth of the size) that only the sorted cell keys fit in memory; with
+    each point of one half moved five tolerances off its image, none."""
+    rng = np.random.default_rng(3)
+    half = rng.uniform([0.25, 0.0, 0.0], [1.0, 1.0, 0.6], (500, 3))
+    cloud = np.vstack([half, half * [-1, 1, 1] + [0.5, 0, 0]])
+    for tolerance in (0.02, 1e-6):
+        planes = symmetric_planes(cloud, column_bounds(cloud), tolerance, TUNING)
+        assert [(axis, offset) for axis, offset, _ in planes] == [(0, pytest.approx(0.25))]
+        away = rng.normal(size=half.shape)
+        moved = np.vstack([half, half * [-1, 1, 1] + [0.5, 0, 0] + 5 * tolerance * away / np.linalg.norm(
+            away, axis=1, keepdims=True)])
+        assert symmetric_planes(moved, column_bounds(moved), tolerance, TUNING) == []
 
 
 def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_at_all():

@@ -104,13 +104,13 @@ def symmetric_planes(vertices, bounds, tolerance, tuning):
     Tries the planes through the centre of ``bounds`` (their (2, 3) bounding box) perpendicular to X, Y and Z where
     the box is more than two ``tolerance`` deep (across a flat mesh's own plane nothing has a side); a plane fits
     when a ``plane_share`` of (up to ``plane_samples``) vertices have a mirror image among the vertices within
-    ``tolerance``: vertices are hashed to a grid of that size and the mirrored ones looked up in the sorted hashes,
+    ``tolerance``: vertices are hashed to a grid of that size and the mirrored ones looked up in it (``_CellSet``),
     with their 26 neighbour cells.
     """
     low, high = bounds
     origin = low - 2 * tolerance
     span = np.floor((high - low) / tolerance).astype(np.int64) + 5
-    table = np.unique(_cell_keys(np.floor((vertices - origin) / tolerance).astype(np.int64), span))
+    occupied = _CellSet(_cell_keys(np.floor((vertices - origin) / tolerance).astype(np.int64), span), span)
     step = max(1, len(vertices) // tuning.plane_samples)
     probe = vertices[::step]
     offsets = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)])
@@ -119,9 +119,7 @@ def symmetric_planes(vertices, bounds, tolerance, tuning):
         centre = 0.5 * (low[axis] + high[axis])
         cells = np.floor((mirrored(probe, (axis, centre)) - origin) / tolerance).astype(np.int64)
         around = np.clip(cells[:, None, :] + offsets[None], 0, span - 1).reshape(-1, 3)
-        keys = _cell_keys(around, span)
-        at = np.minimum(np.searchsorted(table, keys), len(table) - 1)
-        score = (table[at] == keys).reshape(len(probe), -1).any(axis=1).mean()
+        score = occupied.holds(_cell_keys(around, span)).reshape(len(probe), -1).any(axis=1).mean()
         if score >= tuning.plane_share:
             planes.append((int(axis), centre, score))
     return planes
@@ -148,6 +146,28 @@ def sided_symmetry(vertices, bounds, size, lines, tuning):
 
 def _cell_keys(cells, span):
     return (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]
+
+
+class _CellSet:
+    """The cells of a grid ``span`` cells wide that hold one of ``keys``: a flag per cell where the grid has at most
+    ``DENSE_CELLS`` (one pass over the keys, where sorting them would dominate on a large mesh), else the sorted
+    keys."""
+
+    DENSE_CELLS = 1 << 24
+
+    def __init__(self, keys, span):
+        if np.prod(span) <= self.DENSE_CELLS:
+            self.flags = np.zeros(int(np.prod(span)), dtype=bool)
+            self.flags[keys] = True
+        else:
+            self.flags, self.sorted = None, np.unique(keys)
+
+    def holds(self, keys):
+        """Which of ``keys`` (cells within the grid) hold a key of the set."""
+        if self.flags is not None:
+            return self.flags[keys]
+        at = np.minimum(np.searchsorted(self.sorted, keys), len(self.sorted) - 1)
+        return self.sorted[at] == keys
 
 
 def mirror_chain_pairs(lines, symmetry):
