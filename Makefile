@@ -11,7 +11,8 @@ BPY42_STAMP := $(BPY42_VENV)/.installed
 RAY_STAMP := $(VENV)/.ray-installed
 
 .PHONY: test build demo addon bpy42 ray bench bench-quality bench-silhouette bench-skinning bench-posing \
-	bench-bodyplan bench-frames bench-retarget bench-rigify bench-rig-time bench-batch regress regress-baseline defects clean
+	bench-bodyplan bench-frames bench-robustness bench-retarget bench-rigify bench-rig-time bench-batch regress \
+	regress-baseline defects clean
 
 $(STAMP): requirements.txt
 	$(PYTHON) -m venv $(VENV)
@@ -70,6 +71,10 @@ bench-bodyplan: build
 # Every ../shared/models/gt model rigged read in six frames (its own, four turned, Blender's import): frames.{md,png,json}.
 bench-frames: build
 	$(PY) bench/frames.py
+
+# Every ../shared model rigged clean and with noise too small to see: robustness.{md,png,json}.
+bench-robustness: build
+	$(PY) bench/robustness.py
 
 # The CMU walk and jump (../shared/anim) on game rigs of the humanoids: feet, knees, elbows, weights, seams.
 bench-retarget: build
