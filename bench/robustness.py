@@ -37,17 +37,19 @@ def noisy(vertices, sigma, seed):
     return vertices + offsets[position.ravel()]
 
 
-def rigged(vertices, triangles, normalisation, truth):
-    """(plan kind, bones, unit bones' joints and samples, CD-J2J to the artist's or None) of Rigger on a mesh."""
-    skeleton = rigger.rig_mesh(vertices, triangles)
+def rigged(vertices, triangles, normalisation, truth, params):
+    """(plan kind, bones, unit bones' joints and samples, CD-J2J to the artist's or None) of Rigger on a mesh, with
+    the method parameters ``params``."""
+    skeleton = rigger.rig_mesh(vertices, triangles, **params)
     bones = rigdata.Bones.of(skeleton).mapped(normalisation)
     joints, samples = bones.joints(), bones.samples()
     to_artist = None if truth is None else rigdata.skeleton_distances(joints, samples, *truth)["cd_j2j"]
     return skeleton.body_plan.kind, len(bones), joints, samples, to_artist
 
 
-def measure(name, sigmas=SIGMAS, seeds=SEEDS):
-    """One model's clean rig and every noisy one, compared."""
+def measure(name, sigmas=SIGMAS, seeds=SEEDS, params=None):
+    """One model's clean rig and every noisy one (Rigger with the method parameters ``params``), compared."""
+    params = params or {}
     vertices, triangles, rig, _ = load(name)
     normalisation = rigdata.Normalisation.of_mesh(vertices)
     truth = None
@@ -55,13 +57,13 @@ def measure(name, sigmas=SIGMAS, seeds=SEEDS):
         artist = rig.bones().mapped(normalisation)
         truth = (artist.joints(), artist.samples())
     size = 1.0 / normalisation.scale
-    kind, count, joints, samples, to_artist = rigged(vertices, triangles, normalisation, truth)
+    kind, count, joints, samples, to_artist = rigged(vertices, triangles, normalisation, truth, params)
     record = {"model": name, "label": MODELS[name][0], "plan": kind, "bones": count, "cd_j2j": to_artist,
               "noisy": []}
     for sigma in sigmas:
         for seed in seeds:
             n_kind, n_count, n_joints, n_samples, n_to_artist = rigged(
-                noisy(vertices, sigma * size, seed), triangles, normalisation, truth)
+                noisy(vertices, sigma * size, seed), triangles, normalisation, truth, params)
             record["noisy"].append({
                 "sigma": sigma, "seed": seed, "plan": n_kind, "bones": n_count,
                 "moved": rigdata.chamfer_distance(samples, n_samples),
@@ -156,7 +158,10 @@ def plot(records, sigmas, path):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     subset_options(parser, "robustness")
+    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                        help="a parameter of Rigger's method, e.g. --set prune=1.5 (repeatable)")
     args = parser.parse_args(argv)
+    params = dict(setting.split("=", 1) for setting in args.settings)
     if not SHARED_MODELS.is_dir():
         raise SystemExit(f"No models at {SHARED_MODELS}: the robustness benchmark needs ../shared beside the checkout.")
     names = picked([name for name in sorted(MODELS) if model_path(name).exists()], args.models)
@@ -165,7 +170,7 @@ def main(argv=None):
     started = time.perf_counter()
     records = []
     for name in names:
-        record = measure(name)
+        record = measure(name, params=params)
         records.append(record)
         print(f"{name:30s} {record['plan']:10s} {record['bones']:3d} bones; moved "
               + " ".join(f"{run['moved']:.3f}" for run in record["noisy"]), flush=True)

@@ -173,6 +173,19 @@ def test_without_a_mirror_plane_two_stubby_branches_alike_in_size_stay_as_a_pair
     assert kept(stub((1, 0.2), 0.9), stub((-1, 0.4), 0.8), stub((0, 1), 0.85)).count(True) == 2
 
 
+def test_without_a_mirror_plane_a_stubby_branch_stays_with_its_alike_twin_kept():
+    """Two arms alike in size off a chest, one sticking out 1.4 times its width (over prune, 1.35: kept), the other
+    1.3 (a spur over pair_prune): without a mirror plane, twins near the threshold stay or go together, so the
+    shorter arm stays with its twin, as it would in a pair under prune; one unlike its twin still goes. Noise too
+    small to see moves an arm across the threshold; it should not cost the figure one arm."""
+    def kept(*arms):
+        return tips_kept(*arms, pair_prune=0.74, local_pairs=True)
+
+    assert kept(stub((1, 0.2), 1.4), stub((-1, 0.4), 1.3)) == [True, True]
+    assert kept(stub((1, 0.2), 1.4), stub((-1, 0.4), 0.9, radius=0.18)) == [True, False]  # 1.5 x 1.67 > 1.5
+    assert tips_kept(stub((1, 0.2), 1.4), stub((-1, 0.4), 1.3), pair_prune=0.74) == [True, False]
+
+
 def test_without_a_mirror_plane_the_two_corner_branches_at_a_limb_s_end_still_go():
     """An arm ending at a hand node (radius 0.3) that forks into two alike corner branches, each sticking out 1.1
     times its width: pruning them leaves the hand the arm's end, no base the tree runs through, so they go."""

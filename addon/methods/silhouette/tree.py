@@ -139,9 +139,10 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
     arms, each near the threshold, are kept or dropped together), and with ``pair_prune`` two spurs off one base
     that mirror each other stay: a pair is a limb where a lone bump of that size is not (a dog's ears; outline noise
     is not symmetric). With ``pair_prune`` and ``local_pairs`` instead, two such spurs off one base that stick out
-    about as far and are about as wide stay (``_local_pairs``). With ``pair_prune`` and a ``ground``, such a spur
-    stays when its tip stands where a kept leaf stands, or in a view with no mirror another such spur off another
-    base (``_standing``): a cat's stubby front legs beside its hind legs, a cartoon cow's four, seen from the side.
+    about as far and are about as wide stay, and so does one such spur beside a kept leaf it is that alike to
+    (``_local_pairs``). With ``pair_prune`` and a ``ground``, such a spur stays when its tip stands where a kept
+    leaf stands, or in a view with no mirror another such spur off another base (``_standing``): a cat's stubby front
+    legs beside its hind legs, a cartoon cow's four, seen from the side.
     """
     prune, min_reach, max_reach, pair_prune = pruning.prune, pruning.min_reach, pruning.max_reach, pruning.pair_prune
     tuning = pruning.tuning
@@ -157,6 +158,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
         # those that may pair; (chain, base, its nodes outside the base's disc) of the kept leaves and those that may
         # pair
         spurs, pairable, leaves, heads = {}, {}, [], {}  # heads: spur -> its nodes up to a round part on it
+        kept_leaves = []  # (base, nodes from base to tip, reach, width) of the leaves that are no spurs
         for i, chain in enumerate(chains):
             for base, tip in ((chain[0], chain[-1]), (chain[-1], chain[0])):
                 if degree[tip] == 1 and degree[base] >= 3:
@@ -181,6 +183,8 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                         spurs[i] = base, tip
                     if may_pair:
                         pairable[i] = base, ordered, beyond, width
+                    elif not spur:
+                        kept_leaves.append((base, ordered, beyond, width))
                     if may_pair or not spur:
                         leaves.append((i, base, outside))
                     break
@@ -195,7 +199,8 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
             links = links_of(chains)
             if not dropped:
                 return links
-            return np.vstack([links, links_of(_local_pairs(dropped, links, points, tuning.local_pair))])
+            return np.vstack([links, links_of(_local_pairs(dropped, kept_leaves, links, points,
+                                                           tuning.local_pair))])
         if pruning.local_pairs:
             dropped += [pairable[i] for i in spurs if i in pairable]
         if pruning.ground is not None:
@@ -311,24 +316,28 @@ def _unmirrored(spurs, pairable, leaves, points, radius, mirror):
         chain not in spurs or (i in pairable and i in lying_on[chain]) for chain in twins)}
 
 
-def _local_pairs(dropped, links, points, most_unlike):
+def _local_pairs(dropped, kept, links, points, most_unlike):
     """Node lists of the spurs among ``dropped`` ((base, nodes from base to tip, reach, width) each, pruned although
-    they stick out enough to be limbs in a pair) that pair up off a base the kept tree (``links``) still runs through
-    (two links at least: not the end a limb's two corner branches forked from): the ratio of their reaches times the
-    ratio of their widths at most ``most_unlike``, their tips farther apart than either is wide, the most alike paired
-    first. A hand-made figure's two stubby arms or ears are never exact mirror images, while outline noise does not
-    come in such pairs."""
+    they stick out enough to be limbs in a pair) that pair up, with each other or with one of the ``kept`` leaves
+    (the same form), off a base the kept tree (``links``) still runs through (two links at least: not the end a
+    limb's two corner branches forked from): the ratio of their reaches times the ratio of their widths at most
+    ``most_unlike``, their tips farther apart than either is wide, the most alike paired first. A hand-made figure's
+    two stubby arms or ears are never exact mirror images, while outline noise does not come in such pairs; twins
+    near the threshold stay or go together, not one arm kept and its twin pruned."""
     degree = np.bincount(links.ravel(), minlength=len(points))
     by_base = {}
-    for spur in dropped:
-        if degree[spur[0]] >= 2:
-            by_base.setdefault(spur[0], []).append(spur)
+    for leaf, was_dropped in [(spur, True) for spur in dropped] + [(leaf, False) for leaf in kept]:
+        if degree[leaf[0]] >= 2:
+            by_base.setdefault(leaf[0], []).append((leaf, was_dropped))
     restored = []
-    for spurs in by_base.values():
+    for leaves in by_base.values():
         pairs = []
-        for a in range(len(spurs)):
+        for a in range(len(leaves)):
             for b in range(a):
-                (_, nodes_a, reach_a, width_a), (_, nodes_b, reach_b, width_b) = spurs[a], spurs[b]
+                ((_, nodes_a, reach_a, width_a), dropped_a), ((_, nodes_b, reach_b, width_b), dropped_b) = \
+                    leaves[a], leaves[b]
+                if not (dropped_a or dropped_b):
+                    continue
                 unlike = max(reach_a / reach_b, reach_b / reach_a) * max(width_a / width_b, width_b / width_a)
                 apart = np.linalg.norm(points[nodes_a[-1]] - points[nodes_b[-1]])
                 if unlike <= most_unlike and apart > max(width_a, width_b):
@@ -337,7 +346,7 @@ def _local_pairs(dropped, links, points, most_unlike):
         for _, a, b in sorted(pairs):
             if a not in used and b not in used:
                 used |= {a, b}
-                restored += [list(spurs[a][1]), list(spurs[b][1])]
+                restored += [list(leaves[k][0][1]) for k in (a, b) if leaves[k][1]]
     return restored
 
 
