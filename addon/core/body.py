@@ -712,7 +712,7 @@ def _nearest_links(graph, vertices):
     nearest = np.zeros(len(vertices), dtype=np.int64)
     if len(pairs):
         starts, ends = graph.points[pairs[:, 0]], graph.points[pairs[:, 1]]
-        for start in range(0, len(vertices), 4096):
-            nearest[start:start + 4096] = np.argmin(segment_distances(vertices[start:start + 4096], starts, ends),
+        for start in range(0, len(vertices), 1024):  # blocks whose (1024, links, 3) arrays stay in cache
+            nearest[start:start + 1024] = np.argmin(segment_distances(vertices[start:start + 1024], starts, ends),
                                                     axis=1)
     return segments, nearest

@@ -101,14 +101,20 @@ def _narrowings(arc, widths, ratio, reach):
     """Nodes where the part narrows, narrowest first: the least half-width within ``reach`` (arc length) either
     side, and at most ``ratio`` times the widest on each side within that reach (a knee between thigh and calf, an
     elbow, a wrist); not within ``reach`` of the chain's end, where a part tapers to its tip."""
-    found = []
+    arc, widths = arc.tolist(), widths.tolist()  # plain floats: a loop over the nodes, each with a short window
+    first, last, found = 0, 0, []
     for i in range(1, len(arc) - 1):
-        near = (arc >= arc[i] - reach) & (arc <= arc[i] + reach)
-        if arc[i] > arc[-1] - reach or widths[i] > widths[near].min():
+        here = arc[i]
+        while arc[first] < here - reach:
+            first += 1
+        while last + 1 < len(arc) and arc[last + 1] <= here + reach:
+            last += 1
+        if here > arc[-1] - reach or widths[i] > min(widths[first:last + 1]):
             continue
-        before, after = widths[near & (arc < arc[i])], widths[near & (arc > arc[i])]
-        if len(before) and len(after) and widths[i] <= ratio * min(before.max(), after.max()):
-            found.append((widths[i] / min(before.max(), after.max()), i))
+        before = [w for a, w in zip(arc[first:i], widths[first:i]) if a < here]
+        after = [w for a, w in zip(arc[i + 1:last + 1], widths[i + 1:last + 1]) if a > here]
+        if before and after and widths[i] <= ratio * min(max(before), max(after)):
+            found.append((widths[i] / min(max(before), max(after)), i))
     return [i for _, i in sorted(found)]
 
 

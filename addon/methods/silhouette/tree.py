@@ -149,6 +149,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
     chains = [list(c) for c in chains]
     dropped = []  # with local_pairs, the pairable spurs removed so far (``pairable`` entries below)
     stood = {}  # node -> the sides of the outline its removed spurs stood on (a leg keeps its foot's footing)
+    reaching = None if pruning.ground is None else _sides_reached(points, radius, pruning.ground)
     while True:
         degree = {}
         for chain in chains:
@@ -191,7 +192,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
         if spurs and pruning.mirror is not None:
             spurs = _unmirrored(spurs, pairable, leaves, points, radius, pruning.mirror)
         if spurs and pruning.ground is not None:
-            spurs = _standing(spurs, pairable, leaves, chains, points, radius, pruning.ground, stood,
+            spurs = _standing(spurs, pairable, leaves, chains, points, radius, reaching, stood,
                               spurs_stand=pruning.mirror is None)
         trims = {i: heads[i] for i in spurs if i in heads}  # a head the spur runs on past: only the rest goes
         spurs = {i: ends for i, ends in spurs.items() if i not in trims}
@@ -205,8 +206,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
             dropped += [pairable[i] for i in spurs if i in pairable]
         if pruning.ground is not None:
             for base, tip in spurs.values():
-                stood[base] = stood.get(base, set()) | stood.get(tip, set()) | _sides(tip, points, radius,
-                                                                                        pruning.ground)
+                stood[base] = stood.get(base, set()) | stood.get(tip, set()) | _sides(tip, reaching)
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
         kept = [trims.get(i, c) for i, c in enumerate(chains) if i not in spurs]
         if not kept:
@@ -231,19 +231,25 @@ def _jump_width(ordered, points, radius, outline):
     return 2 * float(segment_distances(edge[None], *outline).min())
 
 
-def _sides(node, points, radius, ground):
-    """The sides ((axis, 0 for low or 1 for high)) of the view's outline (``ground``: its low and high corner and a
-    tolerance) that ``node``'s disc reaches."""
+def _sides_reached(points, radius, ground):
+    """Per node, whether its disc reaches each side of the view's outline (``ground``: its low and high corner and a
+    tolerance): (high (n, 2), low (n, 2)) flags as lists, for :func:`_sides`."""
     low, high, tolerance = ground
-    reach = points[node] + radius[node], points[node] - radius[node]
-    return {(axis, end) for axis in range(2) for end, touches in
-            ((1, reach[0][axis] >= high[axis] - tolerance), (0, reach[1][axis] <= low[axis] + tolerance))
-            if touches}
+    return ((points + radius[:, None] >= np.asarray(high, dtype=np.float64) - tolerance).tolist(),
+            (points - radius[:, None] <= np.asarray(low, dtype=np.float64) + tolerance).tolist())
 
 
-def _standing(spurs, pairable, leaves, chains, points, radius, ground, stood, spurs_stand=True):
+def _sides(node, reaching):
+    """The sides ((axis, 0 for low or 1 for high)) of the view's outline that ``node``'s disc reaches
+    (``reaching``: :func:`_sides_reached`)."""
+    high, low = reaching[0][node], reaching[1][node]
+    return {(axis, end) for axis in range(2) for end, touches in ((1, high[axis]), (0, low[axis])) if touches}
+
+
+def _standing(spurs, pairable, leaves, chains, points, radius, reaching, stood, spurs_stand=True):
     """The ``spurs`` (chain -> (base, tip)) without the ``pairable`` ones that stand on a side of the view's outline
-    (``ground``: its low and high corner and a tolerance), with a node or through spurs already removed from one
+    (``reaching``: which side each node's disc reaches, :func:`_sides_reached`), with a node or through spurs
+    already removed from one
     (``stood``: a leg whose foot's corners went), that a kept leaf stands on too, their tips farther apart than
     either is wide: legs reach the ground together, however stubby (a foot's toe beside its own leg's foot is no
     leg). With ``spurs_stand`` (a view with no mirror in it), a pairable spur off another base standing there counts
@@ -251,7 +257,7 @@ def _standing(spurs, pairable, leaves, chains, points, radius, ground, stood, sp
     and twins across a mirror, pair by the pairing rules alone."""
     def sides(chain, base):
         nodes = [node for node in chains[chain] if node != base]
-        return set().union(*(_sides(node, points, radius, ground) | stood.get(node, set()) for node in nodes))
+        return set().union(*(_sides(node, reaching) | stood.get(node, set()) for node in nodes))
 
     def tip(chain, base):
         return chains[chain][-1] if chains[chain][0] == base else chains[chain][0]
