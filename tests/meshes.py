@@ -1,5 +1,5 @@
-"""Small generated meshes the tests share: boxes, UV spheres and ellipsoids, parametric surfaces, and soups of several
-meshes."""
+"""Small generated meshes the tests share: boxes, capped cylinders, UV spheres and ellipsoids, parametric surfaces,
+and soups of several meshes."""
 import numpy as np
 
 
@@ -10,6 +10,23 @@ def box(lo, hi):
     t = [[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
          [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]]
     return v, np.array(t)
+
+
+def cylinder(radius, length, around=48, along=40):
+    """A closed tube along z from 0 to ``length``: ``along`` rings of ``around`` vertices, and a fan on each end."""
+    angles = np.linspace(0.0, 2 * np.pi, around, endpoint=False)
+    ring = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
+    rings = [np.column_stack([ring, np.full(around, z)]) for z in np.linspace(0.0, length, along)]
+    vertices = np.vstack(rings + [[[0.0, 0.0, 0.0], [0.0, 0.0, length]]])
+    bottom, top, last = len(vertices) - 2, len(vertices) - 1, (along - 1) * around
+    triangles = []
+    for j in range(around):
+        following = (j + 1) % around
+        triangles += [(bottom, following, j), (top, last + j, last + following)]
+        for i in range(along - 1):
+            here, there = i * around + j, i * around + following
+            triangles += [(here, there, there + around), (here, there + around, here + around)]
+    return vertices, np.array(triangles)
 
 
 def combine(*meshes):

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 import rigger
 from cdt_checks import polygon_area
 from characters import strictly_inside_fraction, load_character
-from meshes import box, combine, ellipsoids, far_apart_cubes, grid_surface, uv_sphere
+from meshes import box, combine, cylinder, ellipsoids, far_apart_cubes, grid_surface, uv_sphere
 from rigger import samples
 from rigger.core.joints import Cutting
 from rigger.core.polyline import segment_distances
@@ -994,3 +994,16 @@ def test_a_fan_s_body_line_runs_to_the_outline_in_the_middle_of_the_depth_and_st
     assert widths[0] == 0.3 and np.allclose(widths[1:len(widths) // 2], 1.0, atol=2 * sil.cell)
     outside, _ = _body_line(sil, np.array([3.0, 1.0, 0.5]), np.array([0.0, 1.0, 0.0]), 0.3)
     assert len(outside) == 1
+
+
+@pytest.mark.parametrize("seed", [7, 12, 13, 14])
+def test_a_column_with_noise_too_small_to_see_grows_no_limbs(seed):
+    """A column seen end-on is a disc. Noise of a twentieth of a percent of its length (a quarter of a millimetre on
+    half a metre) puts notches on that disc's outline, and pruning once left a chain from the centre to a notch,
+    or through the centre between two: limbs the primary view seemed to hide, a pair of five bones each. The column
+    keeps its five bones in one chain, as it has without the noise."""
+    vertices, triangles = cylinder(0.06, 0.5)
+    clean = rigger.rig_mesh(vertices, triangles)
+    noisy = rigger.rig_mesh(vertices + np.random.default_rng(seed).normal(0.0, 0.00025, vertices.shape), triangles)
+    assert len(clean.names) == len(noisy.names) == 5
+    assert all(name.startswith("trunk.") for name in noisy.names)

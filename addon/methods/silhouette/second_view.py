@@ -12,7 +12,7 @@ import numpy as np
 
 from ...core.polyline import length, segment_distances
 from .depth import PlacedIsland, Placing, placed_islands
-from .tree import pruned_tree
+from .tree import islands, pruned_tree
 
 
 def hidden_limbs(sil, view, lines, rules):
@@ -23,6 +23,9 @@ def hidden_limbs(sil, view, lines, rules):
     params, tuning = rules.params, rules.tuning
     pruning = rules.pruning(view.sil, tuning.hidden_prune * params.prune)
     view_graph, alive, _, kept = pruned_tree(view.axis_graph, params.merge, pruning)
+    kept = _without_bumps(view_graph, alive, kept, pruning.min_reach)
+    if not len(kept):
+        return []
     ends, count = np.unique(kept, return_counts=True)
     tips = view_graph.points[ends[count == 1]]
     across = rules.plane is not None and abs(view.sil.direction[rules.plane[0]]) <= tuning.along_plane
@@ -37,6 +40,21 @@ def hidden_limbs(sil, view, lines, rules):
         if isinstance(placed, PlacedIsland):
             limbs += uncovered_limbs(placed.chains, cover, sil, pruning.min_reach, tuning)
     return limbs
+
+
+def _without_bumps(graph, alive, links, min_reach):
+    """The ``links`` of a view's pruned tree without its islands that are one chain lying within the disc of its
+    widest node, give or take ``min_reach``: a round part seen that way (a column end-on), whose outline's wiggles
+    left junctions on its rim once pruning had taken its other spurs. No limb hangs there."""
+    kept = []
+    for nodes, sub, _ in islands(graph, alive, links):
+        if len(sub) and np.bincount(sub.ravel()).max() <= 2:
+            widest = nodes[int(np.argmax(graph.radius[nodes]))]
+            reach = np.linalg.norm(graph.points[nodes] - graph.points[widest], axis=1) + graph.radius[nodes]
+            if reach.max() - graph.radius[widest] <= min_reach:
+                continue
+        kept.append(sub)
+    return np.concatenate(kept) if kept else np.zeros((0, 2), dtype=np.int64)
 
 
 class Cover:
