@@ -594,3 +594,17 @@ def test_a_knee_bends_below_where_the_thigh_begins():
         assert knee @ up < top - 0.02 * height
         rise = hip - knee
         assert rise @ up > np.cos(np.radians(30)) * np.linalg.norm(rise)  # the thigh stands up from the knee
+
+
+def test_arms_high_on_a_legless_body_are_judged_by_height_not_by_the_spine_s_length():
+    """rignet_15930, a legless ghost (Z up, as Blender imports it), with noise a twentieth of a percent of its size:
+    its head grows a nose, the spine runs out along it and wiggles, and its arms, a little above halfway up the body,
+    left the spine before halfway along it: the ghost was no humanoid. How high the arms hang is a height."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_15930", "rignet_15930.obj"))
+    vertices = vertices @ np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]).T
+    _, position = np.unique(vertices, axis=0, return_inverse=True)  # seams stay closed
+    size = float(np.ptp(vertices, axis=0).max())
+    noise = np.random.default_rng(0).normal(0.0, 0.0005 * size, (position.max() + 1, 3))
+    for mesh in (vertices, vertices + noise[position.ravel()]):
+        skeleton = rigger.rig_mesh(mesh, triangles)
+        assert skeleton.body_plan.kind == "humanoid", skeleton.body_plan.summary()

@@ -235,9 +235,10 @@ def _legless(body, parts, front, lengths, long_pairs, spine_length, forward, con
                        "a pair of long limbs on a small body: wings, no legs")
     if long_pairs and min(rise, 180 - rise) < tuning.upright:
         upward = _upward(body, spine)
-        arc = arc_lengths(graph.points[upward])
-        attach = [arc[upward.index(body.bases[k])] / max(arc[-1], 1e-300) for pair in long_pairs for k in pair
-                  if body.bases[k] in upward]
+        heights = body.height(graph.points[upward])  # how high, not how far along: a head's wiggles add length
+        low, high = float(heights.min()), float(heights.max())
+        attach = [(heights[upward.index(body.bases[k])] - low) / max(high - low, 1e-300) for pair in long_pairs
+                  for k in pair if body.bases[k] in upward]
         if attach and max(attach) >= 0.5:
             chest = _chest(body, upward, 0, [], lengths, tuning)
             _name_parts(body, parts, lengths, upward, 0, chest, "humanoid", tuning)
