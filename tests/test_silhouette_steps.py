@@ -374,6 +374,18 @@ def test_a_chain_that_cannot_end_before_its_tip_between_the_ears_follows_one_ear
         assert len(line) == 6 and line[-1, 2] == -0.75
 
 
+def test_parts_that_come_together_again_before_the_tip_are_one_chain():
+    """A neck (one part), then a head whose rays cross two parts (eye holes, horns seen edge-on), then one part
+    spanning both to its crown: one chain, not two parallel necks. Two arms one behind the other, the front one
+    shorter, still split: past the front wrist the rays cross the back arm alone, which spans no gap."""
+    head = [layers((-0.5, 0.5))] * 6 + [layers((-0.5, -0.1), (0.1, 0.5))] * 8 + [layers((-0.45, 0.45))] * 6
+    _, placed = placed_along_x(head)
+    assert len(placed) == 1 and len(placed[0][0]) == len(head)
+    arms = [layers((-0.5, 1.5))] * 4 + [layers((-0.5, 0.4), (0.6, 1.5))] * 10 + [layers((0.6, 1.5))] * 4
+    _, placed = placed_along_x(arms)
+    assert len(placed) == 2
+
+
 def straight(length, points=101):
     return np.stack([np.linspace(0.0, length, points), np.zeros(points), np.zeros(points)], axis=1)
 

@@ -103,6 +103,8 @@ def place_chains(sil, points, radius, root, chains, placing):
         if placing.split:
             parts = [separate_parts(layer, r, tuning) for layer, r in zip(node_layers, radius[nodes])]
             copies = layer_count(parts, tuning)
+            if copies > 1 and _merged_again(parts):
+                copies = 1
             if copies == 1 and mirror is not None:
                 end, stays = _plane_course(node_layers, *mirror, leaf=ci not in has_children)
                 nodes, node_layers, parts = nodes[:end], node_layers[:end], parts[:end]
@@ -282,6 +284,18 @@ def _follow(node_layers, copies, start, mirror=None):
                 previous = 0.5 * (low + high)
             depths[i] = previous
     return followed
+
+
+def _merged_again(parts):
+    """Whether the parts a chain's rays cross come together again before its tip: past the outermost node crossing
+    two or more, the rays cross one part at every node (three at least), and at the first of them that part spans
+    the gap between the outer two (a head with eye holes or horns seen edge-on, not two ears or legs, which end
+    apart, nor an arm behind a shorter one, whose hand the rays past the front wrist cross alone)."""
+    apart = [i for i, layer in enumerate(parts) if len(layer) >= 2]
+    if not apart or len(parts) - 1 - apart[-1] < 3 or any(len(layer) != 1 for layer in parts[apart[-1] + 1:]):
+        return False
+    outer, (low, high) = parts[apart[-1]], parts[apart[-1] + 1][0]
+    return low <= outer[0][1] and high >= outer[-1][0]
 
 
 def _anchor(node_layers, copies):
