@@ -8,7 +8,7 @@ import pytest
 import rigger
 from characters import load_character
 from conftest import shared_path
-from meshes import box, combine
+from meshes import box, combine, cylinder
 from rigdata import load_obj
 from rigger import samples
 from rigger.core import rooting
@@ -608,3 +608,16 @@ def test_arms_high_on_a_legless_body_are_judged_by_height_not_by_the_spine_s_len
     for mesh in (vertices, vertices + noise[position.ravel()]):
         skeleton = rigger.rig_mesh(mesh, triangles)
         assert skeleton.body_plan.kind == "humanoid", skeleton.body_plan.summary()
+
+
+def test_a_log_whose_spine_runs_into_one_end_cap_does_not_taper():
+    """A column lying down is a log, no fish: it neither tapers nor curves. Noise too small to see can make its
+    spine run on to the middle of one end cap, where the mesh is no thickness at all; each end's thickness is the
+    thickest the body is there, so that tip does not make the log taper."""
+    vertices, triangles = cylinder(0.06, 0.5)
+    vertices = vertices[:, [2, 1, 0]]  # lying along x, Z up
+    joints = np.column_stack([np.linspace(0.0, 0.45, 6), np.zeros(6), np.zeros(6)])  # from one cap's centre
+    skeleton = Skeleton([f"trunk.{k:02d}" for k in range(5)], joints[:-1], joints[1:], [-1, 0, 1, 2, 3])
+    plane = MirrorPlane(1, 0.0, np.array([0.0, 1.0, 0.0]))  # the log's left and right, as the method finds them
+    plan, _ = recognise(skeleton, (vertices, triangles), plane=plane, prefer_up=np.array([0.0, 0.0, 1.0]))
+    assert plan.kind == "other" and "neither tapers nor curves" in plan.reason, plan.summary()

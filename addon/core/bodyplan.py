@@ -430,7 +430,8 @@ def _head_score(body, spine, legs, lengths, tuning):
 
 
 def _end_thickness(body, spine, tuning):
-    """Mean mesh radius over the first and the last ``end_part`` of the spine's length."""
+    """Largest mesh radius over the first and the last ``end_part`` of the spine's length: how thick each end of the
+    body is, whether or not the spine runs on into the rounded tip (where any body is thin)."""
     points = body.graph.points[spine]
     if len(spine) < 2:
         return (float(body.radius[spine[0]]),) * 2
@@ -438,7 +439,7 @@ def _end_thickness(body, spine, tuning):
     radius = body.radius[spine]
     first = radius[arc <= arc[-1] * tuning.end_part]
     last = radius[arc >= arc[-1] * (1 - tuning.end_part)]
-    return float(first.mean()), float(last.mean())
+    return float(first.max()), float(last.max())
 
 
 def _end_spread(body, spine, tuning):
