@@ -621,3 +621,18 @@ def test_a_log_whose_spine_runs_into_one_end_cap_does_not_taper():
     plane = MirrorPlane(1, 0.0, np.array([0.0, 1.0, 0.0]))  # the log's left and right, as the method finds them
     plan, _ = recognise(skeleton, (vertices, triangles), plane=plane, prefer_up=np.array([0.0, 0.0, 1.0]))
     assert plan.kind == "other" and "neither tapers nor curves" in plan.reason, plan.summary()
+
+
+def test_a_foot_turned_along_the_ground_leaves_a_leg_a_leg():
+    """rignet_8338, a quadruped (Z up, as Blender imports it), with noise a twentieth of a percent of its size: a
+    front foot grows a bone turned in along the ground. A leg runs down at least 0.45 of its length; the bone after
+    the foot has reached the ground no longer counts against it, so the front legs stay legs and the plan a
+    quadruped."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_8338", "rignet_8338.obj"))
+    vertices = vertices @ np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]).T
+    _, position = np.unique(vertices, axis=0, return_inverse=True)  # seams stay closed
+    size = float(np.ptp(vertices, axis=0).max())
+    noise = np.random.default_rng(1).normal(0.0, 0.0005 * size, (position.max() + 1, 3))
+    for mesh in (vertices, vertices + noise[position.ravel()]):
+        skeleton = rigger.rig_mesh(mesh, triangles)
+        assert skeleton.body_plan.kind == "quadruped", skeleton.body_plan.summary()

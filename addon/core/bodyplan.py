@@ -4,7 +4,7 @@ and why, and which part each limb is; from geometry (``core.body``), whatever me
 The rules, in order (``Body`` gives the up axis, the mirror plane, the spine and the limbs):
 
 - legs are limbs off the mirror plane that hang from at least ``leg_lift`` of the mesh's height and run down
-  (``leg_drop``) to near the ground (``leg_reach``);
+  (``leg_drop``; toes along the ground aside) to near the ground (``leg_reach``);
 - more than four legs, or legs standing in more than two rows along the body, make no known plan (``other``), nor
   do three or more pairs of long limbs (an octopus);
 - legs in two rows, front and back (``front_back`` apart), make a quadruped;
@@ -55,6 +55,8 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
     wing_flat: float = tuned(0.45, "a limb whose blade is this flat (thin across over wide across) or flatter is a "
                                    "wing or a fin (a bird's wings 0.2 to 0.35, arms 0.55 or rounder)")
     front_back: float = tuned(0.15, "feet this far apart along the body stand in two rows, front and back")
+    ground_slack: float = tuned(0.02, "a leg runs down to where it first comes this near (a share of the size) to "
+                                      "its tip's height; toes along the ground beyond that do not count")
     upright: float = tuned(45.0, "degrees: a biped whose torso leans less than this from up is a humanoid")
     overturned: float = tuned(100.0, "degrees: a biped whose body leans more than this from up hangs below its hips: "
                                      "no plan (a bird's body leans about 90)")
@@ -293,10 +295,24 @@ def _legs(body, lengths, tuning):
     for k, limb in enumerate(limbs):
         if lengths[k] >= tuning.min_limb * size and body.touches(limb.main[-1], tuning.leg_reach) \
                 and body.height(body.graph.points[limb.attach]) >= tuning.leg_lift \
-                and (limb.side != 0 or body.plane is None) \
-                and (body.graph.points[limb.attach] - _tip(body, k)) @ body.up >= tuning.leg_drop * lengths[k]:
-            legs.add(k)
+                and (limb.side != 0 or body.plane is None):
+            drop, run = _descent(body, limb, tuning)
+            if drop >= tuning.leg_drop * run:
+                legs.add(k)
     return sorted(legs)
+
+
+def _descent(body, limb, tuning):
+    """(how far down, how long) a limb's main path runs from where it hangs to where it comes within
+    ``ground_slack`` of the height of its tip to stay there, when what follows is the shorter part: toes along the
+    ground after the foot reaches it (a bird's, a bone turned in along it) make a leg no less a leg, while a limb
+    lying along the ground (a wing spread flat) runs as long as it is."""
+    points = body.graph.points[list(limb.main)]
+    heights = points @ body.up
+    above = np.flatnonzero(heights > heights[-1] + tuning.ground_slack * body.size)
+    down = int(above[-1]) + 1 if len(above) else 0
+    descent, along = length(points[:down + 1]), length(points[down:])
+    return float(heights[0] - heights[-1]), max(descent if along <= descent else descent + along, 1e-300)
 
 
 def _tip(body, k):
