@@ -186,6 +186,23 @@ def test_without_a_mirror_plane_a_stubby_branch_stays_with_its_alike_twin_kept()
     assert tips_kept(stub((1, 0.2), 1.4), stub((-1, 0.4), 1.3), pair_prune=0.74) == [True, False]
 
 
+def test_a_wide_part_that_reaches_far_through_its_corners_stays_once_they_go():
+    """A head off a chest (a neck 0.9 wide, ending where it forks into two corner branches, an ear and a snout):
+    pruning takes the corner branches together, and the head, a wide bump measured to its fork, would go with them.
+    A part reaching ``max_reach`` beyond its base is kept however wide; it reaches as far as its corners did, so it
+    stays (noise too small to see decides whether its outline forks there or not)."""
+    points, radius, chains = chest_with_legs([(0.0, y, 0.9) for y in (1.2, 1.5, 1.8)] + [(0.0, 2.0, 0.8)])
+    fork = chains[-1][-1]
+    for side in (-1, 1):
+        corner = [(side * 0.2, 2.5, 0.5), (side * 0.4, 2.9, 0.45), (side * 0.6, 3.2, 0.05)]
+        chains.append([fork] + list(range(len(points), len(points) + 3)))
+        points = np.vstack([points, [c[:2] for c in corner]])
+        radius = np.r_[radius, [c[2] for c in corner]]
+    links = prune_spurs(points, radius, chains, Pruning(1.35, max_reach=2.0))
+    assert fork in links and chains[-1][-1] not in links and chains[-2][-1] not in links
+    assert fork not in prune_spurs(points, radius, chains, Pruning(1.35, max_reach=2.4))  # reaching 2.3: a bump
+
+
 def test_without_a_mirror_plane_the_two_corner_branches_at_a_limb_s_end_still_go():
     """An arm ending at a hand node (radius 0.3) that forks into two alike corner branches, each sticking out 1.1
     times its width: pruning them leaves the hand the arm's end, no base the tree runs through, so they go."""

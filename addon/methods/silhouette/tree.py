@@ -62,7 +62,8 @@ class Pruning:
     Attributes:
         prune: a branch sticking out of its base's disc by at most this many times its width is a bump ...
         min_reach: ... and so is one sticking out by at most this (mesh units), however thin ...
-        max_reach: ... but never one reaching this far (mesh units): a cow's short thick neck with its head.
+        max_reach: ... but never one reaching this far (mesh units): a cow's short thick neck with its head (as far
+            as the spurs pruned off its end reached: noise that forks its outline earlier does not shorten it).
         pair_prune: two twin spurs sticking out more than this many times their width (and ``min_reach``) stay;
             None: spurs never pair.
         mirror: a function reflecting (P, 2) points of the view across the mesh's mirror plane, or None.
@@ -149,6 +150,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
     chains = [list(c) for c in chains]
     dropped = []  # with local_pairs, the pairable spurs removed so far (``pairable`` entries below)
     stood = {}  # node -> the sides of the outline its removed spurs stood on (a leg keeps its foot's footing)
+    reached = {}  # node -> the tips of the spurs removed off it: a part keeps its corners' reach
     reaching = None if pruning.ground is None else _sides_reached(points, radius, pruning.ground)
     while True:
         degree = {}
@@ -174,7 +176,10 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                         width = max(width, _jump_width(ordered, points, radius, pruning.outline))
                     bump = beyond <= prune * width and not (  # the round-part test only where it can matter
                         blobs is not None and _round_part(apart, radius, blobs, base, tip, tuning.round_tip))
-                    spur = beyond < max_reach and (beyond <= min_reach or bump)
+                    ends = [tip] + reached.get(tip, [])
+                    reach = float((np.linalg.norm(points[ends] - points[base], axis=1) + radius[ends]).max()
+                                  - radius[base])
+                    spur = reach < max_reach and (beyond <= min_reach or bump)
                     part = _round_part_on(ordered, points, radius, blobs, min_reach, tuning.round_tip) \
                         if spur and pruning.heads and blobs is not None else None
                     if part is not None:
@@ -207,6 +212,8 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
         if pruning.ground is not None:
             for base, tip in spurs.values():
                 stood[base] = stood.get(base, set()) | stood.get(tip, set()) | _sides(tip, reaching)
+        for base, tip in spurs.values():
+            reached[base] = reached.get(base, []) + [tip] + reached.get(tip, [])
         # every spur goes at once: the two corner branches at the end of a limb leave the limb ending at their fork
         kept = [trims.get(i, c) for i, c in enumerate(chains) if i not in spurs]
         if not kept:
