@@ -596,16 +596,23 @@ def test_a_knee_bends_below_where_the_thigh_begins():
         assert rise @ up > np.cos(np.radians(30)) * np.linalg.norm(rise)  # the thigh stands up from the knee
 
 
+def clean_and_noisy(name, seed):
+    """((vertices, noisy vertices), triangles) of a ``../shared`` artist-rigged model as Blender imports it (Z up),
+    the noise a twentieth of a percent of its size per vertex position (seams stay closed), seeded."""
+    vertices, triangles = load_obj(shared_path("models", "gt", name, f"{name}.obj"))
+    vertices = vertices @ np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]).T
+    _, position = np.unique(vertices, axis=0, return_inverse=True)
+    size = float(np.ptp(vertices, axis=0).max())
+    noise = np.random.default_rng(seed).normal(0.0, 0.0005 * size, (position.max() + 1, 3))
+    return (vertices, vertices + noise[position.ravel()]), triangles
+
+
 def test_arms_high_on_a_legless_body_are_judged_by_height_not_by_the_spine_s_length():
     """rignet_15930, a legless ghost (Z up, as Blender imports it), with noise a twentieth of a percent of its size:
     its head grows a nose, the spine runs out along it and wiggles, and its arms, a little above halfway up the body,
     left the spine before halfway along it: the ghost was no humanoid. How high the arms hang is a height."""
-    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_15930", "rignet_15930.obj"))
-    vertices = vertices @ np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]).T
-    _, position = np.unique(vertices, axis=0, return_inverse=True)  # seams stay closed
-    size = float(np.ptp(vertices, axis=0).max())
-    noise = np.random.default_rng(0).normal(0.0, 0.0005 * size, (position.max() + 1, 3))
-    for mesh in (vertices, vertices + noise[position.ravel()]):
+    meshes, triangles = clean_and_noisy("rignet_15930", seed=0)
+    for mesh in meshes:
         skeleton = rigger.rig_mesh(mesh, triangles)
         assert skeleton.body_plan.kind == "humanoid", skeleton.body_plan.summary()
 
@@ -628,11 +635,7 @@ def test_a_foot_turned_along_the_ground_leaves_a_leg_a_leg():
     front foot grows a bone turned in along the ground. A leg runs down at least 0.45 of its length; the bone after
     the foot has reached the ground no longer counts against it, so the front legs stay legs and the plan a
     quadruped."""
-    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_8338", "rignet_8338.obj"))
-    vertices = vertices @ np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]).T
-    _, position = np.unique(vertices, axis=0, return_inverse=True)  # seams stay closed
-    size = float(np.ptp(vertices, axis=0).max())
-    noise = np.random.default_rng(1).normal(0.0, 0.0005 * size, (position.max() + 1, 3))
-    for mesh in (vertices, vertices + noise[position.ravel()]):
+    meshes, triangles = clean_and_noisy("rignet_8338", seed=1)
+    for mesh in meshes:
         skeleton = rigger.rig_mesh(mesh, triangles)
         assert skeleton.body_plan.kind == "quadruped", skeleton.body_plan.summary()
