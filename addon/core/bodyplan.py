@@ -55,8 +55,8 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
     wing_flat: float = tuned(0.45, "a limb whose blade is this flat (thin across over wide across) or flatter is a "
                                    "wing or a fin (a bird's wings 0.2 to 0.35, arms 0.55 or rounder)")
     front_back: float = tuned(0.15, "feet this far apart along the body stand in two rows, front and back")
-    ground_slack: float = tuned(0.02, "a leg runs down to where it first comes this near (a share of the size) to "
-                                      "its tip's height; toes along the ground beyond that do not count")
+    ground_slack: float = tuned(0.02, "a leg runs down to where it comes this near (a share of the size) to its "
+                                      "tip's height for good; toes along the ground beyond do not count")
     upright: float = tuned(45.0, "degrees: a biped whose torso leans less than this from up is a humanoid")
     overturned: float = tuned(100.0, "degrees: a biped whose body leans more than this from up hangs below its hips: "
                                      "no plan (a bird's body leans about 90)")

@@ -256,12 +256,11 @@ def _sides(node, reaching):
 def _standing(spurs, pairable, leaves, chains, points, radius, reaching, stood, spurs_stand=True):
     """The ``spurs`` (chain -> (base, tip)) without the ``pairable`` ones that stand on a side of the view's outline
     (``reaching``: which side each node's disc reaches, :func:`_sides_reached`), with a node or through spurs
-    already removed from one
-    (``stood``: a leg whose foot's corners went), that a kept leaf stands on too, their tips farther apart than
-    either is wide: legs reach the ground together, however stubby (a foot's toe beside its own leg's foot is no
-    leg). With ``spurs_stand`` (a view with no mirror in it), a pairable spur off another base standing there counts
-    as a kept leaf: every leg of a cartoon cow seen from the side is stubby. Spurs off one base (a forked tail fin),
-    and twins across a mirror, pair by the pairing rules alone."""
+    already removed from one (``stood``: a leg whose foot's corners went), that a kept leaf stands on too, their tips
+    farther apart than either is wide: legs reach the ground together, however stubby (a foot's toe beside its own
+    leg's foot is no leg). With ``spurs_stand`` (a view with no mirror in it), a pairable spur off another base
+    standing there counts as a kept leaf: every leg of a cartoon cow seen from the side is stubby. Spurs off one base
+    (a forked tail fin), and twins across a mirror, pair by the pairing rules alone."""
     def sides(chain, base):
         nodes = [node for node in chains[chain] if node != base]
         return set().union(*(_sides(node, reaching) | stood.get(node, set()) for node in nodes))
