@@ -639,3 +639,21 @@ def test_a_foot_turned_along_the_ground_leaves_a_leg_a_leg():
     for mesh in meshes:
         skeleton = rigger.rig_mesh(mesh, triangles)
         assert skeleton.body_plan.kind == "quadruped", skeleton.body_plan.summary()
+
+
+def test_a_leg_whose_foot_curls_in_to_the_middle_keeps_its_side():
+    """A leg reaching out to one side and down, its foot turned in to the mirror plane (a crow's toes, a cow's
+    horns meeting over its head): a limb is on the side it reaches farthest into, not only where its tip ends."""
+    vertices, triangles = box((-0.3, -0.1, 0.0), (0.3, 0.1, 1.0))
+    joints = {"hips": (0.0, 0.0, 0.5), "chest": (0.0, 0.0, 0.9)}
+    heads, tails, parents, names = [joints["hips"]], [joints["chest"]], [-1], ["trunk.00"]
+    for sign, side in ((1, "L"), (-1, "R")):
+        path = [joints["hips"], (0.2 * sign, 0.0, 0.4), (0.2 * sign, 0.0, 0.05), (0.0, 0.0, 0.0)]
+        for k, (head, tail) in enumerate(zip(path, path[1:])):
+            parents.append(0 if k == 0 else len(heads) - 1)
+            heads.append(head)
+            tails.append(tail)
+            names.append(f"limb01.{k:02d}.{side}")
+    skeleton = Skeleton(names, np.array(heads), np.array(tails), parents)
+    body = read_body(skeleton, Mesh(vertices, triangles), plane=MirrorPlane(0, 0.0, np.array([1.0, 0.0, 0.0])))
+    assert sorted(limb.side for limb in body.limbs) == [-1, 1]

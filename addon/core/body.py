@@ -277,7 +277,8 @@ class Plane:
 class Limb:
     """A limb: the joint it hangs from (``attach``), its joints with the joint each hangs from (``before``: joint →
     joint, the attachment's children first), its ``main`` path (attach to its farthest tip), its ``side`` (+1 on the
-    plane's positive side, -1, or 0 on the plane) and its ``twin`` (index of the limb mirroring it, or -1)."""
+    plane's positive side, -1, or 0 on the plane: the side its main path reaches farthest into) and its ``twin``
+    (index of the limb mirroring it, or -1)."""
 
     attach: int
     before: dict
@@ -612,8 +613,9 @@ def _limb(graph, attach, before, plane, size, tuning):
     while main[-1] != attach:
         main.append(before[main[-1]])
     side = 0
-    if plane is not None:
-        offset = float(plane.distance(graph.points[tip]))
+    if plane is not None:  # a foot curling in to the middle leaves a leg on its side
+        offsets = np.array([plane.distance(graph.points[node]) for node in main], dtype=np.float64)
+        offset = float(offsets[int(np.argmax(np.abs(offsets)))])
         side = 0 if abs(offset) <= tuning.midline * size else int(np.sign(offset))
     return Limb(attach, dict(before), tuple(main[::-1]), side)
 
