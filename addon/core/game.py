@@ -66,6 +66,7 @@ ENDS = (("ForeArm", "Hand", ("hand",), ("hand_tip",), ("finger",)),
         ("Leg", "Foot", ("foot",), ("toe", "toe_tip"), ("toe",)),
         ("Neck", "Head", ("head",), ("head_top",), ("jaw", "ear")))
 END_SHARE = 0.5  # an end bone with nowhere to end goes on along its limb bone for this share of that bone's length
+END_STARTS = (0.5, 1.0)  # an end bone begins at its named joint only when that lies this far along the limb bone
 # a limb bone, the bone after it it may lack, the named joint that begins at, the roles that bone carries
 MIDDLES = (("UpLeg", "Leg", "shin", ("foot", "toe")), ("Arm", "ForeArm", "forearm", ("hand", "finger")))
 SPLIT_SHARES = (0.2, 0.8)  # a limb bone is split where the missing bone begins only this far along it
@@ -503,25 +504,17 @@ def _split_middles(names, heads, tails, parents, roles, places):
     end and carries what hung there (a foot; a hand and its fingers). ``_completed_ends`` then adds what it lacks."""
     names, heads, tails, parents, roles = list(names), heads.copy(), tails.copy(), list(parents), list(roles)
     for limb in range(len(names)):
-        stem, _, suffix = names[limb].partition("_")
         for word, next_word, joint, carried in MIDDLES:
-            side_word = stem[:-len(word)]
-            next_name = f"{side_word}{next_word}{'_' + suffix if suffix else ''}"
-            if not stem.endswith(word) or side_word not in ("Left", "Right") or next_name in names:
+            parsed = _parsed(names[limb], word, ("Left", "Right"))
+            if parsed is None or _named(parsed[0], next_word, parsed[1]) in names:
                 continue
+            side_word, suffix = parsed
             letter = side_word[0]
             point = places.get((joint, letter, None))
-            head, tail = heads[limb], tails[limb]
-            along = tail - head
-            length = float(np.linalg.norm(along))
-            if point is None or not length > 0:
+            if point is None or not _well_along(point, heads[limb], tails[limb], SPLIT_SHARES):
                 continue
-            share = float((point - head) @ along) / length ** 2
-            if not SPLIT_SHARES[0] < share < SPLIT_SHARES[1] or \
-                    segment_distances(point[None], head[None], tail[None])[0, 0] > 0.25 * length:
-                continue
-            point = np.asarray(point, dtype=np.float64)
-            names.append(next_name)
+            point, tail = np.asarray(point, dtype=np.float64), tails[limb].copy()
+            names.append(_named(side_word, next_word, suffix))
             heads, tails = np.vstack([heads, point]), np.vstack([tails, tail])
             tails[limb] = point
             parents.append(limb)
@@ -531,6 +524,29 @@ def _split_middles(names, heads, tails, parents, roles, places):
                 if parents[child] == limb and roles[child].role in carried:
                     parents[child] = added
     return names, heads, tails, parents, roles
+
+
+def _parsed(name, word, sides):
+    """(side word, suffix) of a game bone ``name`` like ``LeftForeArm_2`` (``LeftForeArm``, ``_2`` numbering a
+    second pair of arms) that is a ``word`` with one of the ``sides`` before it ("" for none), else None."""
+    stem, _, suffix = name.partition("_")
+    side_word = stem[:-len(word)]
+    return (side_word, suffix) if stem.endswith(word) and side_word in sides else None
+
+
+def _named(side_word, word, suffix):
+    """The game bone name of a ``word`` on a side (``_parsed``), with the suffix of the bone it was read from."""
+    return f"{side_word}{word}{'_' + suffix if suffix else ''}"
+
+
+def _well_along(point, head, tail, shares):
+    """Whether ``point`` lies along the bone from ``head`` to ``tail``: between the ``shares`` (low, high) of its
+    length along it, within a quarter of its length of it."""
+    along = tail - head
+    length = float(np.linalg.norm(along))
+    share = float((point - head) @ along) / max(length ** 2, 1e-300)
+    return shares[0] < share < shares[1] and \
+        segment_distances(np.asarray(point)[None], head[None], tail[None])[0, 0] <= 0.25 * length
 
 
 def _completed_ends(names, heads, tails, parents, roles, places, vertices, faced):
@@ -543,14 +559,12 @@ def _completed_ends(names, heads, tails, parents, roles, places, vertices, faced
     its tip. The bone's fingers (toes; jaw and ears) hang from it. Game engines' humanoids and mocap need all three."""
     names, heads, tails, parents, roles = list(names), heads.copy(), tails.copy(), list(parents), list(roles)
     for limb in range(len(names)):
-        stem, _, suffix = names[limb].partition("_")  # LeftForeArm, 2
         for word, end_word, starts, ends, carried in ENDS:
-            side_word = stem[:-len(word)]
-            if not stem.endswith(word) or side_word not in ("Left", "Right", ""):
+            parsed = _parsed(names[limb], word, ("Left", "Right", ""))
+            if parsed is None or _named(parsed[0], end_word, parsed[1]) in names:
                 continue
-            end_name = f"{side_word}{end_word}{'_' + suffix if suffix else ''}"
-            if end_name in names:
-                continue
+            side_word, suffix = parsed
+            end_name = _named(side_word, end_word, suffix)
             letter = side_word[:1] or None
             head, tail = heads[limb], tails[limb]
             along = tail - head
@@ -558,11 +572,8 @@ def _completed_ends(names, heads, tails, parents, roles, places, vertices, faced
             start = tail
             for key in starts:
                 point = places.get((key, letter, None))
-                if point is not None:
-                    share = float((point - head) @ along) / max(bone_length ** 2, 1e-300)
-                    if 0.5 < share < 1.0 and segment_distances(point[None], head[None], tail[None])[0, 0] \
-                            <= 0.25 * bone_length:
-                        start = np.asarray(point, dtype=np.float64)
+                if point is not None and _well_along(point, head, tail, END_STARTS):
+                    start = np.asarray(point, dtype=np.float64)
             finish = start + END_SHARE * along
             for key in ends:
                 point = places.get((key, letter, None))
@@ -578,7 +589,7 @@ def _completed_ends(names, heads, tails, parents, roles, places, vertices, faced
             end = len(names) - 1
             parents.append(limb)
             roles.append(BoneRole(end_word.lower(), letter))
-            toe_name = f"{side_word}ToeBase{'_' + suffix if suffix else ''}"
+            toe_name = _named(side_word, "ToeBase", suffix)
             if foot is not None and toe_name not in names:
                 names.append(toe_name)
                 heads, tails = np.vstack([heads, foot[0]]), np.vstack([tails, foot[1]])
