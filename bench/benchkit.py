@@ -1,6 +1,7 @@
 """Helpers the benchmarks share: where the checkout, the shared models and the results are, the machine and commit,
 markdown tables, time formatting, mesh refinement."""
 import datetime
+import json
 import os
 import pathlib
 import subprocess
@@ -48,6 +49,27 @@ def subset_options(parser, name):
     parser.add_argument("--models", nargs="+", help="names or substrings of names (commas also separate)")
     parser.add_argument("--out", type=pathlib.Path,
                         help=f"results folder (default bench/results, or out/{name} with --models)")
+
+
+def settings_option(parser):
+    """Add a benchmark's ``--set KEY=VALUE`` (repeatable): parameters of Rigger's method, for ``method_params``."""
+    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                        help="a parameter of Rigger's method, e.g. --set bone_length=0.08 (repeatable)")
+
+
+def method_params(assignments):
+    """``key=value`` strings to method parameters; values are read as JSON when they parse, else kept as text.
+    SystemExit for a string without a key and an ``=``."""
+    params = {}
+    for assignment in assignments:
+        key, separator, value = assignment.partition("=")
+        if not separator or not key:
+            raise SystemExit(f"--set expects key=value, got {assignment!r}")
+        try:
+            params[key] = json.loads(value)
+        except json.JSONDecodeError:
+            params[key] = value
+    return params
 
 
 def results_folder(args, name):

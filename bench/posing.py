@@ -37,8 +37,8 @@ from scipy.stats import spearmanr  # noqa: E402
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import posing_math as pm  # noqa: E402  (bench/ is not a package)
 import rigdata  # noqa: E402
-from benchkit import (REPO, SHARED_MODELS, cpu_model, described_commit, markdown_table, picked,  # noqa: E402
-                      results_folder, subset_options, table_cell)
+from benchkit import (REPO, SHARED_MODELS, cpu_model, described_commit, markdown_table, method_params,  # noqa: E402
+                      picked, results_folder, settings_option, subset_options, table_cell)
 from bodyplan import blender_turn  # noqa: E402
 from quality import principal_stick  # noqa: E402
 from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
@@ -543,14 +543,13 @@ def main(argv=None):
                         help=f"largest turn of a joint, degrees (default {MAX_DEGREES:g})")
     parser.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
     parser.add_argument("--compare", type=pathlib.Path, help="a previous run's posing.json to compare against")
-    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
-                        help="a parameter of Rigger's method, e.g. --set bone_length=0.08 (repeatable)")
+    settings_option(parser)
     parser.add_argument("--blender-frame", action="store_true",
                         help="Rigger rigs each file as Blender's OBJ importer reads it (default out/posing-blender)")
     args = parser.parse_args(argv)
     if args.blender_frame and not args.out:
         args.out = REPO / "out" / "posing-blender"
-    params = dict(setting.split("=", 1) for setting in args.settings)
+    params = method_params(args.settings)
     if not MODELS_DIR.is_dir():
         raise SystemExit(f"No models at {MODELS_DIR}: the posing benchmark needs ../shared beside the checkout.")
     if args.poses < 1 or args.jobs < 1:

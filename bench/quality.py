@@ -24,7 +24,8 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
 import rigger  # noqa: E402
-from benchkit import RESULTS_DIR, SHARED_MODELS, cpu_model, markdown_table, table_cell  # noqa: E402
+from benchkit import (RESULTS_DIR, SHARED_MODELS, cpu_model, markdown_table, method_params,  # noqa: E402
+                      settings_option, table_cell)
 
 MODELS_DIR = SHARED_MODELS / "gt"
 DRAWN_MODELS = ("CesiumMan", "Quaternius_Fox", "rignet_2982")
@@ -463,26 +464,11 @@ def plot_models(path, truths, records, methods, drawn=DRAWN_MODELS):
     plt.close(figure)
 
 
-def parse_params(assignments):
-    """``key=value`` strings to method parameters; values are read as JSON when they parse, else kept as text."""
-    params = {}
-    for assignment in assignments:
-        key, separator, value = assignment.partition("=")
-        if not separator or not key:
-            raise SystemExit(f"--set expects key=value, got {assignment!r}")
-        try:
-            params[key] = json.loads(value)
-        except json.JSONDecodeError:
-            params[key] = value
-    return params
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--models", help="comma-separated substrings; run the models whose name contains one")
     parser.add_argument("--methods", help=f"comma-separated, from {', '.join(METHODS)} (default: all available)")
-    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                        help="parameter for rigger.rig_mesh (repeatable)")
+    settings_option(parser)
     parser.add_argument("--timeout", type=float, default=300.0, help="seconds per method and model (default 300)")
     parser.add_argument("--out", type=pathlib.Path, default=RESULTS_DIR, help="results folder (default bench/results)")
     parser.add_argument("--draw", default=",".join(DRAWN_MODELS),
@@ -503,7 +489,7 @@ def main(argv=None):
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
         raise SystemExit(f"Unknown methods {unknown}; choose from {list(METHODS)}.")
-    params = parse_params(args.set)
+    params = method_params(args.settings)
     if params:
         notes.append(f"rigger parameters: {params}.")
     if args.models:

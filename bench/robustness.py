@@ -23,7 +23,8 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import rigdata  # noqa: E402  (bench/ is not a package)
 import rigger  # noqa: E402
-from benchkit import SHARED_MODELS, markdown_table, picked, results_folder, run_record, subset_options  # noqa: E402
+from benchkit import (SHARED_MODELS, markdown_table, method_params, picked, results_folder, run_record,  # noqa: E402
+                      settings_option, subset_options)
 from bodyplan import MODELS, load, model_path  # noqa: E402
 
 SIGMAS = (0.0005, 0.001, 0.0025)  # noise standard deviations, shares of the size: 0.1% of a 2 m figure is 2 mm
@@ -183,10 +184,9 @@ def plot(records, sigmas, path):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     subset_options(parser, "robustness")
-    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
-                        help="a parameter of Rigger's method, e.g. --set prune=1.5 (repeatable)")
+    settings_option(parser)
     args = parser.parse_args(argv)
-    params = dict(setting.split("=", 1) for setting in args.settings)
+    params = method_params(args.settings)
     if not SHARED_MODELS.is_dir():
         raise SystemExit(f"No models at {SHARED_MODELS}: the robustness benchmark needs ../shared beside the checkout.")
     names = picked([name for name in sorted(MODELS) if model_path(name).exists()], args.models)
