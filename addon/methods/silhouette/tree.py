@@ -176,9 +176,9 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                         width = max(width, _jump_width(ordered, points, radius, pruning.outline))
                     bump = beyond <= prune * width and not (  # the round-part test only where it can matter
                         blobs is not None and _round_part(apart, radius, blobs, base, tip, tuning.round_tip))
-                    ends = [tip] + reached.get(tip, [])
-                    reach = float((np.linalg.norm(points[ends] - points[base], axis=1) + radius[ends]).max()
-                                  - radius[base])
+                    reach = beyond if tip not in reached else float(  # to the spurs cut off its end, too
+                        (np.linalg.norm(points[[tip, *reached[tip]]] - points[base], axis=1)
+                         + radius[[tip, *reached[tip]]]).max() - radius[base])
                     spur = reach < max_reach and (beyond <= min_reach or bump)
                     part = _round_part_on(ordered, points, radius, blobs, min_reach, tuning.round_tip) \
                         if spur and pruning.heads and blobs is not None else None
