@@ -614,7 +614,7 @@ def _limb(graph, attach, before, plane, size, tuning):
         main.append(before[main[-1]])
     side = 0
     if plane is not None:  # a foot curling in to the middle leaves a leg on its side
-        offsets = np.array([plane.distance(graph.points[node]) for node in main], dtype=np.float64)
+        offsets = plane.distance(graph.points[main])
         offset = float(offsets[int(np.argmax(np.abs(offsets)))])
         side = 0 if abs(offset) <= tuning.midline * size else int(np.sign(offset))
     return Limb(attach, dict(before), tuple(main[::-1]), side)
