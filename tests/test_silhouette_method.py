@@ -780,6 +780,23 @@ def test_twin_legs_leave_the_middle_together_where_the_triangulation_split_the_j
             np.testing.assert_allclose(tails[twin], tails[names.index(name)] * [-1, 1, 1], atol=1e-9)
 
 
+def test_twin_legs_leave_the_middle_together_from_a_chain_placed_after_them():
+    """As above, but the leg that leaves the middle hangs from a chain placed after its twin's (the order the depth
+    step placed them in): its twin moves there too, and the bones are still built parents first."""
+    builder = bone_builder(0.3, plane=(0, 0.0))
+    spine = (np.array([[0.0, 0.0, 0.0], [-0.02, -0.06, 0.0]]), -1, np.full(2, 0.3))
+    right = (np.array([[-0.02, -0.06, 0.0], [-0.3, -0.3, 0.0], [-0.4, -1.5, 0.0]]), 0, np.full(3, 0.1))
+    rest_of_spine = (np.array([[-0.02, -0.06, 0.0], [0.0, -0.1, 0.0]]), 0, np.full(2, 0.3))
+    left = (np.array([[0.0, -0.1, 0.0], [0.3, -0.3, 0.0], [0.4, -1.5, 0.0]]), 2, np.full(3, 0.1))
+    builder.add_island(np.zeros(3), [spine, right, rest_of_spine, left])
+    heads, _, parents = builder.arrays()
+    names = builder.names()
+    first = {side: names.index(next(n for n in names if n.endswith(side))) for side in (".L", ".R")}
+    assert parents[first[".L"]] == parents[first[".R"]]
+    assert all(parent < bone for bone, parent in enumerate(parents))
+    np.testing.assert_allclose(heads[first[".R"]], heads[first[".L"]] * [-1, 1, 1], atol=1e-9)
+
+
 def test_a_round_head_on_the_shoulders_keeps_its_bone_when_its_outline_s_corners_are_pruned():
     """rignet_8333's round head sits on its shoulders. Pruning its outline's corner branches left the chain running on
     from the head to one corner, and then the whole chain went as a bump: no bone reached the head. The corner goes,

@@ -43,7 +43,7 @@ class BoneBuilder:
         roots = [i for i, (_, parent, _) in enumerate(placed) if parent < 0]
         on_plane = {i: self.symmetry is not None and self.symmetry.side(placed[i][0]) == 0 for i in roots}
         trunk = max(roots, key=lambda i: (on_plane[i], placed[i][2].mean()))
-        order = [trunk] + [i for i in range(len(placed)) if i != trunk]
+        order = _parents_first([trunk] + [i for i in range(len(placed)) if i != trunk], placed)
         inner = {parent for _, parent, _ in placed}
         across = [is_across(line, widths) for line, _, widths in placed]
         joints = self._joints([(line, widths, i not in inner) for i, (line, _, widths) in enumerate(placed)], across)
@@ -94,6 +94,8 @@ class BoneBuilder:
             if (self.symmetry.side(start[None]) != 0
                     or np.linalg.norm(lines[far][0] - self.symmetry.reflect(start)) <= 1e-9 * self.bone_length):
                 continue
+            if _descends(placed[near][1], far, moved):
+                continue  # hanging it there would hang it from itself
             line, _, widths = placed[far]
             moved[far] = (np.vstack([start, line[1:]]), placed[near][1], widths)
         return moved
@@ -343,3 +345,29 @@ def _body_line(sil, root_point, along, radius):
                              for k in range(0, len(line2d), 64)])  # in blocks: a fine outline has many segments
     widths[0] = radius
     return sil.lift(line2d, depths), widths
+
+
+def _parents_first(order, placed):
+    """``order`` (placed chain indices) with every chain moved after its parent, the rest as they were: moving
+    twins together (``_twins_together``) may hang a chain from one placed after it."""
+    result, done, waiting = [], set(), list(order)
+    while waiting:
+        for i in waiting:
+            if placed[i][1] < 0 or placed[i][1] in done:
+                result.append(i)
+                done.add(i)
+        left = [i for i in waiting if i not in done]
+        if len(left) == len(waiting):
+            raise ValueError("placed chains hang from each other in a loop")
+        waiting = left
+    return result
+
+
+def _descends(chain, ancestor, placed):
+    """Whether placed ``chain`` (-1: the root) is ``ancestor`` or hangs from it, directly or not."""
+    while chain >= 0:
+        if chain == ancestor:
+            return True
+        chain = placed[chain][1]
+    return False
+
