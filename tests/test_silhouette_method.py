@@ -205,6 +205,22 @@ def test_min_branch_leaves_short_spikes_without_bones():
         assert list(reaches) == reached, f"min_branch {min_branch}: tips reached {reaches}"
 
 
+@pytest.mark.parametrize("semi_axes", [(2.0, 0.6, 0.3), (2.0, 0.5, 0.4)])
+def test_a_smooth_flat_part_gets_a_straight_chain_not_a_zigzag(semi_axes):
+    """A flattened ellipsoid (a pebble, a fish's body) seen flat: its dense convex outline leaves the triangulation a
+    row of obtuse junction triangles across it, each with a one-triangle spur to the outline, their centroids
+    alternately above and below the middle. Once the spurs go, the axis runs along the middle through them."""
+    vertices, triangles = ellipsoids([((0.0, 0.0, 0.0), semi_axes)])
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    directions = skeleton.tails - skeleton.heads
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    child = np.flatnonzero(skeleton.parents >= 0)
+    turns = np.degrees(np.arccos(np.clip((directions[child] * directions[skeleton.parents[child]]).sum(1), -1, 1)))
+    assert turns.max() < 20, f"the chain turns by up to {turns.max():.0f} degrees"
+    assert np.abs(skeleton.joints()[:, 1]).max() < 0.1 * semi_axes[1]
+    assert len(skeleton) <= 6
+
+
 def test_the_hole_between_arm_and_body_is_cut():
     vertices, triangles = load_character("humanoid_hips")
     skeleton = rigger.rig_mesh(vertices, triangles, view="Y")

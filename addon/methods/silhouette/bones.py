@@ -370,4 +370,3 @@ def _descends(chain, ancestor, placed):
             return True
         chain = placed[chain][1]
     return False
-

@@ -26,6 +26,8 @@ class ChordalAxis:
         junction: (n,) bool, True where branches meet (junction or isolated triangles).
         links: (m, 2) int node pairs.
         island: (n,) int, the connected part of the silhouette each node belongs to.
+        passing: (n, 2) points and (n,) radii where each node sits should the axis only pass through it
+            (``passed_through``), or None: where it is.
     """
 
     points: np.ndarray
@@ -33,6 +35,7 @@ class ChordalAxis:
     junction: np.ndarray
     links: np.ndarray
     island: np.ndarray
+    passing: tuple = None
 
     def centred_on_mirror(self, hubs, mirror):
         """A copy with each of the nodes ``hubs`` (int array) whose mirror image lies within its disc (``mirror``
@@ -44,6 +47,19 @@ class ChordalAxis:
         points = self.points.copy()
         points[hubs[near]] = 0.5 * (points[hubs[near]] + image[near])
         return replace(self, points=points)
+
+    def passed_through(self, nodes):
+        """A copy with the ``nodes`` (int array) the axis only passes through, once their other branches are pruned,
+        moved to where they sit then (``passing``). A junction whose triangle is obtuse sits at its centroid, off
+        the middle of the part: a dense convex outline (a rounded head, a pebble seen flat) gives such triangles
+        across the part, each with a one-triangle spur to a notch of the outline, alternately above and below the
+        middle, and an axis through their centroids zigzags. Passed through, such a junction is a sleeve, and sits
+        on the middle of its longest edge, the chord across the part."""
+        if self.passing is None or not len(nodes):
+            return self
+        points, radius = self.points.copy(), self.radius.copy()
+        points[nodes], radius[nodes] = self.passing[0][nodes], self.passing[1][nodes]
+        return replace(self, points=points, radius=radius)
 
 
 def triangle_classes(tri):
@@ -74,7 +90,8 @@ def chordal_axis(tri, classes):
 
     # one node per junction, terminal and isolated triangle
     centre_tris = np.flatnonzero(classes != SLEEVE)
-    centre_points, centre_radius = _triangle_centres(corners[centre_tris], classes[centre_tris])
+    centre_points, centre_radius, chord_points, chord_radius = _triangle_centres(corners[centre_tris],
+                                                                               classes[centre_tris])
     centre_id = np.full(count, -1, dtype=np.int64)
     centre_id[centre_tris] = len(owner_t) + np.arange(len(centre_tris))
 
@@ -90,12 +107,16 @@ def chordal_axis(tri, classes):
     points = np.concatenate([edge_points, centre_points])
     radius = np.concatenate([edge_radius, centre_radius])
     junction = np.concatenate([np.zeros(len(edge_points), bool), classes[centre_tris] != TERMINAL])
-    return ChordalAxis(points, radius, junction, links, components(len(points), links))
+    passing = np.concatenate([edge_points, chord_points]), np.concatenate([edge_radius, chord_radius])
+    return ChordalAxis(points, radius, junction, links, components(len(points), links), passing)
 
 
 def _triangle_centres(corners, classes):
-    """Junctions sit at the circumcentre when it lies inside the triangle (the centre of the largest disc touching
-    the three outline points), otherwise at the centroid; terminals sit at their centroid, near the branch tip."""
+    """(centres, radii, passing centres, passing radii) of triangles: junctions sit at the circumcentre when it lies
+    inside the triangle (the centre of the largest disc touching the three outline points), otherwise at the
+    centroid; terminals sit at their centroid, near the branch tip. Passed through (``ChordalAxis.passed_through``),
+    a junction at its centroid sits on the middle of its longest edge instead. A radius is the distance to the
+    nearest corner."""
     centroid = corners.mean(axis=1)
     a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
     ab, ac = b - a, c - a
@@ -107,8 +128,17 @@ def _triangle_centres(corners, classes):
     inside = np.isfinite(circum).all(axis=1) & _inside_triangle(circum, a, b, c)
     use_circum = inside & (classes != TERMINAL)
     centre = np.where(use_circum[:, None], circum, centroid)
-    radius = np.linalg.norm(corners - centre[:, None, :], axis=2).min(axis=1)
-    return centre, radius
+    edges = np.stack([c - b, a - c, b - a], axis=1)  # edge k lies opposite corner k
+    longest = np.argmax((edges ** 2).sum(axis=2), axis=1)
+    rows = np.arange(len(corners))
+    chord = 0.5 * (corners[rows, (longest + 1) % 3] + corners[rows, (longest + 2) % 3])
+    passing = np.where(((classes != TERMINAL) & ~inside)[:, None], chord, centre)
+    return centre, _nearest_corner(corners, centre), passing, _nearest_corner(corners, passing)
+
+
+def _nearest_corner(corners, points):
+    """Per triangle (``corners`` (T, 3, 2)), the distance from its point in ``points`` (T, 2) to its nearest corner."""
+    return np.linalg.norm(corners - points[:, None, :], axis=2).min(axis=1)
 
 
 def _inside_triangle(p, a, b, c):

@@ -5,7 +5,7 @@ A *chain* is a polyline of axis nodes between two *key* nodes (ends and branch p
 1. Blob merging (Pan's "merge the triangles that lie within one maximal inscribed disc"): every junction, largest
    first, swallows the axis nodes it reaches without leaving its disc, so a round head becomes one node.
 2. Spur pruning (``prune_spurs``): branches that are bumps or outline noise go, repeatedly, since removing one can
-   expose another.
+   expose another; junctions the kept axis zigzags through move onto the chords across the part (``_zigzag``).
 3. Rooting at the most central branch point, then cutting every cycle (holes in the silhouette) where two parts
    touch (``_cut_cycle``).
 """
@@ -91,15 +91,30 @@ class Pruning:
 
 def pruned_tree(graph, merge, pruning):
     """Blob merging (discs grown ``merge`` times) and spur pruning (``pruning``) of a ``ChordalAxis``, its junctions
-    being the blobs that keep a spur ending in one. Returns (graph, alive nodes, merged links, kept links): with a
-    mirror, the graph whose blobs near the mirror line are centred on it (``ChordalAxis.centred_on_mirror``), which
-    the stages show and the bones follow."""
+    being the blobs that keep a spur ending in one. Returns (graph, alive nodes, merged links, kept links): the
+    graph with the junctions the kept links zigzag through on their chords (``_zigzag``) and, with a mirror, its
+    blobs near the mirror line centred on it (``ChordalAxis.centred_on_mirror``), which the stages show and the
+    bones follow."""
     representative, merged = merge_discs(graph.points, graph.radius, graph.junction, graph.links, merge)
     alive = np.unique(representative)
     if pruning.mirror is not None:
         graph = graph.centred_on_mirror(alive[graph.junction[alive]], pruning.mirror)
     _, chains = chains_of(alive.tolist(), merged)
-    return graph, alive, merged, prune_spurs(graph.points, graph.radius, chains, pruning, blobs=graph.junction)
+    kept = prune_spurs(graph.points, graph.radius, chains, pruning, blobs=graph.junction)
+    return graph.passed_through(_zigzag(graph, kept)), alive, merged, kept
+
+
+def _zigzag(graph, kept):
+    """The junctions the ``kept`` links pass through (two links each) that lie off the middle of the part to the
+    other side than a linked such junction: the axis zigzags between them (``ChordalAxis.passed_through``). Such
+    junctions all off to one side are a bend, or a part whose middle bends that way."""
+    if not len(kept) or graph.passing is None:
+        return np.zeros(0, dtype=np.int64)
+    through = graph.junction & (np.bincount(kept.ravel(), minlength=len(graph.junction)) == 2)
+    pairs = kept[through[kept[:, 0]] & through[kept[:, 1]]]
+    off = graph.points - graph.passing[0]  # from the middle of its longest edge to where it sits
+    crossing = (off[pairs[:, 0]] * off[pairs[:, 1]]).sum(axis=1) < 0
+    return np.unique(pairs[crossing])
 
 
 def removed_links(before, after):
