@@ -112,8 +112,8 @@ def _zigzag(graph, kept):
         return np.zeros(0, dtype=np.int64)
     through = graph.junction & (np.bincount(kept.ravel(), minlength=len(graph.junction)) == 2)
     pairs = kept[through[kept[:, 0]] & through[kept[:, 1]]]
-    off = graph.points - graph.passing[0]  # from the middle of its longest edge to where it sits
-    crossing = (off[pairs[:, 0]] * off[pairs[:, 1]]).sum(axis=1) < 0
+    off = graph.points[pairs] - graph.passing[0][pairs]  # (pairs, 2, 2): from its chord's middle to where it sits
+    crossing = (off[:, 0] * off[:, 1]).sum(axis=1) < 0
     return np.unique(pairs[crossing])
 
 
