@@ -22,6 +22,7 @@ from rigger.methods.silhouette.views import reflection_in_view
 
 TUNING = Tuning()
 ACROSS_X = Symmetry((0, 0.0), 0.05, TUNING)  # chains mirror across x = 0 within 0.05
+ROUGHLY_ACROSS_X = Symmetry((0, 0.0), 0.05, TUNING, middle=0.0)  # ... on a body that only roughly mirrors
 
 
 def cutting(max_bones=0):
@@ -557,7 +558,7 @@ def test_twins_of_a_body_that_only_roughly_mirrors_meet_halfway():
     of different shapes allow)."""
     bent, other = np.array([[0.0, 0.0, 0.0], [0.13, 0.0, 0.1], [0.4, 0.0, 0.0]]), straight(-0.45)
     own = [chain_joints(line, cutting(4), leaf=True) for line in (bent, other)]
-    result = symmetric_joints(leaves(bent, other), cutting(4), ACROSS_X, exact=False)
+    result = symmetric_joints(leaves(bent, other), cutting(4), ROUGHLY_ACROSS_X)
     assert len(own[0]) == len(own[1]) == len(result[0]) == len(result[1]) > 2
     for line, joints in zip((bent, other), result):
         np.testing.assert_array_equal(joints[0], line[0])
@@ -569,16 +570,16 @@ def test_twins_of_a_body_that_only_roughly_mirrors_meet_halfway():
 def test_twins_of_a_body_that_only_roughly_mirrors_mirror_where_they_nearly_do():
     """Two arms 0.08 thick across a plane the body only roughly mirrors about, the right one traced 0.01 deeper and
     its hand bent down, and two legs, the right foot turned 0.03 out: the joints that nearly mirror after meeting
-    halfway (the arms' shoulder ends, the legs) become exact mirror images across one plane, each within its limb,
-    and the lopsided foot does not pull that plane off the body's middle; the bent hand's joints, too far from their
-    twins' images for a mean inside both arms, stay on their own lines."""
+    halfway (the arms' shoulder ends, the legs) become exact mirror images across the body's middle, each within its
+    limb; the bent hand's joints, too far from their twins' images for a mean inside both arms, stay on their own
+    lines."""
     left = np.array([[0.0, 1.0, 0.0], [0.6, 1.0, 0.0]])
     right = np.array([[0.0, 1.0, 0.01], [-0.42, 1.0, 0.01], [-0.54, 0.9, 0.01]])
     legs = [np.array([[0.0, 0.5, 0.0], [0.3, 0.4, 0.0], [0.3, 0.0, 0.0]]),
             np.array([[0.0, 0.5, 0.0], [-0.3, 0.4, 0.0], [-0.3, 0.05, 0.0], [-0.33, 0.0, 0.0]])]
     lines = (left, right, *legs)
     chains = [(line, np.full(len(line), 0.04), True) for line in lines]
-    result = symmetric_joints(chains, cutting(), Symmetry((0, 0.0), 0.15, TUNING), exact=False)
+    result = symmetric_joints(chains, cutting(), Symmetry((0, 0.0), 0.15, TUNING, middle=0.0))
     assert len(result[0]) == len(result[1]) > 3 and len(result[2]) == len(result[3]) > 3
     middle = (0, (result[2][1, 0] + result[3][1, 0]) / 2)
     assert abs(middle[1]) < 1e-9
@@ -778,6 +779,24 @@ def test_a_roughly_symmetric_body_gets_a_plane_for_its_sides_through_its_spine()
     lying = figure((0.52, 0.48), spine_along=0)
     along_x = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
     assert sided_symmetry(lying, column_bounds(lying), 2.0, [along_x, *arms], TUNING) is None
+
+
+def test_a_roughly_symmetric_body_s_twins_mirror_where_it_mirrors_best_not_across_its_spine():
+    """Points filling a body and two arms, mirrored across x = 0 but for one hand bent down 5% of the size, and a
+    traced spine leaning 1.5% of the size to one side (as a posed body's may): the plane for its sides runs through
+    the spine, but twins mirror across the body's middle, where most of it mirrors, within ``rough_step``."""
+    random = np.random.default_rng(0)
+    half = np.concatenate([random.uniform([0.0, -1.0, -0.1], [0.2, 0.5, 0.1], (400, 3)),
+                           random.uniform([0.2, 0.45, -0.05], [1.0, 0.55, 0.05], (200, 3))])
+    vertices = np.concatenate([half, half * [-1, 1, 1]])
+    vertices[vertices[:, 0] < -0.8, 1] -= 0.1
+    bounds = column_bounds(vertices)
+    assert mirror_plane(vertices, bounds, 0.02, TUNING) is None
+    spine = np.array([[0.03, -1.0, 0.0], [0.03, 0.5, 0.0]])
+    arms = [np.array([[0.0, 0.5, 0.0], [1.0, 0.5, 0.0]]), np.array([[0.0, 0.5, 0.0], [-1.0, 0.4, 0.0]])]
+    sides = sided_symmetry(vertices, bounds, 2.0, [spine, *arms], TUNING)
+    assert sides.plane == (0, 0.03) and not sides.exact
+    assert sides.twin_plane[0] == 0 and abs(sides.twin_plane[1]) <= TUNING.rough_step * 2.0
 
 
 def test_copies_of_a_split_chain_keep_their_own_parts_to_the_end():

@@ -153,7 +153,7 @@ def recognise(skeleton, mesh, *, plane=None, prefer_up=AXES[2], tuning=BodyPlanT
     factor = mesh.unit_factor  # read at unit size (a power of two: exact), as the methods rig
     at_unit_size = Skeleton(skeleton.names, skeleton.heads * factor, skeleton.tails * factor, skeleton.parents)
     if plane is not None:
-        plane = MirrorPlane(plane.axis, plane.offset * factor, plane.normal)
+        plane = MirrorPlane(plane.axis, plane.offset * factor, plane.normal, plane.exact)
     body = read_body(at_unit_size, mesh.at_unit_size(), tuning, plane, prefer_up / np.linalg.norm(prefer_up))
     layout = lay_out(body, tuning)
     paths = twin_paths(body, tuning)

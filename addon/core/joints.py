@@ -172,7 +172,7 @@ def _turns(line, tolerance):
     return turns
 
 
-def symmetric_joints(chains, cutting, symmetry, exact=True):
+def symmetric_joints(chains, cutting, symmetry):
     """Joints along each of the (polyline, half-widths or None, is a leaf) ``chains`` (``chain_joints``), each pair
     of mirror twins (``mirror_chain_pairs``) given mirror-image joints where the mesh allows, so every bone has a
     twin in the mirrored place (``.L`` and ``.R``, X-mirror posing).
@@ -185,17 +185,17 @@ def symmetric_joints(chains, cutting, symmetry, exact=True):
     get one bone count: the smaller, unless the other's corners or the longest bone need more, then the larger.
     Each chain keeps its first joint, where it attaches to its parent.
 
-    Across a plane the body only roughly mirrors about (not ``exact``: a posed or hand-made figure, whose twins are
-    no images of each other) twins get one bone count and their joints meet halfway (``_met_halfway``); those that
-    then nearly mirror each other (``_nearly_mirrored``) move to their mean, mirror images across one plane: the
-    median of those pairs' midpoints (the body's own middle, which a posed figure's box or spine may miss, and a
-    lopsided ear tip does not pull off).
+    Across a plane the body only roughly mirrors about (``symmetry`` not exact: a posed or hand-made figure, whose
+    twins are no images of each other) twins get one bone count and their joints meet halfway (``_met_halfway``);
+    those that then nearly mirror each other (``_nearly_mirrored``) move to their mean, mirror images across the
+    body's ``middle``.
     """
     chains = [(line, np.zeros(len(line)) if widths is None else widths, leaf) for line, widths, leaf in chains]
     joints = [chain_joints(line, cutting, widths, leaf) for line, widths, leaf in chains]
     lines = [line for line, _, _ in chains]
     close = []  # (i, j, which of their joints nearly mirror) across a rough plane
     for i, j in mirror_chain_pairs(lines, symmetry):
+        exact = symmetry.exact
         shared = _shared_joints(chains[i], chains[j], joints[i], joints[j], cutting, symmetry) if exact else None
         if shared is not None:
             joints[i] = np.vstack([joints[i][:1], shared[0][1:]])
@@ -206,13 +206,9 @@ def symmetric_joints(chains, cutting, symmetry, exact=True):
         if not exact:
             joints[i], joints[j] = _met_halfway(lines[i], lines[j], joints[i], joints[j], symmetry)
             close.append((i, j, _nearly_mirrored(chains[i], chains[j], joints[i], joints[j], symmetry)))
-    if any(near.any() for _, _, near in close):
-        axis = symmetry.plane[0]
-        middle = np.concatenate([(joints[i][near, axis] + joints[j][near, axis]) / 2 for i, j, near in close])
-        plane = (axis, float(np.median(middle)))
-        for i, j, near in close:
-            joints[i][near] = (joints[i][near] + mirrored(joints[j][near], plane)) / 2
-            joints[j][near] = mirrored(joints[i][near], plane)
+    for i, j, near in close:
+        joints[i][near] = (joints[i][near] + mirrored(joints[j][near], symmetry.twin_plane)) / 2
+        joints[j][near] = mirrored(joints[i][near], symmetry.twin_plane)
     return joints
 
 

@@ -1,6 +1,6 @@
 """A mesh's mirror plane, and mirror twins among chains (3D polylines): which chain is which one's image, on which
 side of the plane a chain lies, and limbs completed from a longer twin's image."""
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -31,18 +31,33 @@ class MirrorTuning(TuningTable):
                                      "share of the size (a hand-made or posed figure)")
     rough_twin_tolerance: float = tuned(0.1, "on such a body, the twin tolerance (share of the size) for naming "
                                              "twins")
+    rough_step: float = tuned(0.001, "on such a body, twins mirror across where the mesh mirrors best, found to "
+                                     "this share of the size")
 
 
 @dataclass(frozen=True)
 class Symmetry:
     """A mirror ``plane`` (axis 0, 1 or 2, offset), the ``tolerance`` (mesh units) within which chains mirror each
     other, the ``tuning``, and how far off the plane the tip of a chain that leaves it lies on a side
-    (``side_tolerance``, mesh units; None: the tolerance)."""
+    (``side_tolerance``, mesh units; None: the tolerance). For a body that only roughly mirrors (hand-made, posed)
+    ``middle`` is the offset along the plane's axis where it mirrors best, which twins' joints mirror across; None
+    when the mesh mirrors exactly about ``plane``."""
 
     plane: tuple
     tolerance: float
     tuning: MirrorTuning
     side_tolerance: float = None
+    middle: float = None
+
+    @property
+    def exact(self):
+        """Whether the mesh is a mirror image about the plane."""
+        return self.middle is None
+
+    @property
+    def twin_plane(self):
+        """The plane twins' joints mirror across: the mirror plane, or the rough body's ``middle``."""
+        return self.plane if self.exact else (self.plane[0], self.middle)
 
     def reflect(self, points):
         """``mirrored(points, plane)``."""
@@ -113,12 +128,11 @@ def symmetric_planes(vertices, bounds, tolerance, tuning):
     occupied = _CellSet(_cell_keys(np.floor((vertices - origin) / tolerance).astype(np.int64), span), span)
     step = max(1, len(vertices) // tuning.plane_samples)
     probe = vertices[::step]
-    offsets = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)])
     planes = []
     for axis in np.flatnonzero(high - low > 2 * tolerance):
         centre = 0.5 * (low[axis] + high[axis])
         cells = np.floor((mirrored(probe, (axis, centre)) - origin) / tolerance).astype(np.int64)
-        around = np.clip(cells[:, None, :] + offsets[None], 0, span - 1).reshape(-1, 3)
+        around = np.clip(cells[:, None, :] + _NEIGHBOURS[None], 0, span - 1).reshape(-1, 3)
         score = occupied.holds(_cell_keys(around, span)).reshape(len(probe), -1).any(axis=1).mean()
         if score >= tuning.plane_share:
             planes.append((int(axis), centre, score))
@@ -131,7 +145,8 @@ def sided_symmetry(vertices, bounds, size, lines, tuning):
     ``rough_match`` of the ``size`` and the trunk (``lines[0]``, the chain the root bone starts) lies on it within
     the twin tolerance, as a spine does (a side-view cut-out of an animal is symmetric front to back, but its spine
     crosses that plane); of those, moved to pass through the trunk, the plane across which most chains (``lines``)
-    pair as twins, within ``rough_twin_tolerance``."""
+    pair as twins, within ``rough_twin_tolerance``, with its ``middle`` where the mesh mirrors best
+    (``best_offset``)."""
     best, most = None, 0
     for axis, offset, _ in symmetric_planes(vertices, bounds, tuning.rough_match * size, tuning):
         if not lines or np.abs(lines[0][:, axis] - offset).max() > tuning.twin_tolerance * size:
@@ -141,7 +156,62 @@ def sided_symmetry(vertices, bounds, size, lines, tuning):
         pairs = len(mirror_chain_pairs(lines, symmetry))
         if pairs > most:
             best, most = symmetry, pairs
-    return best
+    return None if best is None else replace(best, middle=best_offset(vertices, best.plane, size, tuning))
+
+
+def best_offset(vertices, plane, size, tuning):
+    """The offset, within the twin tolerance of ``plane``'s (axis, offset), of the plane across its axis the
+    ``vertices`` mirror best about: where the median distance from mirrored vertices to the nearest vertex is least.
+    A median: a raised arm or a prop on one side does not pull the plane, as it pulls a posed body's box or spine.
+
+    Searched in eighths of the tolerance with a quarter of the ``plane_samples`` probes and distances up to
+    ``rough_match`` of the ``size`` (a coarse mesh's vertices mirror only that closely), then in ``rough_step`` about
+    the best with all of them and distances up to twice the best median (few neighbours on a dense mesh)."""
+    (axis, around), reach = plane, tuning.twin_tolerance * size
+    probe = vertices[::max(1, len(vertices) // tuning.plane_samples)]
+
+    def best(offsets, probe, nearest):
+        medians = [np.median(nearest.distances(mirrored(probe, (axis, offset)))) for offset in offsets]
+        return offsets[int(np.argmin(medians))], min(medians)
+
+    centre, median = best(around + np.linspace(-reach, reach, 17), probe[::4],
+                          _Nearest(vertices, tuning.rough_match * size))
+    step = tuning.rough_step * size
+    fine = centre + step * np.arange(-np.ceil(reach / 8 / step), np.ceil(reach / 8 / step) + 1)
+    return float(best(fine, probe, _Nearest(vertices, max(2 * median, step)))[0])
+
+
+class _Nearest:
+    """The distance from points to the nearest of ``vertices``, up to ``reach`` (farther ones read ``reach``):
+    vertices hashed to a grid of cells ``reach`` wide, each point compared with those in its 27 cells."""
+
+    def __init__(self, vertices, reach):
+        self.reach, self.origin = reach, vertices.min(axis=0) - 2 * reach
+        self.span = np.floor((vertices.max(axis=0) - self.origin) / reach).astype(np.int64) + 3
+        keys = _cell_keys(self._cells(vertices), self.span)
+        order = np.argsort(keys, kind="stable")
+        self.keys, self.vertices = keys[order], vertices[order]
+
+    def _cells(self, points):
+        return np.clip(np.floor((points - self.origin) / self.reach).astype(np.int64), 1, self.span - 2)
+
+    def distances(self, points):
+        around = (self._cells(points)[:, None, :] + _NEIGHBOURS[None]).reshape(-1, 3)
+        keys = _cell_keys(around, self.span)
+        starts, ends = np.searchsorted(self.keys, keys), np.searchsorted(self.keys, keys, side="right")
+        counts = ends - starts
+        at = np.repeat(starts - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
+        per_point = counts.reshape(len(points), -1).sum(axis=1)
+        found = per_point > 0
+        squares = ((self.vertices[at] - np.repeat(points, per_point, axis=0)) ** 2).sum(axis=1)
+        result = np.full(len(points), self.reach)
+        if found.any():
+            first = (np.cumsum(per_point) - per_point)[found]
+            result[found] = np.minimum(np.sqrt(np.minimum.reduceat(squares, first)), self.reach)
+        return result
+
+
+_NEIGHBOURS = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)])
 
 
 def _cell_keys(cells, span):

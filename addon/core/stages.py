@@ -322,12 +322,15 @@ class Joints(Stage):
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class MirrorPlane(Stage):
-    """The plane a mesh is mirror-symmetric about: perpendicular to axis ``axis`` (0, 1 or 2) of the frame the method
-    worked in, whose world direction is ``normal``, at ``offset`` along it. Not drawn."""
+    """The plane a mesh is mirror-symmetric about, and its bones' twins mirror across: perpendicular to axis ``axis``
+    (0, 1 or 2) of the frame the method worked in, whose world direction is ``normal``, at ``offset`` along it.
+    ``exact``: the mesh is a mirror image about it; else it only roughly is (a hand-made or posed body), and the plane
+    lies where it mirrors best. Not drawn."""
 
     axis: int
     offset: float
     normal: np.ndarray
+    exact: bool = True
 
     label = "Mirror Plane"
 
@@ -338,7 +341,7 @@ class MirrorPlane(Stage):
         _vector(self, "normal", unit=True)
 
     def mapped(self, placement):
-        return MirrorPlane(self.axis, placement.length(self.offset), placement.vector(self.normal))
+        return MirrorPlane(self.axis, placement.length(self.offset), placement.vector(self.normal), self.exact)
 
     def reflect(self, points):
         """World ``points`` (..., 3) reflected across the plane."""

@@ -117,7 +117,7 @@ class SilhouetteMethod(RigMethod):
         if sides is None:  # a body with a left and a right that is no exact mirror image: twins get one bone count
             sides = sided_symmetry(mesh.used_vertices, mesh.bbox, mesh.scale, builder.lines, tuning)
             if sides is not None:
-                builder = _bones(sil, islands, other_views, rules, sides, exact=False)
+                builder = _bones(sil, islands, other_views, rules, sides)
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()
@@ -136,18 +136,19 @@ class SilhouetteMethod(RigMethod):
             "pruned": PrunedBranches(view_frame_stage, graph.points, graph.radius, removed_links(merged, kept)),
             "chains": Chains(builder.lines),
         }
-        if rules.plane is not None:
-            stages["mirror_plane"] = MirrorPlane(rules.plane[0], rules.plane[1], np.eye(3)[rules.plane[0]])
+        if sides is not None:
+            axis, offset = sides.twin_plane
+            stages["mirror_plane"] = MirrorPlane(axis, offset, np.eye(3)[axis], sides.exact)
         stages = {name: stage.mapped(placement) for name, stage in stages.items()}
         heads, tails = placement.point(heads), placement.point(tails)
         stages["joints"] = Joints(np.unique(np.concatenate([heads, tails]), axis=0))
         return Skeleton(names, heads, tails, parents, stages=stages, timings=clock.laps)
 
 
-def _bones(sil, islands, other_views, rules, symmetry, exact=True):
+def _bones(sil, islands, other_views, rules, symmetry):
     """A ``BoneBuilder`` with the bones of the placed ``islands`` (``Blob`` or ``PlacedIsland`` each) and of the limbs
-    the ``other_views`` find hidden, twins across ``symmetry`` (``exact``: see ``BoneBuilder``)."""
-    builder = BoneBuilder(rules.cutting, symmetry, rules.tuning, exact)
+    the ``other_views`` find hidden, twins across ``symmetry``."""
+    builder = BoneBuilder(rules.cutting, symmetry, rules.tuning)
     for placed in islands:
         if isinstance(placed, Blob):
             builder.add_blob(sil, placed.point, placed.radius)

@@ -14,12 +14,13 @@ from .outline import loop_edges
 class BoneBuilder:
     """Accumulates bones island by island; the first island's trunk holds the single root bone. Chains are cut as
     ``cutting`` says. With a ``symmetry`` (None without a mirror plane) twins are named for their sides; across an
-    ``exact`` one, the mesh's mirror plane, they get mirror-image joints and a limb its longer twin's image, so a
+    exact one, the mesh's mirror plane, they get mirror-image joints and a limb its longer twin's image, so a
     symmetric mesh gets a symmetric rig; across a plane a body only roughly mirrors about, just one bone count.
     ``tuning``: the method's (hanging hidden limbs)."""
 
-    def __init__(self, cutting, symmetry, tuning, exact=True):
-        self.cutting, self.symmetry, self.tuning, self.exact = cutting, symmetry, tuning, exact
+    def __init__(self, cutting, symmetry, tuning):
+        self.cutting, self.symmetry, self.tuning = cutting, symmetry, tuning
+        self.exact = symmetry is not None and symmetry.exact
         self.bone_length = cutting.bone_length
         self.heads, self.tails, self.parents = [], [], []
         self.chain_of_bone, self.index_in_chain = [], []
@@ -172,7 +173,7 @@ class BoneBuilder:
         limbs share does not depend on their order, so mirror pairs stay mirror pairs."""
         if not limbs:
             return
-        if self.symmetry is not None and self.exact:
+        if self.exact:
             limbs = mirror_completed(limbs, self.symmetry)
         chains, ups, meets_of = [], [], {}  # meets_of: limb number -> where it meets its bone, for the limbs to extend
         for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
@@ -246,7 +247,7 @@ class BoneBuilder:
         if self.symmetry is None:
             joints = iter([chain_joints(line, self.cutting, widths, leaf) for line, widths, leaf in cut])
         else:
-            joints = iter(symmetric_joints(cut, self.cutting, self.symmetry, exact=self.exact))
+            joints = iter(symmetric_joints(cut, self.cutting, self.symmetry))
         return [line.copy() if one else next(joints) for (line, _, _), one in zip(chains, across)]
 
     def _add_chain(self, line, joints, up):
