@@ -195,15 +195,15 @@ def symmetric_joints(chains, cutting, symmetry):
     lines = [line for line, _, _ in chains]
     close = []  # (i, j, which of their joints nearly mirror) across a rough plane
     for i, j in mirror_chain_pairs(lines, symmetry):
-        exact = symmetry.exact
-        shared = _shared_joints(chains[i], chains[j], joints[i], joints[j], cutting, symmetry) if exact else None
+        shared = (_shared_joints(chains[i], chains[j], joints[i], joints[j], cutting, symmetry) if symmetry.exact
+                  else None)
         if shared is not None:
             joints[i] = np.vstack([joints[i][:1], shared[0][1:]])
             joints[j] = np.vstack([joints[j][:1], shared[1][1:]])
             continue
         if len(joints[i]) != len(joints[j]):
             joints[i], joints[j] = _one_count(chains[i], chains[j], joints[i], joints[j], cutting)
-        if not exact:
+        if not symmetry.exact:
             joints[i], joints[j] = _met_halfway(lines[i], lines[j], joints[i], joints[j], symmetry)
             close.append((i, j, _nearly_mirrored(chains[i], chains[j], joints[i], joints[j], symmetry)))
     for i, j, near in close:
