@@ -164,9 +164,11 @@ def best_offset(vertices, plane, size, tuning):
     ``vertices`` mirror best about: where the median distance from mirrored vertices to the nearest vertex is least.
     A median: a raised arm or a prop on one side does not pull the plane, as it pulls a posed body's box or spine.
 
-    Searched in eighths of the tolerance with a quarter of the ``plane_samples`` probes and distances up to
-    ``rough_match`` of the ``size`` (a coarse mesh's vertices mirror only that closely), then in ``rough_step`` about
-    the best with all of them and distances up to twice the best median (few neighbours on a dense mesh)."""
+    Searched in eighths of the tolerance with a quarter of the ``plane_samples`` probes, against at most 16 times
+    that many vertices, and distances up to ``rough_match`` of the ``size`` (a coarse mesh's vertices mirror only that
+    closely), then in ``rough_step`` about the best with all probes and vertices and distances up to twice the
+    median found, scaled to the denser vertices' spacing (few neighbours to compare on a dense mesh), doubled until
+    the best median is under half of it."""
     (axis, around), reach = plane, tuning.twin_tolerance * size
     probe = vertices[::max(1, len(vertices) // tuning.plane_samples)]
 
@@ -174,11 +176,17 @@ def best_offset(vertices, plane, size, tuning):
         medians = [np.median(nearest.distances(mirrored(probe, (axis, offset)))) for offset in offsets]
         return offsets[int(np.argmin(medians))], min(medians)
 
+    sparse = vertices[::max(1, len(vertices) // (16 * tuning.plane_samples))]
     centre, median = best(around + np.linspace(-reach, reach, 17), probe[::4],
-                          _Nearest(vertices, tuning.rough_match * size))
+                          _Nearest(sparse, tuning.rough_match * size))
     step = tuning.rough_step * size
     fine = centre + step * np.arange(-np.ceil(reach / 8 / step), np.ceil(reach / 8 / step) + 1)
-    return float(best(fine, probe, _Nearest(vertices, max(2 * median, step)))[0])
+    cap = max(2 * median * np.sqrt(len(sparse) / len(vertices)), step)
+    while True:
+        offset, median = best(fine, probe, _Nearest(vertices, cap))
+        if median < cap / 2 or cap >= tuning.rough_match * size:
+            return float(offset)
+        cap *= 2
 
 
 class _Nearest:
