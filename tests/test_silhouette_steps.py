@@ -135,6 +135,21 @@ def test_a_spur_whose_mirror_image_is_kept_stays():
     assert tips_kept(*parts, prune=0.8, mirror=reflect) == [True, True, True]
 
 
+def test_a_stubby_head_going_on_from_the_spine_stays():
+    """A helmeted trooper's head on a short neck, seen from the front: off the shoulders' disc (radius 1), between
+    two arms, it sticks out 1.2 times its neck's width, under prune (1.35), so it went as a bump, and noise of 0.1%
+    of the size took the head off a rig that had it. On the mirror line, going on straight from the spine (a chain
+    on the line down through the same disc), it stays; turned off the line, too short for a part (less than half the
+    disc's radius beyond it), or with no spine on the line to go on from, it goes."""
+    arms = stub((1.0, 0.0), 3.0), stub((-1.0, 0.0), 3.0)
+    spine = {"legs": (0.0,), "mirror": reflect}
+    assert tips_kept(*arms, stub((0.0, 1.0), 1.2), **spine) == [True, True, True]
+    assert tips_kept(*arms, stub((0.0, 1.0), 1.2), legs=(0.0,)) == [True, True, False]  # no mirror plane
+    assert tips_kept(*arms, stub((1.0, 1.0), 1.2), **spine) == [True, True, False]  # turned off the line
+    assert tips_kept(*arms, stub((0.0, 1.0), 1.2, radius=0.1), **spine) == [True, True, False]  # reaching 0.24
+    assert tips_kept(*arms, stub((0.0, 1.0), 1.2), mirror=reflect) == [True, True, False]  # legs off the line
+
+
 def test_a_mirror_pair_of_stubby_branches_stays_where_a_lone_one_goes():
     """Two ears off a head (a chest disc of radius 1), each sticking out 0.9 times its width: under prune (1.35),
     over pair_prune (0.74). With the reflection the pair stays; a lone ear, a pair under pair_prune, or either rule

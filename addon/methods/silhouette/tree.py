@@ -154,7 +154,8 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
     a neck. With a ``mirror``, a spur whose mirror image is a branch kept off the same base stays too (a figure's two
     arms, each near the threshold, are kept or dropped together), and with ``pair_prune`` two spurs off one base
     that mirror each other stay: a pair is a limb where a lone bump of that size is not (a dog's ears; outline noise
-    is not symmetric). With ``pair_prune`` and ``local_pairs`` instead, two such spurs off one base that stick out
+    is not symmetric); and a spur on the mirror plane going on from a chain on it stays (``_not_going_on``: a head
+    on its neck). With ``pair_prune`` and ``local_pairs`` instead, two such spurs off one base that stick out
     about as far and are about as wide stay, and so does one such spur beside a kept leaf it is that alike to
     (``_local_pairs``). With ``pair_prune`` and a ``ground``, such a spur stays when its tip stands where a kept
     leaf stands, or in a view with no mirror another such spur off another base (``_standing``): a cat's stubby front
@@ -211,6 +212,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                     break
         if spurs and pruning.mirror is not None:
             spurs = _unmirrored(spurs, pairable, leaves, points, radius, pruning.mirror)
+            spurs = _not_going_on(spurs, chains, points, radius, pruning.mirror, tuning)
         if spurs and pruning.ground is not None:
             spurs = _standing(spurs, pairable, leaves, chains, points, radius, reaching, stood,
                               spurs_stand=pruning.mirror is None)
@@ -341,6 +343,33 @@ def _unmirrored(spurs, pairable, leaves, points, radius, mirror):
         lying_on[i] = set(owners[np.linalg.norm(points[nodes] - image, axis=1) <= radius[nodes]].tolist()) - {i}
     return {i: spurs[i] for i, twins in lying_on.items() if not any(
         chain not in spurs or (i in pairable and i in lying_on[chain]) for chain in twins)}
+
+
+def _not_going_on(spurs, chains, points, radius, mirror, tuning):
+    """The ``spurs`` (chain -> (base, tip)) but those on the mirror plane that go on straight from another chain on
+    it through their base (within ``straight_on`` degrees), reaching beyond its disc by ``straight_reach`` of its
+    radius: a head on its neck going on from the spine, however stubby it is for the width of the shoulders' disc
+    (a bump on the body's middle line is no part). On the plane: the node's disc holds its mirror image."""
+    def on_plane(nodes):
+        return np.linalg.norm(mirror(points[nodes]) - points[nodes], axis=1) <= radius[nodes]
+
+    going_on = set()
+    for i, (base, tip) in spurs.items():
+        reach = np.linalg.norm(points[tip] - points[base]) + radius[tip] - radius[base]
+        if reach <= tuning.straight_reach * radius[base] or not on_plane([base, tip]).all():
+            continue
+        ahead = (points[tip] - points[base]) / max(np.linalg.norm(points[tip] - points[base]), 1e-300)
+        for k, chain in enumerate(chains):
+            if k == i or k in spurs or base not in (chain[0], chain[-1]):
+                continue
+            ordered = chain if chain[0] == base else chain[::-1]
+            out = [n for n in ordered[1:] if np.linalg.norm(points[n] - points[base]) > radius[base]]
+            node = out[0] if out else ordered[-1]
+            back = points[node] - points[base]
+            if on_plane([node])[0] and ahead @ back <= -np.cos(np.radians(tuning.straight_on)) * np.linalg.norm(back):
+                going_on.add(i)
+                break
+    return {i: ends for i, ends in spurs.items() if i not in going_on}
 
 
 def _local_pairs(dropped, kept, links, points, most_unlike):

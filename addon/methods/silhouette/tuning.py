@@ -32,6 +32,9 @@ class Tuning(JointTuning, MirrorTuning):
                                     "are limbs (a dog's ears)")
     local_pair: float = tuned(1.5, "without a mirror plane, two branches off one base pair when their reach ratio "
                                    "times width ratio is at most this")
+    straight_on: float = tuned(30.0, "degrees: a spur on the mirror plane going on from a chain on it through its "
+                                     "base within this turn stays (a head on its neck) ...")
+    straight_reach: float = tuned(0.5, "... when it reaches beyond the base's disc by this share of its radius")
     round_tip: float = tuned(0.7, "a branch ending in a blob this share of its base's width, off the base's disc, is "
                                   "a part (a head without a neck)")
     ground_reach: float = tuned(0.03, "a branch tip this close (share of the size) to a side of the outline stands on "
