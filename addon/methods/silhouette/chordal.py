@@ -42,10 +42,9 @@ class ChordalAxis:
         reflects (P, 2) points across the mesh's mirror plane) moved to the midpoint of it and its image, onto the
         mirror line. The triangulation of a symmetric outline is not symmetric: a body's centre left off the line
         would hang a figure's left and right limbs from it at different angles."""
-        image = mirror(self.points[hubs])
-        near = np.linalg.norm(image - self.points[hubs], axis=1) <= self.radius[hubs]
+        near = on_mirror_line(self.points[hubs], self.radius[hubs], mirror)
         points = self.points.copy()
-        points[hubs[near]] = 0.5 * (points[hubs[near]] + image[near])
+        points[hubs[near]] = 0.5 * (points[hubs[near]] + mirror(points[hubs[near]]))
         return replace(self, points=points)
 
     def passed_through(self, nodes):
@@ -60,6 +59,12 @@ class ChordalAxis:
         points, radius = self.points.copy(), self.radius.copy()
         points[nodes], radius[nodes] = self.passing[0][nodes], self.passing[1][nodes]
         return replace(self, points=points, radius=radius)
+
+
+def on_mirror_line(points, radius, mirror):
+    """Which of the (P, 2) ``points`` of a view lie on its mirror line: their discs (``radius``) hold their mirror
+    images (``mirror`` reflects (P, 2) points across the mesh's mirror plane)."""
+    return np.linalg.norm(mirror(points) - points, axis=1) <= radius
 
 
 def triangle_classes(tri):

@@ -15,6 +15,7 @@ import numpy as np
 
 from ...core.graphs import chains_of, links_of, neighbour_lists, shortest_paths
 from ...core.polyline import arc_lengths, length, segment_distances
+from .chordal import on_mirror_line
 from .tuning import Tuning
 
 
@@ -351,7 +352,7 @@ def _not_going_on(spurs, chains, points, radius, mirror, tuning):
     radius: a head on its neck going on from the spine, however stubby it is for the width of the shoulders' disc
     (a bump on the body's middle line is no part). On the plane: the node's disc holds its mirror image."""
     def on_plane(nodes):
-        return np.linalg.norm(mirror(points[nodes]) - points[nodes], axis=1) <= radius[nodes]
+        return on_mirror_line(points[nodes], radius[nodes], mirror)
 
     going_on = set()
     for i, (base, tip) in spurs.items():
