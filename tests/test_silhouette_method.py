@@ -927,7 +927,8 @@ def test_a_bear_s_ears_are_twins_though_its_front_view_prunes_one_ear_s_tip():
 def test_legs_seen_from_the_side_hang_from_hips_beside_the_middle(name):
     """Seen from the side, a pair of legs is one chain split in depth. Each copy starts at its own depth where the
     chain leaves the body's middle (or the root): one bone, the hips (shoulder), reaches across to it, level, and
-    the leg goes down from there, beside the middle as the artists' hips are, not slanting in from the middle."""
+    the leg goes down from there, nearly straight, beside the middle as the artists' hips are, not slanting in from
+    the middle."""
     vertices, triangles = load_character(name)
     skeleton = rigger.rig_mesh(vertices, triangles)
     size = float(np.ptp(vertices, axis=0).max())
@@ -940,7 +941,7 @@ def test_legs_seen_from_the_side_hang_from_hips_beside_the_middle(name):
         assert abs(head[0]) <= 0.01 * size and abs(tail[2] - head[2]) <= 0.01 * size, skeleton.names[bone]
         leg = [b for b, r in enumerate(skeleton.roles) if r.side == role.side and r.role in legs[role.role]]
         lowest = skeleton.tails[min(leg, key=lambda b: skeleton.tails[b][2])]
-        assert abs(tail[0] - lowest[0]) <= 0.01 * size, skeleton.names[bone]
+        assert abs(tail[0] - lowest[0]) <= 0.02 * size, skeleton.names[bone]
         found += 1
     assert found == 4
 

@@ -824,6 +824,20 @@ def test_copies_of_a_split_chain_keep_their_own_parts_to_the_end():
     np.testing.assert_allclose(tips, [0.5, 3.5])
 
 
+def test_split_legs_run_down_the_middle_of_each_leg_not_at_their_feet_depth():
+    """A splayed leg pair seen from the side: merged with the body, then each leg apart (depths 2 to 4 and their
+    mirror), ending in a foot turned out (3.5 to 4.5). Each leg's copy runs down the middle of its leg wherever the
+    legs are apart, not at its foot's depth all the way up; it keeps its depth only where they merge."""
+    node_layers = ([layers((-4, 4))] * 4 + [layers((-4, -2), (2, 4))] * 10
+                   + [layers((-4.5, -3.5), (3.5, 4.5))] * 3)
+    _, placed = placed_along_x(node_layers, mirror=(0.0, 0.05))
+    legs = sorted((line for line, _, widths in placed if widths.any()), key=lambda line: line[-1, 2])
+    assert len(legs) == 2
+    for leg, sign in zip(legs, (-1, 1)):
+        np.testing.assert_allclose(leg[-3:, 2], 4.0 * sign)
+        np.testing.assert_allclose(leg[-13:-3, 2], 3.0 * sign)
+
+
 def test_a_stubby_leg_standing_on_the_ground_with_the_others_is_a_leg():
     """A body (radius 1) on two thin legs whose feet stand on the ground (y = -3.2), and a stubby leg as long as it
     is thick whose foot stands there too: under prune it is a bump, but it stands where the kept legs stand, so it

@@ -257,10 +257,11 @@ def _follow(node_layers, copies, start, mirror=None):
     tolerance) or None) it stays there across nodes whose rays pass only beside it (ears on each side of a head), not
     stepping to the one side or the other. Copy k of a split chain is anchored at interval k (front to back) of the
     outermost node crossing exactly ``copies`` intervals and followed from there both ways by nearest depth, so it
-    never jumps to the other part where some node sees the parts merged or an extra part: towards the parent it keeps
-    its depth while an interval holds it (the parts merge with each other and the body there), and past the anchor it
-    never steps into an interval another copy is in (two arms seen one behind the other, where the rays past the
-    front one's wrist hit only the back one: the front arm's copy keeps its depth).
+    never jumps to the other part where some node sees the parts merged or an extra part: towards the parent it is
+    centred in its part while the parts are apart (a splayed leg's middle, not its foot's depth) and keeps its depth
+    while an interval holds it where they are not (they merge with each other and the body there), and past the
+    anchor it never steps into an interval another copy is in (two arms seen one behind the other, where the rays
+    past the front one's wrist hit only the back one: the front arm's copy keeps its depth).
     """
     if copies == 1:
         depths = np.full(len(node_layers), np.nan)
@@ -270,7 +271,7 @@ def _follow(node_layers, copies, start, mirror=None):
     followed = [np.full(len(node_layers), np.nan) for _ in range(copies)]
     for copy, depths in enumerate(followed):
         depths[anchor] = _middle(node_layers[anchor][copy])
-        _track(node_layers, range(anchor - 1, -1, -1), depths[anchor], depths, stay=True)
+        _track(node_layers, range(anchor - 1, -1, -1), depths[anchor], depths, stay=copies)
     for i in range(anchor + 1, len(node_layers)):
         intervals = node_layers[i].tolist()
         held = [next((k for k, (low, high) in enumerate(intervals) if low <= depths[i - 1] <= high), None)
@@ -319,18 +320,19 @@ def _twin_copies(followed, depth):
     return [followed[0], image] if kept == 0 else [image, followed[1]]
 
 
-def _track(node_layers, order, previous, depths, stay=False, mirror=None):
+def _track(node_layers, order, previous, depths, stay=0, mirror=None):
     """Follow a part along its chain: at each node take the interval the previous depth lies in, else the one
     nearest to it (distance to the interval, not to its middle, so a thick neighbour does not steal the track),
-    and centre in it — or, with ``stay``, keep the previous depth while an interval still contains it; on the
-    ``mirror`` plane, keep it where the intervals flank the plane (``_beside``)."""
+    and centre in it — or, with ``stay`` (a chain's copy count), keep the previous depth while an interval still
+    contains it at nodes that do not cross that many parts (where they merge); on the ``mirror`` plane, keep it where
+    the intervals flank the plane (``_beside``)."""
     for i in order:  # plain floats: the intervals are few, and numpy's per-call cost would dominate
         layer = node_layers[i]
         on_plane = mirror is not None and abs(previous - mirror[0]) <= mirror[1]
         if len(layer) and not (on_plane and _beside(layer, *mirror)):
             gap, low, high = min((max(low - previous, 0.0) + max(previous - high, 0.0), low, high)
                                  for low, high in layer.tolist())
-            if not (stay and gap == 0.0):
+            if not (stay and gap == 0.0 and len(layer) != stay):
                 previous = 0.5 * (low + high)
         depths[i] = previous
 
