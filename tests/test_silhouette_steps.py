@@ -171,6 +171,18 @@ def test_a_mirror_pair_of_stubby_branches_stays_where_a_lone_one_goes():
         assert tips_kept(ear(1, 1.34), ear(-1, 0.8), legs=legs, **pair) == [False, False]
 
 
+def test_mirror_twin_arms_whose_chains_end_in_other_corners_of_their_hands_stay_together():
+    """Two arms alike off a chest (radius 1), each sticking out 1.2 times its width (under prune, over pair_prune),
+    one chain running out level, the other turned 14 degrees down into another corner of its hand: neither tip's
+    mirror image lies on the other arm, but within its width of the other's tip. Noise of 0.05% of the size did
+    that to a cartoon man's arms, and both went. Twins alike in reach and width stay together; unlike ones go."""
+    pair = {"mirror": reflect, "pair_prune": 0.74}
+    level, turned = stub((1.0, 0.0), 1.2), stub((-1.0, -0.25), 1.2)
+    assert tips_kept(level, turned, **pair) == [True, True]
+    assert tips_kept(level, stub((-1.0, -0.25), 0.78), **pair) == [False, False]  # reaching 1.2 / 0.78 as far
+    assert tips_kept(level, stub((-1.0, -0.6), 1.2), **pair) == [False, False]  # the image a width away
+
+
 def test_without_a_mirror_plane_two_stubby_branches_alike_in_size_stay_as_a_pair():
     """A hand-made figure's two stubby arms off its chest (radius 1) are never exact mirror images: with
     ``local_pairs`` two spurs over pair_prune (0.74) that stick out about as far and are about as wide both stay,

@@ -212,7 +212,7 @@ def prune_spurs(points, radius, chains, pruning, blobs=None):
                         leaves.append((i, base, outside))
                     break
         if spurs and pruning.mirror is not None:
-            spurs = _unmirrored(spurs, pairable, leaves, points, radius, pruning.mirror)
+            spurs = _unmirrored(spurs, pairable, leaves, points, radius, pruning.mirror, tuning.local_pair)
             spurs = _not_going_on(spurs, chains, points, radius, pruning.mirror, tuning)
         if spurs and pruning.ground is not None:
             spurs = _standing(spurs, pairable, leaves, chains, points, radius, reaching, stood,
@@ -324,13 +324,14 @@ def _round_part_on(ordered, points, radius, blobs, min_reach, round_tip):
     return None
 
 
-def _unmirrored(spurs, pairable, leaves, points, radius, mirror):
+def _unmirrored(spurs, pairable, leaves, points, radius, mirror, most_unlike):
     """The ``spurs`` (chain -> (base, tip)) without a twin: another leaf off the same base (``leaves``: (chain,
     base, its nodes outside the base's disc) each) that stays, with a node whose disc holds the spur tip's mirror
     image. A kept leaf is a twin to every spur. Two ``pairable`` spurs (long enough for limbs when they come in pairs)
-    are twins when each one's image lies on the other, so that two ears each under the threshold stay together,
-    and neither stays for lying on a longer one that goes. The base's own disc covers the body, so a bump whose
-    image falls on it still goes."""
+    are twins when each one's image lies on the other, or, alike in reach and width as ``_local_pairs`` asks
+    (``most_unlike``), within the other's width of its tip (two arms whose chains end in different corners of their
+    hands), so that two ears each under the threshold stay together, and neither stays for lying on a longer one
+    that goes. The base's own disc covers the body, so a bump whose image falls on it still goes."""
     beside = {}
     for chain, base, outside in leaves:
         beside.setdefault(base, []).append((chain, outside))
@@ -342,6 +343,10 @@ def _unmirrored(spurs, pairable, leaves, points, radius, mirror):
     for (i, (base, _)), image in zip(spurs.items(), images):
         nodes, owners = beside.get(base, (np.zeros(0, np.int64), np.zeros(0, np.int64)))
         lying_on[i] = set(owners[np.linalg.norm(points[nodes] - image, axis=1) <= radius[nodes]].tolist()) - {i}
+        if i in pairable:
+            lying_on[i] |= {j for j, (other, ordered, reach, width) in pairable.items() if j != i and other == base
+                            and np.linalg.norm(points[ordered[-1]] - image) <= width
+                            and _unlike(pairable[i][2:], (reach, width)) <= most_unlike}
     return {i: spurs[i] for i, twins in lying_on.items() if not any(
         chain not in spurs or (i in pairable and i in lying_on[chain]) for chain in twins)}
 
@@ -395,7 +400,7 @@ def _local_pairs(dropped, kept, links, points, most_unlike):
                     leaves[a], leaves[b]
                 if not (dropped_a or dropped_b):
                     continue
-                unlike = max(reach_a / reach_b, reach_b / reach_a) * max(width_a / width_b, width_b / width_a)
+                unlike = _unlike((reach_a, width_a), (reach_b, width_b))
                 apart = np.linalg.norm(points[nodes_a[-1]] - points[nodes_b[-1]])
                 if unlike <= most_unlike and apart > max(width_a, width_b):
                     pairs.append((unlike, a, b))
@@ -405,6 +410,11 @@ def _local_pairs(dropped, kept, links, points, most_unlike):
                 used |= {a, b}
                 restored += [list(leaves[k][0][1]) for k in (a, b) if leaves[k][1]]
     return restored
+
+
+def _unlike(a, b):
+    """How unlike two branches ((reach, width) each) are: their reach ratio times their width ratio, 1 or more."""
+    return max(a[0] / b[0], b[0] / a[0]) * max(a[1] / b[1], b[1] / a[1])
 
 
 def rooted_chains(points, keys, chains, radius, tuning):

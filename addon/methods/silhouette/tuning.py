@@ -31,7 +31,8 @@ class Tuning(JointTuning, MirrorTuning):
     pair_prune: float = tuned(0.55, "two twin branches sticking out more than this share of prune times their width "
                                     "are limbs (a dog's ears)")
     local_pair: float = tuned(1.5, "without a mirror plane, two branches off one base pair when their reach ratio "
-                                   "times width ratio is at most this")
+                                   "times width ratio is at most this; with one, twins this alike pair when their "
+                                   "tips' images miss each other by less than a width")
     straight_on: float = tuned(30.0, "degrees: a spur on the mirror plane going on from a chain on it through its "
                                      "base within this turn stays (a head on its neck) ...")
     straight_reach: float = tuned(0.5, "... when it reaches beyond the base's disc by this share of its radius")
