@@ -836,6 +836,18 @@ def test_copies_of_a_split_chain_keep_their_own_parts_to_the_end():
     np.testing.assert_allclose(tips, [0.5, 3.5])
 
 
+def test_fingers_seen_edge_on_end_each_at_its_own_depth_not_in_the_longest_one():
+    """Four fingers seen edge-on (depths 0.5, 2.5, 4.5, 6.5), and past the shorter ones' tips the rays hit only the
+    longest finger, curling a little off its line (3.05 to 3.6): that finger's copy, the nearest, steps into it and
+    the others keep their depths. Every copy stepping in ran three fingers' tips into one point in the fourth (a
+    trooper's hands, a cow's ears ending between them)."""
+    node_layers = ([layers((0, 7))] * 4 + [layers((0, 1), (2, 3), (4, 5), (6, 7))] * 8
+                   + [layers((3.05, 3.6))] * 3)
+    _, placed = placed_along_x(node_layers)
+    tips = sorted(line[-1, 2] for line, _, _ in placed)
+    np.testing.assert_allclose(tips, [0.5, 3.325, 4.5, 6.5])
+
+
 def test_split_legs_run_down_the_middle_of_each_leg_not_at_their_feet_depth():
     """A splayed leg pair seen from the side: merged with the body, then each leg apart (depths 2 to 4 and their
     mirror), ending in a foot turned out (3.5 to 4.5). Each leg's copy runs down the middle of its leg wherever the

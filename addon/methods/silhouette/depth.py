@@ -261,7 +261,9 @@ def _follow(node_layers, copies, start, mirror=None):
     centred in its part while the parts are apart (a splayed leg's middle, not its foot's depth) and keeps its depth
     while an interval holds it where they are not (they merge with each other and the body there), and past the
     anchor it never steps into an interval another copy is in (two arms seen one behind the other, where the rays
-    past the front one's wrist hit only the back one: the front arm's copy keeps its depth).
+    past the front one's wrist hit only the back one: the front arm's copy keeps its depth), nor into one another
+    copy nearer to it steps into (past the shorter fingers' tips the longest finger's copy goes on; the others keep
+    their depths rather than all running into it).
     """
     if copies == 1:
         depths = np.full(len(node_layers), np.nan)
@@ -276,14 +278,18 @@ def _follow(node_layers, copies, start, mirror=None):
         intervals = node_layers[i].tolist()
         held = [next((k for k, (low, high) in enumerate(intervals) if low <= depths[i - 1] <= high), None)
                 for depths in followed]
-        for copy, depths in enumerate(followed):
-            previous = depths[i - 1]
-            free = [(max(low - previous, 0.0) + max(previous - high, 0.0), low, high)
-                    for k, (low, high) in enumerate(intervals) if k not in held[:copy] + held[copy + 1:]]
-            if held[copy] is None and free:
-                _, low, high = min(free)
-                previous = 0.5 * (low + high)
-            depths[i] = previous
+        for depths in followed:
+            depths[i] = depths[i - 1]
+        taken = set(held) - {None}
+        steps = sorted((max(low - depths[i - 1], 0.0) + max(depths[i - 1] - high, 0.0), copy, k)
+                       for copy, depths in enumerate(followed) if held[copy] is None
+                       for k, (low, high) in enumerate(intervals) if k not in taken)
+        moved = set()
+        for _, copy, k in steps:  # the nearest copy steps into a free interval; one copy per interval
+            if copy not in moved and k not in taken:
+                followed[copy][i] = 0.5 * (intervals[k][0] + intervals[k][1])
+                moved.add(copy)
+                taken.add(k)
     return followed
 
 
