@@ -343,10 +343,11 @@ def _unmirrored(spurs, pairable, leaves, points, radius, mirror, most_unlike):
     for (i, (base, _)), image in zip(spurs.items(), images):
         nodes, owners = beside.get(base, (np.zeros(0, np.int64), np.zeros(0, np.int64)))
         lying_on[i] = set(owners[np.linalg.norm(points[nodes] - image, axis=1) <= radius[nodes]].tolist()) - {i}
-        if i in pairable:
-            lying_on[i] |= {j for j, (other, ordered, reach, width) in pairable.items() if j != i and other == base
-                            and np.linalg.norm(points[ordered[-1]] - image) <= width
-                            and _unlike(pairable[i][2:], (reach, width)) <= most_unlike}
+        if i in pairable:  # twins alike whose images miss each other's tips by less than a width
+            own = pairable[i][2:]  # (reach, width)
+            lying_on[i] |= {j for j, (other, ordered, *size) in pairable.items() if j != i and other == base
+                            and np.linalg.norm(points[ordered[-1]] - image) <= size[1]
+                            and _unlike(own, size) <= most_unlike}
     return {i: spurs[i] for i, twins in lying_on.items() if not any(
         chain not in spurs or (i in pairable and i in lying_on[chain]) for chain in twins)}
 
