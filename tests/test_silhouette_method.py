@@ -17,7 +17,7 @@ from rigger.methods.silhouette.tuning import Tuning
 
 import rig_checks
 from conftest import shared_path
-from rigdata import chamfer_distance, load_obj
+from rigdata import chamfer_distance, load_ground_truth, load_obj
 
 CHARACTERS = ("humanoid", "humanoid_hips", "quadruped", "octopus", "tree", "snake")
 
@@ -767,6 +767,18 @@ def test_twins_of_a_rough_mirror_body_mirror_across_where_the_mesh_mirrors_best(
     if model.startswith("gt/"):
         plane = (found.axis, stage.reflect(np.zeros(3))[found.axis] / 2)
         assert max(rig_checks.twin_mismatches(skeleton, size, plane).values()) < 0.005
+
+
+def test_brainstem_s_straight_legs_get_knees():
+    """BrainStem's legs turn below the hip and at the ankle; those joints used up the leg's bones and left thigh and
+    shin one bone 0.26 of the size long, so the leg could not bend at the knee. Each artist knee now has a joint of
+    Rigger's within 0.02 of the size."""
+    vertices, triangles, rig = load_ground_truth(shared_path("models", "gt", "BrainStem"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    size = np.ptp(vertices, axis=0).max()
+    joints = np.vstack([skeleton.heads, skeleton.tails])
+    for knee in ("joint11", "joint15"):
+        assert np.linalg.norm(joints - rig.positions[rig.names.index(knee)], axis=1).min() < 0.02 * size
 
 
 def test_a_side_view_cut_out_gets_no_sides():

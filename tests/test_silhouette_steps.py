@@ -458,6 +458,18 @@ def test_corners_get_joints_even_beyond_the_limit():
     assert np.linalg.norm(np.diff(joints, axis=0), axis=1).min() >= 0.035 - 1e-9  # no stub bones
 
 
+def test_a_straight_thigh_and_shin_between_corners_still_get_a_knee():
+    """A thin leg that bends at the hip, again below it and at the ankle: those joints use up its four bones and leave
+    thigh and shin one straight piece 2.5 bone lengths long. It is cut in two, a knee at its middle, not one bone
+    that cannot bend where the leg does."""
+    leg = np.array([[0, 0, 0], [0.06, 0, 0], [0.09, -0.03, 0], [0.09, -0.28, 0], [0.13, -0.28, 0]], dtype=float)
+    joints = chain_joints(leg, cutting(max_bones=4), widths=np.full(len(leg), 0.005))
+    for corner in leg:
+        assert np.linalg.norm(joints - corner, axis=1).min() < 1e-9
+    assert np.linalg.norm(joints - [0.09, -0.155, 0], axis=1).min() < 1e-9
+    assert np.linalg.norm(np.diff(joints, axis=0), axis=1).max() <= 2 * 0.1 + 1e-9
+
+
 def wave(length, amplitude, waves, points=401):
     line = straight(length, points)
     line[:, 1] = amplitude * np.sin(np.linspace(0.0, 2 * np.pi * waves, points))

@@ -13,6 +13,9 @@ class JointTuning(TuningTable):
     """The tuned numbers of cutting chains into bones (in bone lengths unless said otherwise)."""
 
     longest_bone: float = tuned(3.0, "no bone is longer, whatever max_bones says: a straight leg still gets a knee")
+    longest_share: float = tuned(0.5, "nor, beyond its base's disc, longer than this share of its chain unless that "
+                                      "asks for one bone: the joints a leg needs at hip and ankle leave thigh and "
+                                      "shin no single bone")
     joint_spacing: float = tuned(0.35, "joint candidates closer than this to a joint already placed are dropped")
     leaf_two_bones: float = tuned(0.5, "a leaf chain this long gets two bones, as the artists' leaf chains have")
     disc_exit: float = tuned(0.3, "the joint where a chain leaves its branch point's disc is this far along at least")
@@ -43,9 +46,10 @@ def chain_joints(line, cutting, widths=None, leaf=False, min_bones=0):
     than the bone angle gets a joint (an elbow, a knee), and so does every bend that would take a straight bone out
     of the part, the sharpest first where two are close. The chain has one bone per bone length begun (the artist
     rigs give a chain about one bone more than length / bone length: a hand, a foot), at most ``max_bones`` unless
-    those joints need more, a bone would exceed ``longest_bone``, or ``min_bones`` (its twin's count) asks for more.
+    those joints need more, leave a piece between them whose bones would be longer than ``longest_share`` of the
+    chain, a bone would exceed ``longest_bone``, or ``min_bones`` (its twin's count) asks for more.
     Spare bones go to the gentler bends, from the start: they place joints but add none (every wiggle of a feathered
-    wing would be a bone). The pieces between joints are cut evenly. A ``leaf`` chain (a finger, a toe) long enough
+    wing would be a bone), and take none a long piece needs. The pieces between joints are cut evenly. A ``leaf`` chain (a finger, a toe) long enough
     gets at least two bones.
     """
     tuning, bone_length = cutting.tuning, cutting.bone_length
@@ -58,16 +62,16 @@ def chain_joints(line, cutting, widths=None, leaf=False, min_bones=0):
         wanted = min(wanted, cutting.max_bones)
     wanted = max(wanted, min_bones)
     stops, places = [0.0, arc[-1]], [line[0], line[-1]]
-    candidates, needed = _candidate_stops(line, arc, widths, cutting)
-    for k, (at, place) in enumerate(zip(candidates, point_at(line, arc, np.array(candidates, dtype=float)))):
-        if k >= needed and len(stops) > wanted:
-            break  # no bone to spare for this bend (nor for the gentler ones after it)
-        if min(np.linalg.norm(place - other) for other in places) >= tuning.joint_spacing * bone_length:
-            stops.append(at)
-            places.append(place)
+    candidates, needed, inside = _candidate_stops(line, arc, widths, cutting)
+    points = point_at(line, arc, np.array(candidates, dtype=float))
+    spacing = tuning.joint_spacing * bone_length
+    _place(stops, places, candidates[:needed], points[:needed], spacing)
+    uneven = (wanted, max(tuning.longest_share, 1.0 / wanted) * arc[-1], inside)
+    extra = _uneven(stops, *uneven)  # a leg's thigh and shin, left one piece
+    _place(stops, places, candidates[needed:], points[needed:], spacing, spare=uneven)
     stops.sort()
     lengths = np.diff(stops)
-    counts = _share(lengths, wanted)
+    counts = _share(lengths, wanted + extra)
     counts = np.maximum(counts, np.ceil(lengths / (tuning.longest_bone * bone_length)).astype(int))
     at = [0.0]
     for start, piece, count in zip(stops[:-1], lengths, counts):
@@ -76,9 +80,10 @@ def chain_joints(line, cutting, widths=None, leaf=False, min_bones=0):
 
 
 def _candidate_stops(line, arc, widths, cutting):
-    """Arc lengths where a joint belongs, most important first, and how many of them are needed: leaving the branch
-    point's disc, corners by how sharply they turn and the bends a straight bone would leave the part at (its axis
-    farther than a half-width away); then, for the bones to spare, the bends it would leave the part's middle at."""
+    """Arc lengths where a joint belongs, most important first, how many of them are needed, and where the chain
+    leaves its branch point's disc (0 when it gets no joint there). Needed: leaving that disc, corners by how
+    sharply they turn and the bends a straight bone would leave the part at (its axis farther than a half-width
+    away); then, for the bones to spare, the bends it would leave the part's middle at."""
     tuning, bone_length = cutting.tuning, cutting.bone_length
     found = []
     reach = np.linalg.norm(line - line[0], axis=1)
@@ -86,15 +91,16 @@ def _candidate_stops(line, arc, widths, cutting):
     if len(outside) and arc[outside[0]] >= tuning.disc_exit * bone_length and (
             arc[-1] - arc[outside[0]] >= tuning.disc_exit_rest * bone_length):
         found.append(arc[outside[0]])
+    inside = found[0] if found else 0.0
     turns = _turns(line, np.full(len(line), tuning.corner_tolerance * bone_length))
     found += [arc[i] for i, angle in sorted(turns, key=lambda item: -item[1]) if angle > cutting.bone_angle]
     if not widths.any():
-        return found, len(found)
+        return found, len(found), inside
     found += [arc[i] for i in _simplified(line, np.maximum(widths, 1e-12 * bone_length))[1:-1]]
     needed = len(found)
     found += [arc[i] for i in _narrowings(arc, widths, tuning.narrowing, bone_length)]
     found += [arc[i] for i in _simplified(line, np.maximum(tuning.spare_bend * widths, 1e-12 * bone_length))[1:-1]]
-    return found, needed
+    return found, needed, inside
 
 
 def _narrowings(arc, widths, ratio, reach):
@@ -116,6 +122,30 @@ def _narrowings(arc, widths, ratio, reach):
         if before and after and widths[i] <= ratio * min(max(before), max(after)):
             found.append((widths[i] / min(max(before), max(after)), i))
     return [i for _, i in sorted(found)]
+
+
+def _place(stops, places, candidates, points, spacing, spare=None):
+    """Add the ``candidates`` (arc lengths, at ``points``) in order to ``stops`` and ``places``, each not within
+    ``spacing`` of a joint placed. With ``spare`` (:func:`_uneven`'s bones, longest and inside), until the stops cut
+    the chain into that many pieces, and none that leaves a piece those bones would cut into bones too long."""
+    for at, place in zip(candidates, points):
+        if spare is not None and len(stops) > spare[0]:
+            return  # no bone to spare for this bend (nor for the gentler ones after it)
+        if min(np.linalg.norm(place - other) for other in places) < spacing or (
+                spare is not None and _uneven(stops + [at], *spare)):
+            continue
+        stops.append(at)
+        places.append(place)
+
+
+def _uneven(stops, wanted, longest, inside):
+    """Bones to add to ``wanted`` so that no piece between these ``stops`` (arc lengths) is cut into bones longer
+    than ``longest`` when the bones are shared over the pieces; the piece inside the branch point's disc (up to
+    ``inside``) does not count: a hip's connector in the pelvis needs no joint of its own."""
+    stops = np.sort(stops)
+    lengths = np.diff(stops)
+    over = np.ceil(lengths / longest - 1e-9) - _share(lengths, wanted)
+    return int(np.maximum(over[stops[:-1] >= inside], 0).sum())
 
 
 def _share(lengths, total):
