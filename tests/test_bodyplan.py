@@ -9,7 +9,7 @@ import rigger
 from characters import load_character
 from conftest import shared_path
 from meshes import box, combine, cylinder
-from rigdata import load_obj
+from rigdata import load_ground_truth, load_obj
 from rigger import samples
 from rigger.core import rooting
 from rigger.core.body import read_body
@@ -585,6 +585,23 @@ def test_how_finely_a_spine_is_cut_does_not_decide_a_legless_plan():
                        [index[skeleton.parents[b]] if skeleton.parents[b] >= 0 else -1 for b in keep])
     plan, _ = recognise(coarser, (vertices, triangles), plane=skeleton.stages.get("mirror_plane"), prefer_up=up)
     assert plan.kind == "bird"
+
+
+def test_a_wing_s_bones_in_the_body_are_its_shoulder():
+    """The penguin's flipper chains start on its spine: their first bone, inside the chest, was a `wing` bone, so
+    raising "the wing" turned the flipper about the chest's middle and carried the chest with it. Bones up to where
+    the wing leaves the body are its shoulder, as an arm's are; the wing's own bones start where the artist's do."""
+    vertices, triangles, rig = load_ground_truth(shared_path("models", "gt", "rignet_8184"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert skeleton.body_plan.kind == "bird"
+    size = np.ptp(vertices, axis=0).max()
+    for side, artist in (("L", "joint_7"), ("R", "joint_0")):
+        shoulders = [bone for bone, role in enumerate(skeleton.roles) if role.role == "shoulder" and role.side == side]
+        wings = [bone for bone, role in enumerate(skeleton.roles) if role.role == "wing" and role.side == side]
+        assert shoulders and wings
+        first = min(wings, key=lambda bone: abs(skeleton.heads[bone, 0]))
+        assert skeleton.parents[first] in shoulders
+        assert np.linalg.norm(skeleton.heads[first] - rig.positions[rig.names.index(artist)]) < 0.02 * size
 
 
 def test_a_knee_bends_below_where_the_thigh_begins():

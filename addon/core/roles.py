@@ -11,8 +11,8 @@ more); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up to w
 upper_arm, forearm and hand by shares of the rest of its reach where the artists' humanoids have an elbow and a
 wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the one that leaves earliest
 and points most away the thumb, the others index, middle, ring and pinky in order across the hand. Twins are cut at
-the same joints (on their mirror-averaged points). Wings, fins, ears, tails and jaws take their part's role for
-every bone. A body plan that is ``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when
+the same joints (on their mirror-averaged points). A wing: shoulder up to where it leaves the body, as an arm's,
+then wing. Fins, ears, tails and jaws take their part's role for every bone. A body plan that is ``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when
 a limb's bones have them, else the side of the mirror plane, left being the character's left when its front is known
 (Blender's +X for a character facing -Y).
 
@@ -176,6 +176,10 @@ def assign_roles(skeleton, body, layout, paths, tuning=RoleTuning()):
             _leg(body, limb, path.points, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
         elif part == "arm":
             _arm(body, limb, path, tuning, lambda nodes, names: put(nodes, names, side))
+        elif part == "wing":  # its bones in the body are a shoulder, as an arm's: the wing turns where it leaves
+            arc = arc_lengths(path.points)
+            shoulder = min(_shoulder(path.radius, arc, arc[-1] + path.reach, tuning), len(limb.main) - 1)
+            put(list(limb.main)[:shoulder + 1], ["shoulder"] * shoulder, side)
         for nodes in _paths(limb):
             put(nodes, [part] * (len(nodes) - 1), side)
     _mirror_twin_roles(roles, body, segment_bone)
