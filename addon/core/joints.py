@@ -49,8 +49,8 @@ def chain_joints(line, cutting, widths=None, leaf=False, min_bones=0):
     those joints need more, leave a piece between them whose bones would be longer than ``longest_share`` of the
     chain, a bone would exceed ``longest_bone``, or ``min_bones`` (its twin's count) asks for more.
     Spare bones go to the gentler bends, from the start: they place joints but add none (every wiggle of a feathered
-    wing would be a bone), and take none a long piece needs. The pieces between joints are cut evenly. A ``leaf`` chain (a finger, a toe) long enough
-    gets at least two bones.
+    wing would be a bone), and take none a long piece needs. The pieces between joints are cut evenly. A ``leaf``
+    chain (a finger, a toe) long enough gets at least two bones.
     """
     tuning, bone_length = cutting.tuning, cutting.bone_length
     widths = np.zeros(len(line)) if widths is None else widths

@@ -12,9 +12,9 @@ upper_arm, forearm and hand by shares of the rest of its reach where the artists
 wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the one that leaves earliest
 and points most away the thumb, the others index, middle, ring and pinky in order across the hand. Twins are cut at
 the same joints (on their mirror-averaged points). A wing: shoulder up to where it leaves the body, as an arm's,
-then wing. Fins, ears, tails and jaws take their part's role for every bone. A body plan that is ``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when
-a limb's bones have them, else the side of the mirror plane, left being the character's left when its front is known
-(Blender's +X for a character facing -Y).
+then wing. Fins, ears, tails and jaws take their part's role for every bone. A body plan that is ``other`` gives
+every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when a limb's bones have them, else the side of the
+mirror plane, left being the character's left when its front is known (Blender's +X for a character facing -Y).
 
 Roles are whole bones; named joints are points (:func:`named_joints`: where each role begins, ``{(role, side,
 digit): point}``), placed along the chains where the artists' rigs have them rather than at the nearest bone end
