@@ -621,6 +621,22 @@ def test_a_knee_bends_below_where_the_thigh_begins():
         assert rise @ up > np.cos(np.radians(30)) * np.linalg.norm(rise)  # the thigh stands up from the knee
 
 
+def test_an_arm_turning_at_its_deltoid_has_its_elbow_farther_down():
+    """The ogre's arm turns by 26 degrees under its deltoid, a fifth of the way from the shoulder joint to the hand's
+    end, and by 25 at its elbow, a third of the way: the sharper was taken for the elbow, and bending the forearm
+    folded the biceps. A bend counts the less the farther it lies from where an elbow belongs."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "ogre.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    joints = named_joints(skeleton)
+    for side in ("L", "R"):
+        shoulder, tip = joints[("upper_arm", side, None)], landmarks(skeleton)[("hand_tip", side, None)]
+        for elbow in (joints[("forearm", side, None)],
+                      *[skeleton.heads[bone] for bone, role in enumerate(skeleton.roles)
+                        if role.role == "forearm" and role.side == side and role.index == 0]):
+            along = np.linalg.norm(elbow - shoulder) / np.linalg.norm(tip - shoulder)
+            assert 0.3 < along < 0.5
+
+
 def clean_and_noisy(name, seed):
     """((vertices, noisy vertices), triangles) of a ``../shared`` artist-rigged model as Blender imports it (Z up),
     the noise a twentieth of a percent of its size per vertex position (seams stay closed), seeded."""

@@ -510,7 +510,8 @@ def _digits(body, fingers, wrist, palm, elbow):
 def _pick(points, low, high, share, tuning, start=0, end=None, total=None, bends_only=False):
     """The joint in [low, high] for a joint at ``share`` of the way (by length) from joint ``start`` to joint ``end``
     (or to ``total`` past ``start``): the sharpest bend (:func:`_bend`, seen from ``start`` and ``end``) within
-    ``bend_window`` of it when one turns by ``bend`` or more, else the nearest (None with ``bends_only``)."""
+    ``bend_window`` of it when one turns by ``bend`` or more (the one :func:`_bend_weight` weighs most), else the
+    nearest (None with ``bends_only``)."""
     end = len(points) - 1 if end is None else end
     arc = arc_lengths(points)
     span = (arc[end] - arc[start]) if total is None else total
@@ -520,9 +521,10 @@ def _pick(points, low, high, share, tuning, start=0, end=None, total=None, bends
     if not len(candidates):
         return None if bends_only else int(low)
     turns = np.array([_bend(points[i], points[start], points[end]) for i in candidates])
-    bent = (np.abs(at[candidates] - share) <= tuning.bend_window) & (turns >= tuning.bend)
+    off = np.abs(at[candidates] - share)
+    bent = (off <= tuning.bend_window) & (turns >= tuning.bend)
     if bent.any():
-        return int(candidates[bent][np.argmax(turns[bent])])
+        return int(candidates[bent][np.argmax(_bend_weight(turns[bent], off[bent], tuning))])
     return None if bends_only else int(candidates[np.argmin(np.abs(at[candidates] - share))])
 
 
@@ -864,15 +866,23 @@ def _arm_places(body, limb, path, arc, tuning):
 def _bent(points, arc, start, middle, end, length, tuning):
     """Arc position of a limb's middle joint (an elbow, a knee) between ``start`` and ``end``: the joint within
     ``bend_window`` of the limb's ``length`` from ``middle`` where the limb bends most (:func:`_bend`, seen from
-    ``start`` and ``end``), when it bends by ``bend`` or more, else ``middle``."""
+    ``start`` and ``end``, :func:`_bend_weight`), when it bends by ``bend`` or more, else ``middle``."""
     first, last = _along(points, arc, start), _along(points, arc, end)
-    best, turn = middle, tuning.bend
+    best, weight = middle, 0.0
     for i in range(1, len(points) - 1):
-        if start < arc[i] < end and abs(arc[i] - middle) <= tuning.bend_window * length:
+        off = abs(arc[i] - middle) / max(length, 1e-300)
+        if start < arc[i] < end and off <= tuning.bend_window:
             angle = _bend(points[i], first, last)
-            if angle >= turn:
-                best, turn = float(arc[i]), angle
+            if angle >= tuning.bend and _bend_weight(angle, off, tuning) > weight:
+                best, weight = float(arc[i]), _bend_weight(angle, off, tuning)
     return best
+
+
+def _bend_weight(turn, off, tuning):
+    """How much a bend turning by ``turn`` degrees ``off`` (a share of the limb's length) from where an elbow or a
+    knee belongs counts as that joint: its turn, halved at ``bend_window``'s edge (an ogre's arm turns as much
+    under its deltoid as at its elbow, which lies nearer the elbow's share)."""
+    return turn / (1.0 + off / tuning.bend_window)
 
 
 def _along(points, arc, at):
