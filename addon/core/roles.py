@@ -509,8 +509,8 @@ def _digits(body, fingers, wrist, palm, elbow):
 
 def _pick(points, low, high, share, tuning, start=0, end=None, total=None, bends_only=False):
     """The joint in [low, high] for a joint at ``share`` of the way (by length) from joint ``start`` to joint ``end``
-    (or to ``total`` past ``start``): the sharpest bend (:func:`_bend`, seen from ``start`` and ``end``) within
-    ``bend_window`` of it when one turns by ``bend`` or more (the one :func:`_bend_weight` weighs most), else the
+    (or to ``total`` past ``start``): of the joints within ``bend_window`` of it where the limb turns by ``bend``
+    or more (:func:`_bend`, seen from ``start`` and ``end``), the one :func:`_bend_weight` weighs most; else the
     nearest (None with ``bends_only``)."""
     end = len(points) - 1 if end is None else end
     arc = arc_lengths(points)
@@ -864,17 +864,18 @@ def _arm_places(body, limb, path, arc, tuning):
 
 
 def _bent(points, arc, start, middle, end, length, tuning):
-    """Arc position of a limb's middle joint (an elbow, a knee) between ``start`` and ``end``: the joint within
-    ``bend_window`` of the limb's ``length`` from ``middle`` where the limb bends most (:func:`_bend`, seen from
-    ``start`` and ``end``, :func:`_bend_weight`), when it bends by ``bend`` or more, else ``middle``."""
+    """Arc position of a limb's middle joint (an elbow, a knee) between ``start`` and ``end``: of the joints within
+    ``bend_window`` of the limb's ``length`` from ``middle`` where it turns by ``bend`` or more (:func:`_bend`, seen
+    from ``start`` and ``end``), the one :func:`_bend_weight` weighs most; else ``middle``."""
     first, last = _along(points, arc, start), _along(points, arc, end)
     best, weight = middle, 0.0
     for i in range(1, len(points) - 1):
         off = abs(arc[i] - middle) / max(length, 1e-300)
         if start < arc[i] < end and off <= tuning.bend_window:
             angle = _bend(points[i], first, last)
-            if angle >= tuning.bend and _bend_weight(angle, off, tuning) > weight:
-                best, weight = float(arc[i]), _bend_weight(angle, off, tuning)
+            counts = _bend_weight(angle, off, tuning)
+            if angle >= tuning.bend and counts > weight:
+                best, weight = float(arc[i]), counts
     return best
 
 
