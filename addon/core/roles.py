@@ -177,8 +177,7 @@ def assign_roles(skeleton, body, layout, paths, tuning=RoleTuning()):
         elif part == "arm":
             _arm(body, limb, path, tuning, lambda nodes, names: put(nodes, names, side))
         elif part == "wing":  # its bones in the body are a shoulder, as an arm's: the wing turns where it leaves
-            arc = arc_lengths(path.points)
-            shoulder = min(_shoulder(path.radius, arc, arc[-1] + path.reach, tuning), len(limb.main) - 1)
+            shoulder = _shoulder(path, arc_lengths(path.points), tuning)
             put(list(limb.main)[:shoulder + 1], ["shoulder"] * shoulder, side)
         for nodes in _paths(limb):
             put(nodes, [part] * (len(nodes) - 1), side)
@@ -403,12 +402,11 @@ def _arm(body, limb, path, tuning, put):
     arc = arc_lengths(points)
     total = arc[-1] + path.reach
     middle = 0.5 * (arc[1:] + arc[:-1])
-    shoulder = _shoulder(path.radius, arc, total, tuning)
-    rest = total - arc[min(shoulder, last)]  # from the shoulder joint on
-    elbow, wrist = (int(np.searchsorted(middle, arc[min(shoulder, last)] + share * rest))
+    shoulder = _shoulder(path, arc, tuning)
+    rest = total - arc[shoulder]  # from the shoulder joint on
+    elbow, wrist = (int(np.searchsorted(middle, arc[shoulder] + share * rest))
                     for share in (tuning.elbow_at, tuning.wrist_at))
-    bent = _pick(points, shoulder + 1, wrist - 1, tuning.elbow_at, tuning, min(shoulder, last), last, rest,
-                 bends_only=True)
+    bent = _pick(points, shoulder + 1, wrist - 1, tuning.elbow_at, tuning, shoulder, last, rest, bends_only=True)
     elbow = elbow if bent is None else bent
     branches = _paths(limb)[1:]
     forks = sorted({_fork(branch, nodes) for branch in branches})
@@ -426,11 +424,13 @@ def _arm(body, limb, path, tuning, put):
         put(finger, [("finger", digit)] * (len(finger) - 1))
 
 
-def _shoulder(radius, arc, total, tuning):
-    """Index of an arm's shoulder joint (of the joints with mesh half-thickness ``radius`` at arc lengths ``arc``,
-    reaching ``total``): its first joint where the mesh is about as thin as along the arm (``shoulder_thickness``
-    times the median half-thickness of its joints between ``arm_from`` and ``arm_to`` of its reach): the arm has
-    left the torso there. Else the joint where the bones pass ``shoulder_at`` of the reach."""
+def _shoulder(path, arc, tuning):
+    """Index of an arm's (a wing's) shoulder joint along its ``path`` (:func:`twin_paths`; its joints at arc lengths
+    ``arc``, the mesh's half-thickness ``radius`` there, its ``reach`` beyond the last): its first joint where the
+    mesh is about as thin as along the arm (``shoulder_thickness`` times the median half-thickness of its joints
+    between ``arm_from`` and ``arm_to`` of its reach): the arm has left the torso there. Else the joint where the
+    bones pass ``shoulder_at`` of the reach. Never past the last joint."""
+    radius, total = path.radius, arc[-1] + path.reach
     middle = 0.5 * (arc[1:] + arc[:-1])
     share = arc / max(total, 1e-300)
     along = radius[(share >= tuning.arm_from) & (share <= tuning.arm_to)]
@@ -852,7 +852,7 @@ def _arm_places(body, limb, path, arc, tuning):
     the wrist no farther than where the fingers fork)."""
     nodes, points = list(limb.main), path.points
     total = arc[-1] + path.reach
-    shoulder = float(arc[min(_shoulder(path.radius, arc, total, tuning), len(nodes) - 1)])
+    shoulder = float(arc[_shoulder(path, arc, tuning)])
     rest = total - shoulder
     elbow, wrist = (shoulder + share * rest for share in (tuning.elbow_at, tuning.wrist_at))
     elbow = _bent(points, arc, shoulder, elbow, wrist, rest, tuning)
