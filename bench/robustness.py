@@ -7,8 +7,9 @@ each. Per noisy rig: whether the body plan is the same, the change in bone count
 Chamfer distance between the clean and the noisy skeletons' bone samples, CD-B2B, in units of size) and, on the
 artist-rigged models, how much farther the joints lie from the artist's (CD-J2J). The RigNet models are also
 rigged as RigNet remeshed them (``NAME_remesh.obj``, the same shape in other triangles): the same measures between
-the two rigs. Writes robustness.md, robustness.png and robustness.json to bench/results (out/robustness with
---models).
+the two rigs. Also per rig: how many bones bridge twin parts, lying across the mirror plane with both ends well off
+it (one hip's bone to the other hip, one ear's tip to the other's), a defect whatever the noise. Writes
+robustness.md, robustness.png and robustness.json to bench/results (out/robustness with --models).
 
 No target yet: this measures a weakness found by hand, for the work that fixes it.
 """
@@ -30,6 +31,7 @@ from bodyplan import MODELS, load, model_path  # noqa: E402
 SIGMAS = (0.0005, 0.001, 0.0025)  # noise standard deviations, shares of the size: 0.1% of a 2 m figure is 2 mm
 SEEDS = (0, 1, 2, 3)  # 136 noisy rigs per noise level over the 34 models
 MOVED = 0.01  # a noisy skeleton whose CD-B2B to the clean one is above this (share of size) has visibly moved
+BRIDGE = 0.03  # a bone across the mirror plane with both ends farther than this off it (share of size) bridges twins
 
 
 def noisy(vertices, sigma, seed):
@@ -41,13 +43,24 @@ def noisy(vertices, sigma, seed):
 
 
 def rigged(vertices, triangles, normalisation, truth, params):
-    """(plan kind, bones, unit bones' joints and samples, CD-J2J to the artist's or None) of Rigger on a mesh, with
-    the method parameters ``params``."""
+    """(plan kind, bones, unit bones' joints and samples, CD-J2J to the artist's or None, bridges) of Rigger on a
+    mesh, with the method parameters ``params``."""
     skeleton = rigger.rig_mesh(vertices, triangles, **params)
     bones = rigdata.Bones.of(skeleton).mapped(normalisation)
     joints, samples = bones.joints(), bones.samples()
     to_artist = None if truth is None else rigdata.skeleton_distances(joints, samples, *truth)["cd_j2j"]
-    return skeleton.body_plan.kind, len(bones), joints, samples, to_artist
+    return (skeleton.body_plan.kind, len(bones), joints, samples, to_artist,
+            bridges(skeleton, BRIDGE / normalisation.scale))
+
+
+def bridges(skeleton, distance):
+    """How many of ``skeleton``'s bones lie across its mirror plane with head and tail both farther than
+    ``distance`` (mesh units) off it (0 without a plane)."""
+    plane = skeleton.stages.get("mirror_plane")
+    if plane is None:
+        return 0
+    head, tail = skeleton.heads @ plane.normal - plane.offset, skeleton.tails @ plane.normal - plane.offset
+    return int(np.sum((head * tail < 0) & (np.minimum(abs(head), abs(tail)) > distance)))
 
 
 def measure(name, sigmas=SIGMAS, seeds=SEEDS, params=None):
@@ -60,22 +73,22 @@ def measure(name, sigmas=SIGMAS, seeds=SEEDS, params=None):
         artist = rig.bones().mapped(normalisation)
         truth = (artist.joints(), artist.samples())
     size = 1.0 / normalisation.scale
-    kind, count, joints, samples, to_artist = rigged(vertices, triangles, normalisation, truth, params)
+    kind, count, joints, samples, to_artist, bridged = rigged(vertices, triangles, normalisation, truth, params)
     record = {"model": name, "label": MODELS[name][0], "plan": kind, "bones": count, "cd_j2j": to_artist,
-              "noisy": []}
+              "bridges": bridged, "noisy": []}
     remeshed = model_path(name) / f"{name}_remesh.obj"
     if remeshed.is_file():
         other, other_triangles = rigdata.load_obj(remeshed)
-        r_kind, r_count, r_joints, r_samples, r_to_artist = rigged(other @ turn.T, other_triangles.astype(np.int32),
+        r_kind, r_count, r_joints, r_samples, r_to_artist, _ = rigged(other @ turn.T, other_triangles.astype(np.int32),
                                                                    normalisation, truth, params)
         record["remeshed"] = {"vertices": [len(vertices), len(other)], "plan": r_kind, "bones": r_count,
                               "moved": rigdata.chamfer_distance(samples, r_samples), "cd_j2j": r_to_artist}
     for sigma in sigmas:
         for seed in seeds:
-            n_kind, n_count, n_joints, n_samples, n_to_artist = rigged(
+            n_kind, n_count, n_joints, n_samples, n_to_artist, n_bridged = rigged(
                 noisy(vertices, sigma * size, seed), triangles, normalisation, truth, params)
             record["noisy"].append({
-                "sigma": sigma, "seed": seed, "plan": n_kind, "bones": n_count,
+                "sigma": sigma, "seed": seed, "plan": n_kind, "bones": n_count, "bridges": n_bridged,
                 "moved": rigdata.chamfer_distance(samples, n_samples),
                 "joints_moved": rigdata.chamfer_distance(joints, n_joints),
                 "cd_j2j": n_to_artist})
@@ -85,7 +98,8 @@ def measure(name, sigmas=SIGMAS, seeds=SEEDS, params=None):
 def summarised(records, sigmas):
     """Per noise level: the share of noisy rigs keeping the plan, the median and largest CD-B2B to the clean
     skeleton, the share that moved visibly, the mean relative change in bone count and, on the artist-rigged
-    models, the mean CD-J2J to the artist's joints clean and noisy."""
+    models, the mean CD-J2J to the artist's joints clean and noisy, and the share of rigs with a bone bridging twins
+    (``bridges``)."""
     summary = []
     for sigma in sigmas:
         runs = [(record, run) for record in records for run in record["noisy"] if run["sigma"] == sigma]
@@ -96,6 +110,7 @@ def summarised(records, sigmas):
             "plan_kept": float(np.mean([run["plan"] == record["plan"] for record, run in runs])),
             "moved_median": float(np.median(moved)), "moved_max": float(moved.max()),
             "moved_share": float(np.mean(moved > MOVED)),
+            "bridged": float(np.mean([run["bridges"] > 0 for _, run in runs])),
             "bone_change": float(np.mean([abs(run["bones"] - record["bones"]) / record["bones"]
                                           for record, run in runs])),
             "cd_j2j_clean": float(np.mean([clean for clean, _ in scored])) if scored else None,
@@ -114,28 +129,34 @@ def report(records, summary, run, sigmas):
              f"{', '.join(f'{100 * s:g}%' for s in sigmas)} of the size, seeds {', '.join(map(str, SEEDS))}.",
              "- Moved: the Chamfer distance between the clean and the noisy skeleton's bone samples (CD-B2B); "
              f"visibly moved above {MOVED}. CD-J2J: the artist-rigged models' joints against the artist's.",
+             f"- Bridged: rigs with a bone across the mirror plane whose ends both lie more than {BRIDGE} off it "
+             "(a bone from one twin part to the other through the air).",
              "- No target yet: the benchmark measures a weakness, for the work that fixes it.", "",
              "## Summary", ""]
     lines += markdown_table(
         ["noise σ", "rigs", "body plan kept", "moved, median", "moved, largest", f"moved > {MOVED}",
-         "bone count change", "CD-J2J clean → noisy"],
+         "bone count change", "bridged", "CD-J2J clean → noisy"],
         [[f"{100 * row['sigma']:g}%", row["rigs"], f"{100 * row['plan_kept']:.0f}%", f"{row['moved_median']:.4f}",
           f"{row['moved_max']:.4f}", f"{100 * row['moved_share']:.0f}%", f"{100 * row['bone_change']:.0f}%",
+          f"{100 * row['bridged']:.0f}%",
           "—" if row["cd_j2j_clean"] is None else f"{row['cd_j2j_clean']:.4f} → {row['cd_j2j_noisy']:.4f}"]
          for row in summary])
     lines += ["", "![CD-B2B from the clean skeleton per model and noise level](robustness.png)", "",
               "## Per model", "",
-              "Each cell: the body plans of the noisy rigs where they differ from the clean one, bone counts, and the "
-              "largest CD-B2B to the clean skeleton over the seeds.", ""]
+              "Each cell: the body plans of the noisy rigs where they differ from the clean one, bone counts, the "
+              "largest CD-B2B to the clean skeleton over the seeds and how many rigs have bones bridging twins.", ""]
     rows = []
     for record in records:
-        cells = [record["model"], f"{record['plan']} ({record['bones']})"]
+        bridged = f"; {record['bridges']} bridging" if record["bridges"] else ""
+        cells = [record["model"], f"{record['plan']} ({record['bones']}{bridged})"]
         for sigma in sigmas:
             runs = [run for run in record["noisy"] if run["sigma"] == sigma]
             plans = sorted({run["plan"] for run in runs if run["plan"] != record["plan"]})
             counts = "/".join(str(run["bones"]) for run in runs)
             moved = max(run["moved"] for run in runs)
-            cells.append(f"{', '.join(plans) + '; ' if plans else ''}{counts}; {moved:.4f}")
+            bridged = sum(run["bridges"] > 0 for run in runs)
+            cells.append(f"{', '.join(plans) + '; ' if plans else ''}{counts}; {moved:.4f}"
+                         + (f"; {bridged} bridged" if bridged else ""))
         rows.append(cells)
     lines += markdown_table(["model", "clean plan (bones)"] + [f"σ {100 * s:g}%" for s in sigmas], rows)
     remeshed = [record for record in records if "remeshed" in record]

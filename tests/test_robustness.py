@@ -1,7 +1,11 @@
 """The robustness benchmark's noise (bench/robustness.py)."""
 import numpy as np
+import pytest
 
-from robustness import noisy
+import rigger
+from bodyplan import load
+from conftest import shared_path
+from robustness import BRIDGE, bridges, noisy
 
 
 def test_noise_moves_the_copies_of_a_vertex_together_and_repeats_with_its_seed():
@@ -15,3 +19,18 @@ def test_noise_moves_the_copies_of_a_vertex_together_and_repeats_with_its_seed()
     assert abs(np.std(moved[:2000] - positions) - 0.01) < 0.001
     np.testing.assert_array_equal(moved, noisy(vertices, 0.01, seed=3))
     assert not np.array_equal(moved, noisy(vertices, 0.01, seed=4))
+
+
+@pytest.mark.parametrize("model, sigma, seed", [
+    ("rignet_2982", 0.0005, 0),  # the head's stretch followed one ear: a bone from that ear's tip to the other's
+    ("Quaternius_Husky", 0.001, 1),  # the hind legs' fork piece ended at one hip: a bone from hip to hip
+    ("rignet_8338", 0.001, 3),  # a front leg's copy stepped into the other foot: bones from foot to foot
+])
+def test_no_bone_bridges_twin_parts_under_noise(model, sigma, seed):
+    """Noise nobody would see (a share of the size, per vertex position) once left bones joining twin parts through
+    the air, across the mirror plane; twins now keep to their sides, and what they hang from ends on the plane."""
+    shared_path("models")  # skips without ../shared
+    vertices, triangles, _, _ = load(model)
+    size = np.ptp(vertices, axis=0).max()
+    skeleton = rigger.rig_mesh(noisy(vertices, sigma * size, seed), triangles)
+    assert bridges(skeleton, BRIDGE * size) == 0

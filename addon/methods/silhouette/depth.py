@@ -123,6 +123,8 @@ def place_chains(sil, points, radius, root, chains, placing):
             twins = count == 2 and mirror is not None and _twin_parts(parts[part], *mirror)
             if twins:
                 followed = _twin_copies(followed, mirror[0])
+                if len(parents) == 1:
+                    _end_on_plane(placed[parents[0]][0], sil, mirror[0])
             for copy in range(count):
                 depths = resolve_occlusion(sil, chain_points[part], chain_radius[part], node_layers[part],
                                            followed[copy], placing, followed[:copy] + followed[copy + 1:])
@@ -144,6 +146,16 @@ def place_chains(sil, points, radius, root, chains, placing):
         ends_of[ci] = parents
         end_depth[ci] = depths[-1]
     return root_point, placed
+
+
+def _end_on_plane(line, sil, depth):
+    """Move the end of a placed ``line`` that twin copies hang from onto the mirror plane at ``depth`` when it lies
+    more than a grid cell off it: a stretch before the twins (a fork's piece, a head below its ears) may have
+    followed one of them, and the other twin's bone across the depth would start in its twin (one hip's bone to the
+    other hip)."""
+    off = depth - sil.project(line[-1:])[1][0]
+    if abs(off) > sil.cell:
+        line[-1] += off * sil.direction
 
 
 def _across(start, end, parent):
@@ -320,10 +332,13 @@ def _twin_parts(parts, depth, tolerance):
 def _twin_copies(followed, depth):
     """The two ``followed`` copies of a chain split into twin parts (:func:`_twin_parts`) as twins: the copy that
     keeps to one side of the plane at more nodes, and its mirror image, since where one part hides the other the
-    other copy may have stepped across to it."""
+    other copy may have stepped across to it. Where the kept copy itself stepped across into its twin's part (a foot
+    among splayed toes), it takes that depth's mirror image, in its own part: twins never cross the plane."""
     kept = max((0, 1), key=lambda k: abs(np.sign(followed[k] - depth).sum()))
-    image = 2 * depth - followed[kept]
-    return [followed[0], image] if kept == 0 else [image, followed[1]]
+    side = np.sign(np.sign(followed[kept] - depth).sum())
+    own = np.where(np.sign(followed[kept] - depth) == -side, 2 * depth - followed[kept], followed[kept])
+    image = 2 * depth - own
+    return [own, image] if kept == 0 else [image, own]
 
 
 def _track(node_layers, order, previous, depths, stay=0, mirror=None):
