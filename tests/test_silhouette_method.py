@@ -769,6 +769,19 @@ def test_twins_of_a_rough_mirror_body_mirror_across_where_the_mesh_mirrors_best(
         assert max(rig_checks.twin_mismatches(skeleton, size, plane).values()) < 0.005
 
 
+@pytest.mark.parametrize("name", ["humanoid", "humanoid_a_pose", "bear"])
+def test_a_torso_bends_at_hips_waist_and_chest(name):
+    """The sample figures' trunks, shorter than three bone lengths, got two or three bones, so the posed torso bent
+    in one or two places where the artists' rigs (Rigify's spine to spine.003, Mixamo's Hips to Spine2) bend in
+    four. Now four, named hips, spine, spine.1 and chest; a lower ``max_chain_bones`` asks for no more."""
+    vertices, triangles = load_character(name)
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert [role.label for bone, role in zip(skeleton.names, skeleton.roles)
+            if bone.startswith("trunk")] == ["hips", "spine", "spine.1", "chest"]
+    capped = rigger.rig_mesh(vertices, triangles, max_chain_bones=2)
+    assert sum(bone.startswith("trunk") for bone in capped.names) < 4
+
+
 def test_brainstem_s_straight_legs_get_knees():
     """BrainStem's legs turn below the hip and at the ankle; those joints used up the leg's bones and left thigh and
     shin one bone 0.26 of the size long, so the leg could not bend at the knee. Each artist knee now has a joint of

@@ -18,6 +18,8 @@ class JointTuning(TuningTable):
                                       "shin no single bone")
     joint_spacing: float = tuned(0.35, "joint candidates closer than this to a joint already placed are dropped")
     leaf_two_bones: float = tuned(0.5, "a leaf chain this long gets two bones, as the artists' leaf chains have")
+    trunk_bones: int = tuned(4, "a body's trunk gets this many bones at least (max_bones allowing), as a torso bends "
+                                "at hips, waist and chest: Rigify's spine to spine.003, Mixamo's Hips to Spine2")
     disc_exit: float = tuned(0.3, "the joint where a chain leaves its branch point's disc is this far along at least")
     disc_exit_rest: float = tuned(0.5, "... and this much of the chain lies beyond it")
     corner_tolerance: float = tuned(0.25, "corners are measured on the chain simplified within this: no jitter stubs")

@@ -48,6 +48,8 @@ class BoneBuilder:
         inner = {parent for _, parent, _ in placed}
         across = [is_across(line, widths) for line, _, widths in placed]
         joints = self._joints([(line, widths, i not in inner) for i, (line, _, widths) in enumerate(placed)], across)
+        if not self.heads and not across[trunk] and (on_plane[trunk] or self.symmetry is None):
+            joints[trunk] = self._trunk_joints(placed[trunk], joints[trunk], trunk not in inner)
         attach, _ = self.attachment(root_point)
         last_bone, first_bone = {}, {}
         for i in order:
@@ -62,6 +64,17 @@ class BoneBuilder:
             first_bone[i], last_bone[i] = (added[0], added[-1]) if added else (up, up)
             if across[i]:
                 self.across.update(added)
+
+    def _trunk_joints(self, placed, joints, leaf):
+        """The joints of the body's trunk (the first island's, with no twin): at least ``trunk_bones`` bones, or
+        ``max_bones`` when that is fewer."""
+        line, _, widths = placed
+        least = self.tuning.trunk_bones
+        if self.cutting.max_bones > 0:
+            least = min(least, self.cutting.max_bones)
+        if len(joints) - 1 >= least:
+            return joints
+        return chain_joints(line, self.cutting, widths, leaf, min_bones=least)
 
     def _on_plane(self, line):
         """Whether the chain ``line`` lies on the builder's mirror plane (False without one)."""
