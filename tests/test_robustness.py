@@ -25,10 +25,12 @@ def test_noise_moves_the_copies_of_a_vertex_together_and_repeats_with_its_seed()
     ("rignet_2982", 0.0005, 0),  # the head's stretch followed one ear: a bone from that ear's tip to the other's
     ("Quaternius_Husky", 0.001, 1),  # the hind legs' fork piece ended at one hip: a bone from hip to hip
     ("rignet_8338", 0.001, 3),  # a front leg's copy stepped into the other foot: bones from foot to foot
+    ("rignet_17872", 0.001, 3),  # a hidden leg's copy began at the other hip: two legs more, toes across
 ])
 def test_no_bone_bridges_twin_parts_under_noise(model, sigma, seed):
     """Noise nobody would see (a share of the size, per vertex position) once left bones joining twin parts through
-    the air, across the mirror plane; twins now keep to their sides, and what they hang from ends on the plane."""
+    the air, across the mirror plane; twins now keep to their sides, what they hang from ends on the plane, and a
+    hidden limb running from one side to the other gives way to its twin's image."""
     shared_path("models")  # skips without ../shared
     vertices, triangles, _, _ = load(model)
     size = np.ptp(vertices, axis=0).max()

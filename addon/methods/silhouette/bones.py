@@ -187,7 +187,7 @@ class BoneBuilder:
         if not limbs:
             return
         if self.exact:
-            limbs = mirror_completed(limbs, self.symmetry)
+            limbs = mirror_completed(self._one_sided(limbs), self.symmetry)
         chains, ups, meets_of = [], [], {}  # meets_of: limb number -> where it meets its bone, for the limbs to extend
         for line, widths in limbs:  # every limb hangs from bones already there, none from another (a right foot
             up, meets = self.attachment(line[0], views, self._on_plane(line[:1]))  # from the left one's extension)
@@ -217,6 +217,17 @@ class BoneBuilder:
             up = last_bone[ends[c]] if c in ends else ups[c]
             added = self._add_chain(line, along, up)
             last_bone[c] = added[-1] if added else up
+
+    def _one_sided(self, limbs):
+        """The (polyline, half-widths) ``limbs`` without those running from one side of the mirror plane to the other
+        (start and tip each beyond the twin tolerance), when that leaves any: a view's copy of a limb that began in
+        its twin's part (two legs seen from the side, merged at the hips). The twin's image stands for it."""
+        axis, offset = self.symmetry.plane
+        tolerance = self.symmetry.tolerance
+        kept = [(line, widths) for line, widths in limbs
+                if not ((line[0, axis] - offset) * (line[-1, axis] - offset) < 0
+                        and min(abs(line[0, axis] - offset), abs(line[-1, axis] - offset)) > tolerance)]
+        return kept or limbs
 
     def _twin_meets(self, meets, ups, lines):
         """Make the points where mirror twin limbs to extend meet their bone (``meets``, limb number -> point; the
