@@ -222,10 +222,15 @@ def _plane_course(node_layers, depth, tolerance, leaf):
     ``depth``: where no tip stretch of its nodes passes only beside the plane (``_beside``), all of them, keeping
     to the plane across gaps; for a ``leaf`` whose tip stretch does, after a node whose rays cross the plane inside
     the mesh, the nodes before that stretch, keeping to the plane; else all of them, following one part as without
-    a plane (a chain wholly beside the plane, or one that others hang from, would otherwise run through the air)."""
+    a plane (a chain wholly beside the plane, or one that others hang from, would otherwise run through the air).
+    The stretch takes in the nodes before it whose rays pass one side's part only: on a mirror-symmetric mesh the
+    twin part is there too, and the rays just miss its edge."""
     start = len(node_layers)
     while start > 0 and _beside(node_layers[start - 1], depth, tolerance):
         start -= 1
+    if start < len(node_layers):  # before it, nodes whose rays miss one twin (a thin ear's noisy edge) join it
+        while start > 0 and len(node_layers[start - 1]) and not _holds(node_layers[start - 1].tolist(), depth):
+            start -= 1
     if start == len(node_layers) or (leaf and start >= 2 and _holds(node_layers[start - 1].tolist(), depth)):
         return start, True
     return len(node_layers), False
