@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from conftest import shared_path
+from meshes import cylinder
 
 bpy = pytest.importorskip("bpy")
 import bmesh  # noqa: E402  (Blender's own module, importable once bpy is)
@@ -29,6 +30,7 @@ from rigger.blender.meshdata import mesh_vertices, world_points  # noqa: E402
 from rigger.blender.samples import build_character  # noqa: E402
 from rigger.core.accessories import CONTACT  # noqa: E402
 from rigger.core.polyline import segment_distances  # noqa: E402
+from rigger.core.skeleton import Skeleton  # noqa: E402
 
 import rigdata  # noqa: E402
 from skinning import seam_gap  # noqa: E402  (bench/skinning.py: the benchmark's own seam measure)
@@ -427,6 +429,24 @@ def mesh_object(name, vertices, triangles):
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     return obj
+
+
+def test_a_bone_between_the_rings_of_a_low_poly_tube_moves_some_of_it(scene):
+    """A tube with a vertex ring every quarter of its length and a bone from 0.3 to 0.45 of it, between two rings:
+    bone heat gave that bone no vertex, so bending it moved nothing. It now weighs on the rings beside it and hardly
+    anywhere else, and the report says which bone it was."""
+    vertices, triangles = cylinder(0.1, 1.0, around=12, along=5)
+    obj = mesh_object("tube", vertices, triangles)
+    ends = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.3], [0.0, 0.0, 0.45], [0.0, 0.0, 1.0]])
+    armature = build_armature(Skeleton(["low", "short", "high"], ends[:-1], ends[1:], [-1, 0, 1]), "tube_rig")
+    report = skinning.skin(obj, armature)
+    assert_skinned(obj, armature, report)
+    table = rigdata.vertex_weights(obj, bone_names(armature))
+    assert table[:, 1].max() > 0.1
+    assert stage_names(report) == ["bone heat", skinning.IDLE_STAGE] and report.stages[1].note == "short"
+    assert report.level == "INFO" and "moved no vertex" in report.summary()
+    heights = mesh_vertices(obj.data)[:, 2]
+    assert table[(heights < 0.1) | (heights > 0.7)][:, 1].max() < 1e-3
 
 
 def shared_model(name):

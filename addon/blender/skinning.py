@@ -19,6 +19,10 @@ vertices are counted directly.
 2. ``rigger.weights.bone_weights``: the nearest few bones by distance, which always succeeds (its facing penalty
    takes area-weighted normals of the welded mesh, so a seam's copies face alike).
 
+Then a bone that carries no vertex's largest weight (bone heat heats a bone from the vertices it is the nearest
+visible bone of; between the rings of a low-poly mesh a short bone may be none's) gets a share of the vertices
+around it, blended in from the nearest bones, so that every bone moves some of the mesh.
+
 Last, the accessories, the loose parts no bone runs through (``rigger.core.accessories``: eyes, teeth, nails,
 plates), move as one piece with the other parts' surface nearest to them, so they stay with what they sit on. Bone
 heat still weighs the whole mesh, accessories included, and their weights are replaced afterwards: leaving them out
@@ -55,6 +59,7 @@ FAILURE_MESSAGE = "Bone Heat Weighting: failed to find solution"
 WELD_DISTANCE = 1e-5  # fraction of the mesh's largest extent under which two vertices are one (UV-seam duplicates)
 TEMPORARY_NAME = "Rigger skinning"
 SURFACE_STAGE = "surface weights"  # the accessories' stage (core.accessories)
+IDLE_STAGE = "idle bones"  # the stage giving bones that carry no vertex's largest weight a share
 
 
 @dataclass
@@ -74,7 +79,8 @@ class SkinReport:
 
     ``stages`` lists the stages that ran, first ``"bone heat"`` on the welded mesh (``weighted`` = the vertices it
     weighted), then any of ``"island bone heat"`` and ``"nearest bones"`` (``weighted`` = the vertices each fixed),
-    and last ``"surface weights"`` when the mesh has accessories (``weighted`` = their vertices).
+    ``"idle bones"`` when a bone carried no vertex's largest weight (``weighted`` = the vertices reweighted, ``note``
+    = those bones), and last ``"surface weights"`` when the mesh has accessories (``weighted`` = their vertices).
     ``welded`` counts the vertices merged into another at the same place before weighting (they share its weights),
     ``bone_heat_result`` is the operator's return value, ``unweighted`` the vertices left without any deforming
     weight at the end (always 0), ``warnings`` human-readable sentences about anything that went wrong.
@@ -107,6 +113,9 @@ class SkinReport:
                f"{self.seconds:.2f} s"
         if self.welded:
             head += f", {self.welded} seam vertices welded"
+        idle = next((stage for stage in self.stages if stage.name == IDLE_STAGE), None)
+        if idle is not None:
+            head += f", bones that moved no vertex given a share of {idle.weighted} vertices ({idle.note})"
         surface = next((stage for stage in self.stages if stage.name == SURFACE_STAGE), None)
         if surface is not None:
             head += f", {surface.weighted} vertices of {surface.note} moved with the surface they sit on"
@@ -115,7 +124,7 @@ class SkinReport:
         parts = []
         if any(FAILURE_MESSAGE in message for message in self.messages):
             parts.append("bone heat failed")
-        repairs = [stage for stage in self.stages[1:] if stage is not surface]
+        repairs = [stage for stage in self.stages[1:] if stage is not surface and stage is not idle]
         unweighted = self.vertices - self.stages[0].weighted
         if unweighted:
             fixes = ", ".join(f"{stage.name} {stage.weighted}" for stage in repairs if stage.weighted)
@@ -165,6 +174,7 @@ def skin(mesh_obj, armature_obj):
         _repair_islands(mesh_obj, armature_obj, bone_names, weighted, weld, report)
         if not weighted.all():
             _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report)
+    _weigh_idle_bones(mesh_obj, armature_obj, bone_names, weld, report)
     accessories = _Accessories.of(weld, *_world_bones(armature_obj, bone_names))
     if accessories.parts:
         _weigh_accessories(mesh_obj, bone_names, weld, accessories, report)
@@ -329,6 +339,37 @@ def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report):
     stage.weighted = len(targets)
     _finish_stage(stage, started, report,
                   f"The remaining {len(targets)} vertices were weighted by their nearest bones (distance fallback)")
+
+
+def _weigh_idle_bones(mesh_obj, armature_obj, bone_names, weld, report):
+    """Stage: the bones that carry no vertex's largest weight (idle) get a share of the vertices around them. Each
+    welded vertex blends its weights towards its nearest bones' (``rigger.weights``) by the weight those give the
+    idle bones, so the weights stay continuous (a seam's copies alike) and change little away from those bones."""
+    started = time.perf_counter()
+    first = np.full(len(weld.positions), -1)
+    first[weld.map[::-1]] = np.arange(len(weld.map))[::-1]  # one original vertex of each welded one
+    vertices, bones, weights = weight_entries(mesh_obj, bone_names, first.tolist())
+    current = np.zeros((len(weld.positions), len(bone_names)))
+    np.add.at(current, (weld.map[vertices], bones), weights)
+    idle = np.setdiff1d(np.arange(len(bone_names)), current.argmax(axis=1))
+    if not len(idle):
+        return
+    heads, tails = _world_bones(armature_obj, bone_names)
+    nearest = bone_weights(weld.positions, heads, tails, vertex_normals(weld.positions, weld.triangles))
+    nearest = nearest.dense(len(bone_names))
+    share = np.minimum(nearest[:, idle].sum(axis=1), 1.0)
+    changed = np.flatnonzero(share > 0)
+    blended = (1.0 - share[changed, None]) * current[changed] + share[changed, None] * nearest[changed]
+    rows, columns = np.nonzero(blended > 0)
+    targets = np.flatnonzero(np.isin(weld.map, changed))
+    for name in bone_names:
+        mesh_obj.vertex_groups[name].remove(targets.tolist())
+    stage = SkinStage(IDLE_STAGE, note=", ".join(bone_names[bone] for bone in idle))
+    _transfer(mesh_obj, bone_names, (changed[rows], columns, blended[rows, columns]), targets, weld.map[targets],
+              np.zeros(report.vertices, dtype=bool))
+    stage.weighted = len(targets)
+    stage.seconds = time.perf_counter() - started
+    report.stages.append(stage)
 
 
 def _weigh_accessories(mesh_obj, bone_names, weld, accessories, report):
