@@ -20,8 +20,8 @@ vertices are counted directly.
    takes area-weighted normals of the welded mesh, so a seam's copies face alike).
 
 Then a bone that carries no vertex's largest weight (bone heat heats a bone from the vertices it is the nearest
-visible bone of; between the rings of a low-poly mesh a short bone may be none's) gets a share of the vertices
-around it, blended in from the nearest bones, so that every bone moves some of the mesh.
+visible bone of; between the rings of a low-poly mesh a short bone may be none's) gets a share of the vertices of
+the bones it joins, blended in from the nearest bones, so that every bone moves some of the mesh.
 
 Last, the accessories, the loose parts no bone runs through (``rigger.core.accessories``: eyes, teeth, nails,
 plates), move as one piece with the other parts' surface nearest to them, so they stay with what they sit on. Bone
@@ -343,8 +343,10 @@ def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report):
 
 def _weigh_idle_bones(mesh_obj, armature_obj, bone_names, weld, report):
     """Stage: the bones that carry no vertex's largest weight (idle) get a share of the vertices around them. Each
-    welded vertex blends its weights towards its nearest bones' (``rigger.weights``) by the weight those give the
-    idle bones, so the weights stay continuous (a seam's copies alike) and change little away from those bones."""
+    welded vertex whose largest weight is on an idle bone's parent or child blends its weights towards its nearest
+    bones' (``rigger.weights``), those it already has and that idle bone, by the weight they give the idle bone:
+    the weights stay continuous (a seam's copies alike) and take nothing from other parts near by (the other
+    foot)."""
     started = time.perf_counter()
     first = np.full(len(weld.positions), -1)
     first[weld.map[::-1]] = np.arange(len(weld.map))[::-1]  # one original vertex of each welded one
@@ -357,9 +359,15 @@ def _weigh_idle_bones(mesh_obj, armature_obj, bone_names, weld, report):
     heads, tails = _world_bones(armature_obj, bone_names)
     nearest = bone_weights(weld.positions, heads, tails, vertex_normals(weld.positions, weld.triangles))
     nearest = nearest.dense(len(bone_names))
-    share = np.minimum(nearest[:, idle].sum(axis=1), 1.0)
+    dominant = current.argmax(axis=1)
+    joins = np.zeros_like(current, dtype=bool)  # the idle bones joined to each vertex's dominant bone (or it)
+    for bone in idle.tolist():
+        joins[np.isin(dominant, _joined(armature_obj, bone_names, bone)), bone] = True
+    share = np.minimum((nearest * joins).sum(axis=1), 1.0)
     changed = np.flatnonzero(share > 0)
-    blended = (1.0 - share[changed, None]) * current[changed] + share[changed, None] * nearest[changed]
+    own = nearest[changed] * ((current[changed] > 0) | joins[changed])  # no weight from other parts near by
+    own /= own.sum(axis=1, keepdims=True)
+    blended = (1.0 - share[changed, None]) * current[changed] + share[changed, None] * own
     rows, columns = np.nonzero(blended > 0)
     targets = np.flatnonzero(np.isin(weld.map, changed))
     for name in bone_names:
@@ -370,6 +378,15 @@ def _weigh_idle_bones(mesh_obj, armature_obj, bone_names, weld, report):
     stage.weighted = len(targets)
     stage.seconds = time.perf_counter() - started
     report.stages.append(stage)
+
+
+def _joined(armature_obj, bone_names, bone):
+    """Indices (into ``bone_names``, the deforming bones) of ``bone`` and of the deforming bones it joins: its
+    parent and its children."""
+    index = {name: k for k, name in enumerate(bone_names)}
+    data = armature_obj.data.bones[bone_names[bone]]
+    return [bone] + [index[other.name] for other in [data.parent, *data.children]
+                     if other is not None and other.name in index]
 
 
 def _weigh_accessories(mesh_obj, bone_names, weld, accessories, report):
