@@ -353,13 +353,13 @@ def _weigh_idle_bones(mesh_obj, armature_obj, bone_names, weld, report):
     vertices, bones, weights = weight_entries(mesh_obj, bone_names, first.tolist())
     current = np.zeros((len(weld.positions), len(bone_names)))
     np.add.at(current, (weld.map[vertices], bones), weights)
-    idle = np.setdiff1d(np.arange(len(bone_names)), current.argmax(axis=1))
+    dominant = current.argmax(axis=1)
+    idle = np.setdiff1d(np.arange(len(bone_names)), dominant)
     if not len(idle):
         return
     heads, tails = _world_bones(armature_obj, bone_names)
     nearest = bone_weights(weld.positions, heads, tails, vertex_normals(weld.positions, weld.triangles))
     nearest = nearest.dense(len(bone_names))
-    dominant = current.argmax(axis=1)
     joins = np.zeros_like(current, dtype=bool)  # the idle bones joined to each vertex's dominant bone (or it)
     for bone in idle.tolist():
         joins[np.isin(dominant, _joined(armature_obj, bone_names, bone)), bone] = True
