@@ -211,6 +211,13 @@ def seam_verdict(records):
     return text + "."
 
 
+def idle_count(record):
+    """How many bones bone heat left carrying no vertex's largest weight (the skinning's idle-bones stage)."""
+    from rigger.blender.skinning import IDLE_STAGE
+    note = record["notes"].get(IDLE_STAGE)
+    return len(note.split(", ")) if note else 0
+
+
 def summary_rows(records, alone):
     rows = []
     for kind in SKELETONS:
@@ -225,19 +232,21 @@ def summary_rows(records, alone):
             cells.append(f"{len(ran)} / {sum(r['stages'][stage] > 0 for r in ran)} / "
                          f"{sum(r['stages'][stage] for r in ran)}")
         cells.append(f"{sum(r['accessories'] > 0 for r in good)} / {sum(r['accessories'] for r in good)}")
+        cells.append(f"{sum(idle_count(r) > 0 for r in good)} / {sum(idle_count(r) for r in good)}")
         seconds = [r["seconds"] for r in good]
         cells.append(f"{sum(r['seam_gap'] > 0 for r in good)} / {max((r['seam_gap'] for r in good), default=0):.3f}")
         cells += [format_seconds(statistics.median(seconds)) if seconds else "–",
                   format_seconds(max(seconds)) if seconds else "–",
                   percent(np.nanmean([r["agreement"] for r in good]) if good else None)]
         rows.append(cells)
-    rows.append(["artist, nearest bones alone", str(len(alone)), "", "0", "", "", "", "", "", "", "", "",
+    rows.append(["artist, nearest bones alone", str(len(alone)), "", "0", "", "", "", "", "", "", "", "", "",
                  percent(np.nanmean(list(alone.values())) if alone else None)])
     return rows
 
 
 def markdown(records, alone, speed, run):
     import bpy
+    from rigger.blender.skinning import IDLE_STAGE
 
     commit = described_commit()
     out = [
@@ -267,7 +276,8 @@ def markdown(records, alone, speed, run):
         "- Repair columns: models where the stage ran / where it weighted vertices / vertices it weighted. "
         "*Accessories*: the loose parts no bone runs through, weighted by bone heat with the rest, then moved as "
         "one piece with the surface nearest to them (`rigger.core.accessories`): models that have any / their "
-        "vertices.",
+        "vertices. *Idle bones*: bones bone heat left carrying no vertex's largest weight, given a share of the "
+        "vertices of the bones they join: models that had any / such bones (per model: their names).",
         "- Seams: *seam vertices* share their exact position with another vertex (the file split them for UVs or "
         "normals); the *seam gap* is the largest difference of one bone's weight between two such copies (0: the "
         "posed mesh cannot crack there). *Seams cracked* counts the models whose gap is above 0.",
@@ -281,26 +291,28 @@ def markdown(records, alone, speed, run):
     ]
     out += markdown_table(["skeleton", "models", "errors", "unweighted vertices", "bone heat failed (message)",
                   "bone heat left vertices silently", "island bone heat", "nearest bones",
-                  "accessories (models / vertices)", "seams cracked / largest gap", "time (median)", "time (max)",
-                  "top-1 agreement (mean)"],
+                  "accessories (models / vertices)", "idle bones (models / bones)", "seams cracked / largest gap",
+                  "time (median)", "time (max)", "top-1 agreement (mean)"],
                          summary_rows(records, alone))
     out += ["", "![agreement per model, skinning time, fallback speed](skinning.png)", "", "## Per model", ""]
     rows = []
     for record in sorted(records, key=lambda r: (r["model"], SKELETONS.index(r["skeleton"]))):
         if "error" in record:
-            rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}"] + [""] * 10
+            rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}"] + [""] * 11
                         + [f"error: {table_cell(record['error'])}"])
             continue
         rows.append([record["model"], record["skeleton"], f"{record['vertices']:,}", str(record["bones"]),
                      f"{record['seam_vertices']:,}", f"{record['welded']:,}", bone_heat_cell(record),
                      *(stage_cell(record, stage) for stage in REPAIR_STAGES),
-                     str(record["accessories"]) if record["accessories"] else "", str(unweighted_count(record)),
+                     str(record["accessories"]) if record["accessories"] else "",
+                     record["notes"].get(IDLE_STAGE, ""), str(unweighted_count(record)),
                      f"{record['seam_gap']:.3f}",
                      format_seconds(record["seconds"]),
                      percent(record["agreement"]),
                      percent(alone.get(record["model"])) if record["skeleton"] == "artist" else ""])
     out += markdown_table(["model", "skeleton", "vertices", "bones", "seam vertices", "welded", "bone heat",
-                  "islands", "nearest", "accessories", "unweighted", "seam gap", "skin time", "top-1 agreement",
+                  "islands", "nearest", "accessories", "idle bones", "unweighted", "seam gap", "skin time",
+                  "top-1 agreement",
                   "nearest bones alone"], rows)
     if speed:
         out += ["", "## The compiled nearest-bones weighting alone", "",
