@@ -174,8 +174,9 @@ def skin(mesh_obj, armature_obj):
         _repair_islands(mesh_obj, armature_obj, bone_names, weighted, weld, report)
         if not weighted.all():
             _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report)
-    _weigh_idle_bones(mesh_obj, armature_obj, bone_names, weld, report)
-    accessories = _Accessories.of(weld, *_world_bones(armature_obj, bone_names))
+    bones = _world_bones(armature_obj, bone_names)
+    _weigh_idle_bones(mesh_obj, armature_obj, bone_names, bones, weld, report)
+    accessories = _Accessories.of(weld, *bones)
     if accessories.parts:
         _weigh_accessories(mesh_obj, bone_names, weld, accessories, report)
 
@@ -341,40 +342,49 @@ def _repair_nearest(mesh_obj, armature_obj, bone_names, weighted, weld, report):
                   f"The remaining {len(targets)} vertices were weighted by their nearest bones (distance fallback)")
 
 
-def _weigh_idle_bones(mesh_obj, armature_obj, bone_names, weld, report):
+def _weigh_idle_bones(mesh_obj, armature_obj, bone_names, bones, weld, report):
     """Stage: the bones that carry no vertex's largest weight (idle) get a share of the vertices around them. Each
     welded vertex whose largest weight is on an idle bone's parent or child blends its weights towards its nearest
-    bones' (``rigger.weights``), those it already has and that idle bone, by the weight they give the idle bone:
-    the weights stay continuous (a seam's copies alike) and take nothing from other parts near by (the other
-    foot)."""
+    bones' (``rigger.weights``, the deforming ``bones``' heads and tails), those it already has and that idle bone,
+    by the weight they give the idle bone: the weights stay continuous (a seam's copies alike) and take nothing from
+    other parts near by (the other foot). Only those vertices are weighed again, row by row."""
     started = time.perf_counter()
+    count = len(bone_names)
     first = np.full(len(weld.positions), -1)
     first[weld.map[::-1]] = np.arange(len(weld.map))[::-1]  # one original vertex of each welded one
-    vertices, bones, weights = weight_entries(mesh_obj, bone_names, first.tolist())
-    current = np.zeros((len(weld.positions), len(bone_names)))
-    np.add.at(current, (weld.map[vertices], bones), weights)
-    dominant = current.argmax(axis=1)
-    idle = np.setdiff1d(np.arange(len(bone_names)), dominant)
+    vertices, columns, weights = weight_entries(mesh_obj, bone_names, first.tolist())
+    welded = weld.map[vertices]
+    order = np.lexsort((-columns, weights, welded))  # by vertex, then weight, the lower bone last among equals
+    largest = order[np.r_[welded[order][1:] != welded[order][:-1], True]]
+    dominant = np.full(len(weld.positions), -1)
+    dominant[welded[largest]] = columns[largest]
+    idle = np.setdiff1d(np.arange(count), dominant)
     if not len(idle):
         return
-    heads, tails = _world_bones(armature_obj, bone_names)
-    nearest = bone_weights(weld.positions, heads, tails, vertex_normals(weld.positions, weld.triangles))
-    nearest = nearest.dense(len(bone_names))
-    joins = np.zeros_like(current, dtype=bool)  # the idle bones joined to each vertex's dominant bone (or it)
-    for bone in idle.tolist():
-        joins[np.isin(dominant, _joined(armature_obj, bone_names, bone)), bone] = True
+    joined = {bone: _joined(armature_obj, bone_names, bone) for bone in idle.tolist()}
+    near = np.flatnonzero(np.isin(dominant, np.concatenate(list(joined.values()))))  # welded vertices to weigh
+    joins = np.zeros((len(near), count), dtype=bool)  # the idle bones joined to each one's dominant bone (or it)
+    for bone, others in joined.items():
+        joins[np.isin(dominant[near], others), bone] = True
+    row = np.full(len(weld.positions), -1)
+    row[near] = np.arange(len(near))
+    current = np.zeros((len(near), count))
+    mine = row[welded] >= 0
+    current[row[welded[mine]], columns[mine]] = weights[mine]
+    normals = vertex_normals(weld.positions, weld.triangles)[near]
+    nearest = bone_weights(weld.positions[near], *bones, normals).dense(count)
     share = np.minimum((nearest * joins).sum(axis=1), 1.0)
     changed = np.flatnonzero(share > 0)
     own = nearest[changed] * ((current[changed] > 0) | joins[changed])  # no weight from other parts near by
     own /= own.sum(axis=1, keepdims=True)
     blended = (1.0 - share[changed, None]) * current[changed] + share[changed, None] * own
-    rows, columns = np.nonzero(blended > 0)
-    targets = np.flatnonzero(np.isin(weld.map, changed))
+    rows, blended_columns = np.nonzero(blended > 0)
+    targets = np.flatnonzero(np.isin(weld.map, near[changed]))
     for name in bone_names:
         mesh_obj.vertex_groups[name].remove(targets.tolist())
     stage = SkinStage(IDLE_STAGE, note=", ".join(bone_names[bone] for bone in idle))
-    _transfer(mesh_obj, bone_names, (changed[rows], columns, blended[rows, columns]), targets, weld.map[targets],
-              np.zeros(report.vertices, dtype=bool))
+    _transfer(mesh_obj, bone_names, (near[changed][rows], blended_columns, blended[rows, blended_columns]), targets,
+              weld.map[targets], np.zeros(report.vertices, dtype=bool))
     stage.weighted = len(targets)
     stage.seconds = time.perf_counter() - started
     report.stages.append(stage)

@@ -222,11 +222,8 @@ class BoneBuilder:
         """The (polyline, half-widths) ``limbs`` without those running from one side of the mirror plane to the other
         (start and tip each beyond the twin tolerance), when that leaves any: a view's copy of a limb that began in
         its twin's part (two legs seen from the side, merged at the hips). The twin's image stands for it."""
-        axis, offset = self.symmetry.plane
-        tolerance = self.symmetry.tolerance
-        kept = [(line, widths) for line, widths in limbs
-                if not ((line[0, axis] - offset) * (line[-1, axis] - offset) < 0
-                        and min(abs(line[0, axis] - offset), abs(line[-1, axis] - offset)) > tolerance)]
+        side = self.symmetry.side
+        kept = [(line, widths) for line, widths in limbs if side(line[:1]) * side(line[-1:]) >= 0]
         return kept or limbs
 
     def _twin_meets(self, meets, ups, lines):

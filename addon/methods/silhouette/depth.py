@@ -339,9 +339,9 @@ def _twin_copies(followed, depth):
     keeps to one side of the plane at more nodes, and its mirror image, since where one part hides the other the
     other copy may have stepped across to it. Where the kept copy itself stepped across into its twin's part (a foot
     among splayed toes), it takes that depth's mirror image, in its own part: twins never cross the plane."""
-    kept = max((0, 1), key=lambda k: abs(np.sign(followed[k] - depth).sum()))
-    side = np.sign(np.sign(followed[kept] - depth).sum())
-    own = np.where(np.sign(followed[kept] - depth) == -side, 2 * depth - followed[kept], followed[kept])
+    sides = [np.sign(copy - depth) for copy in followed]
+    kept = max((0, 1), key=lambda k: abs(sides[k].sum()))
+    own = np.where(sides[kept] == -np.sign(sides[kept].sum()), 2 * depth - followed[kept], followed[kept])
     image = 2 * depth - own
     return [own, image] if kept == 0 else [image, own]
 
