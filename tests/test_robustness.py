@@ -21,6 +21,18 @@ def test_noise_moves_the_copies_of_a_vertex_together_and_repeats_with_its_seed()
     assert not np.array_equal(moved, noisy(vertices, 0.01, seed=4))
 
 
+def test_a_stubby_quadrupeds_legs_stay_four_under_noise():
+    """rignet_15446, a stubby dinosaur, seen from the side: its hind legs' long two-toed feet cross four parts at
+    more nodes than the legs cross two once noise adds nodes there, and each hind leg got two chains side by side:
+    six legs, no body plan."""
+    shared_path("models")  # skips without ../shared
+    vertices, triangles, _, _ = load("rignet_15446")
+    size = np.ptp(vertices, axis=0).max()
+    skeleton = rigger.rig_mesh(noisy(vertices, 0.0005 * size, 1), triangles)
+    assert skeleton.body_plan.kind == "quadruped"
+    assert skeleton.body_plan.parts["legs"] == 4
+
+
 @pytest.mark.parametrize("model, sigma, seed", [
     ("rignet_2982", 0.0005, 0),  # the head's stretch followed one ear: a bone from that ear's tip to the other's
     ("Quaternius_Husky", 0.001, 1),  # the hind legs' fork piece ended at one hip: a bone from hip to hip

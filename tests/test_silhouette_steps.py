@@ -323,6 +323,20 @@ def test_a_chain_splits_into_its_limbs_not_into_their_toes():
     assert depth.layer_count([layers((0, 1), (3, 4))] * 10, TUNING) == 2
 
 
+def test_long_toes_do_not_make_more_legs_and_fingers_parting_one_by_one_stay_fingers():
+    """A stubby dinosaur's hind legs seen from the side, hanging from the body's end: two legs, then each foot's two
+    toes over more nodes than the legs had (with noise, the nodes under the toes were enough to outvote the legs),
+    then the toes' tips merging. A hand seen edge-on: the palm, then its fingers parting one after another (two,
+    then three parts for a node each), then all four: four fingers, not two."""
+    toes = layers((0, 0.4), (0.6, 1), (3, 3.4), (3.6, 4))
+    dinosaur = [layers((0, 4))] * 2 + [layers((0, 1), (3, 4))] * 10 + [toes] * 10 + [layers((0.6, 0.7))] * 3
+    assert depth.layer_count(dinosaur, TUNING) == 2
+    fingers = layers((0, 0.2), (0.3, 0.5), (0.6, 0.8), (0.9, 1.1))
+    hand = [layers((0, 1.1))] * 8 + [layers((0, 0.2), (0.3, 1.1)), layers((0, 0.2), (0.3, 0.5), (0.6, 1.1))] \
+        + [fingers] * 10
+    assert depth.layer_count(hand, TUNING) == 4
+
+
 def test_plates_of_one_limb_are_one_part():
     """A robot's forearm seen along the view: shells and plates thinner than the arm is wide, a little apart."""
     plates = layers((0.0, 0.3), (0.35, 0.6), (0.9, 1.1))

@@ -255,8 +255,10 @@ def _holds(intervals, depth):
 def layer_count(node_layers, tuning):
     """How many separate parts a chain runs through, judged over its outer nodes (all but the first
     ``1 / near_parent_divisor``: near its parent it often runs into the body): the fewest parts (more than one) that a
-    ``split_share`` of those nodes cross, else the most frequent count. Fewest, because parts split further towards
-    the tip (a dinosaur's feet, each with its toes) are still one limb each."""
+    ``split_share`` of those nodes cross, else the most frequent count; fewer still, k > 1, when from the chain's start
+    up to its first node crossing more than k parts the nodes crossing k outnumber the unsplit ones.
+    Fewest, because parts split further towards the tip (a dinosaur's feet, each with its toes) are still one limb
+    each, however far the toes run; a hand whose fingers part one after another is split as far as they go."""
     counts = np.array([len(layer) for layer in node_layers])
     outer = counts[len(counts) // tuning.near_parent_divisor:]
     outer = outer[outer > 0]
@@ -264,7 +266,14 @@ def layer_count(node_layers, tuning):
         return 1
     frequency = np.bincount(outer)
     several = np.flatnonzero(frequency[2:] >= tuning.split_share * len(outer)) + 2
-    return int(several[0]) if len(several) else int(np.argmax(frequency))
+    if not len(several):
+        return int(np.argmax(frequency))
+    seen = counts[counts > 0]
+    for fewer in range(2, int(several[0])):
+        before = seen[:int(np.argmax(seen > fewer))]
+        if (before == fewer).sum() > (before < fewer).sum():
+            return fewer
+    return int(several[0])
 
 
 def _follow(node_layers, copies, start, mirror=None):
