@@ -9,6 +9,7 @@ import rigger
 from characters import load_character
 from conftest import shared_path
 from meshes import box, combine, cylinder
+from bodyplan import load as load_blender_frame
 from rigdata import load_ground_truth, load_obj
 from rigger import samples
 from rigger.core import rooting
@@ -165,6 +166,23 @@ def test_arms_reaching_out_from_where_the_legs_hang_are_arms():
         arm = [role.role for role in skeleton.roles if role.side == side and role.role not in ("hips", "thigh", "shin",
                                                                                              "foot", "toe")]
         assert {"shoulder", "upper_arm", "forearm", "hand"} <= set(arm), arm
+
+
+def test_a_gingerbread_man_s_legs_hang_from_his_hips_not_his_chest():
+    """woody's legs run up into the junction his arms leave (0.56 of his height): his hip joints were put 0.89 of
+    the way up there, in his chest (0.50), and his knees above his crotch. A humanoid's hip joints lie no higher
+    above the crotch than the legs lie off the mirror plane there, so the knees bend below it, in the legs."""
+    vertices, triangles, _, _ = load_blender_frame("woody")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    height = np.ptp(vertices[:, 2])
+    middle = np.abs(vertices[:, 0] - 0.5 * (vertices[:, 0].min() + vertices[:, 0].max())) < 0.01 * height
+    crotch = np.sort(vertices[middle, 2])[0]  # the lowest vertex on the middle: the top of the gap between the legs
+    joints = named_joints(skeleton)
+    for side in "LR":
+        hip, knee, ankle = (joints[(role, side, None)] for role in ("thigh", "shin", "foot"))
+        assert crotch < hip[2] < crotch + 0.15 * height
+        assert ankle[2] < knee[2] < crotch
+    assert joints[("hips", None, None)][2] < joints[("upper_arm", "L", None)][2] - 0.1 * height
 
 
 @pytest.mark.parametrize("blender", [False, True])

@@ -245,10 +245,11 @@ def test_a_humanoid_game_rig_has_hands_and_feet_though_its_limbs_end_without(pat
 
 
 @pytest.mark.parametrize("name", ["ogre", "woody"])
-def test_a_thigh_starts_at_the_hip_joint_above_where_the_skeleton_s_leg_began(name):
-    """The ogre's loincloth hides the top of its legs and woody's legs slant in from its crotch: Rigger's leg chains
-    run in from the pelvis down to where the thighs show, far below the hip joints, and the thigh bones are short.
-    The game's UpLeg began there, the Hips holding the top of the thigh. It begins at the hip joint."""
+def test_a_thigh_starts_at_the_hip_joint_wherever_the_skeleton_s_leg_began(name):
+    """The ogre's loincloth hides the top of its legs: Rigger's leg chains run in from the pelvis down to where the
+    thighs show, far below the hip joints, and the thigh bones are short; the game's UpLeg began there, the Hips
+    holding the top of the thigh. woody's legs run up into his chest, far above his hip joints, and his UpLeg began
+    there. It begins at the hip joint, up or down the skeleton's leg."""
     vertices, triangles = load_obj(shared_path("models", "nogt", f"{name}.obj"))
     skeleton = rigger.rig_mesh(vertices, triangles)
     joints, bones = named_joints(skeleton), game_skeleton(skeleton, vertices).skeleton

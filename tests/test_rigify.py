@@ -230,10 +230,11 @@ def test_a_limb_end_the_skeleton_lacks_is_placed_on_the_mesh_and_the_fit_says_so
 
 
 @pytest.mark.parametrize("name", ["ogre", "woody"])
-def test_a_thigh_starts_at_the_hip_joint_above_where_the_skeleton_s_leg_began(metarigs, name):
-    """The ogre's loincloth hides the top of its legs and woody's legs slant in from its crotch: Rigger's leg chains
-    run in from the pelvis to where the thighs show, far below the hip joints. Rigify's thighs began there, a
-    quarter of the ogre's leg long, and posing one left the top of the thigh with the torso."""
+def test_a_thigh_starts_at_the_hip_joint_wherever_the_skeleton_s_leg_began(metarigs, name):
+    """The ogre's loincloth hides the top of its legs: Rigger's leg chains run in from the pelvis to where the thighs
+    show, far below the hip joints. Rigify's thighs began there, a quarter of the ogre's leg long, and posing one
+    left the top of the thigh with the torso. woody's legs run up into his chest, far above his hip joints. The
+    thigh begins at the hip joint, up or down the skeleton's leg."""
     vertices, triangles = load_obj(shared_path("models", "nogt", f"{name}.obj"))
     skeleton = rigger.rig_mesh(vertices, triangles)
     fit = fit_metarig(skeleton, (vertices, triangles), "basic_human", metarigs["basic_human"])

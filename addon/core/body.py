@@ -294,8 +294,9 @@ class Body:
     (joints along the midline's longest path), the ``limbs`` with the spine joint each hangs from (``bases``; through
     ``connectors``, midline joints off the spine, each with the spine joint it leaves), the ``radius`` (local
     half-thickness of the mesh) at each joint, each limb's ``flatness`` (the mesh around it: thin across over wide
-    across, 1 for a round limb, near 0 for a wing or a fin; 1 on a flat mesh) and how up was found
-    (``up_evidence``: "legs", "flat" or "preferred")."""
+    across, 1 for a round limb, near 0 for a wing or a fin; 1 on a flat mesh), how up was found
+    (``up_evidence``: "legs", "flat" or "preferred") and the ``midsection``: the mesh cut by the mirror plane, as
+    (S, 2, 3) segments (none without a plane)."""
 
     graph: JointGraph
     size: float
@@ -311,6 +312,7 @@ class Body:
     radius: np.ndarray
     flatness: tuple
     up_evidence: str
+    midsection: np.ndarray
 
     def height(self, points):
         """Height above the mesh's lowest point, as a share of the mesh's height."""
@@ -348,7 +350,30 @@ def read_body(skeleton, mesh, tuning=BodyTuning(), plane=None, prefer_up=AXES[2]
         flatness = tuple(_flatness(limb, graph, vertices, segments, nearest, (tuning.blade_from, tuning.blade_to))
                          for limb in limbs)
     return Body(graph, size, up, float(heights.min()), float(heights.max()), found, vertices, tuple(spine),
-                tuple(limbs), bases, connectors, radius, flatness, up_evidence)
+                tuple(limbs), bases, connectors, radius, flatness, up_evidence, _section(mesh, found))
+
+
+def _section(mesh, plane):
+    """The (S, 2, 3) segments where ``mesh``'s triangles meet ``plane`` (none without one): each triangle with
+    corners on both sides, or with an edge on it, gives the points where its edges cross it or lie on it."""
+    if plane is None:
+        return np.zeros((0, 2, 3))
+    corners = mesh.vertices[mesh.triangles]  # (T, 3, 3)
+    offsets = plane.distance(corners)
+    ends = np.full((len(corners), 3, 3), np.nan)
+    for k in range(3):
+        a, b = offsets[:, k], offsets[:, (k + 1) % 3]
+        crossing = a * b < 0
+        share = np.where(crossing, a / np.where(crossing, a - b, 1.0), 0.0)
+        point = corners[:, k] + share[:, None] * (corners[:, (k + 1) % 3] - corners[:, k])
+        ends[:, k] = np.where((crossing | (a == 0))[:, None], point, np.nan)
+    found = ~np.isnan(ends[:, :, 0])
+    meets = found.sum(axis=1) >= 2
+    if not meets.any():
+        return np.zeros((0, 2, 3))
+    ends, found = ends[meets], found[meets]
+    order = np.argsort(~found, axis=1, kind="stable")[:, :2]  # the first two points found on each
+    return np.take_along_axis(ends, order[:, :, None], axis=1)
 
 
 def _sampled(rows, count):

@@ -29,7 +29,8 @@ The naming scheme (one for every body plan; the README says the same for users):
 
 Each bone with a Mixamo name begins at its role's named joint (``core.roles.named_joints``: a knee where the artists'
 rigs have it, which may lie inside a bone of Rigger's) when it lies near (``core.roles.within_reach``; a thigh's or
-upper arm's up the Rigger bone the limb hangs from counts as near), the bones ending there moved with it.
+upper arm's up the Rigger bone the limb hangs from, or down its own, counts as near), the bones ending there moved
+with it.
 
 The hierarchy is Rigger's read from the hips outwards (Rigger may root a quadruped at its neck): a chain hangs from the
 game bone that holds the joint it starts from, else the nearest joint on its way to the hips. Twins hang from one bone
@@ -419,7 +420,7 @@ class _Bones:
         """Move the head of each first bone of a Mixamo name to its role's named joint, with the bones of its side
         ending there (siblings starting there have joints of their own; a sided branch off a midline bone leaves that
         bone's end on the midline), when it is within reach (``core.roles.within_reach``)."""
-        for bone in self.bones:
+        for index, bone in enumerate(self.bones):
             role = bone["role"]
             key = (role.role, role.side, None)
             if bone["number"] or bone["suffix"] or role.index or key not in self.joints:
@@ -430,7 +431,8 @@ class _Bones:
             limb_start = role.role in LIMB_STARTS
             start = bone["start"]
             if limb_start and start is not None and np.linalg.norm(self.graph.points[start] - old) <= tolerance:
-                ends += [self.graph.points[node] for node, _ in self.graph.neighbours[start]]  # Rigger's bones there
+                ends += [self.graph.points[node] for node, edge in self.graph.neighbours[start]
+                         if self.edge_owner.get(edge) != index]  # Rigger's bones there, but those the bone holds
             if not within_reach(old, new, ends, limb_start=limb_start):
                 continue
             bone["head"] = new.copy()

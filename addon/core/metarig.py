@@ -22,7 +22,7 @@ How the bones are placed, in order:
 - On that path, a metarig joint between bones of two roles sits where the skeleton's next role begins (a knee where
   the shin begins), or where the one before ends when the next is missing; where the role has a named joint
   (``core.roles.named_joints``) the joint sits at the path's point nearest it, and on it when that is within reach
-  (``core.roles.within_reach``: a hip joint beside the path, or up the skeleton's bone the leg hangs from); the
+  (``core.roles.within_reach``: a hip joint beside the path, up the bone the leg hangs from or down its own); the
   other joints divide the stretch between such joints in the metarig's own proportions and move onto a skeleton
   joint near them (the skeleton's joints sit where the mesh bends): a skeleton without a toe gets its foot split at
   the metarig's ball. A chain whose last roles the skeleton lacks goes on to where the mesh ends ahead of it, when
@@ -613,8 +613,10 @@ def _joints(body, groups, points, arc, step_roles, lengths, tuning, named=None, 
     for k, joint in ends.items():
         beside = placed[[i for i in (k - 1, k + 1) if 0 <= i < len(placed)]]
         limb_start = k == 0 and groups[0][0] in LIMB_STARTS
-        if limb_start:  # the skeleton's bones meeting there count (a leg's hips bone above its thigh)
-            beside = np.vstack([beside, body.meeting(placed[k])])
+        if limb_start:  # the skeleton's bones meeting there count (a leg's hips bone above its thigh), not the limb's
+            meeting = body.meeting(placed[k])
+            own = np.linalg.norm(meeting[:, None] - points[None], axis=2).min(axis=1) <= tuning.merge * body.size
+            beside = np.vstack([beside, meeting[~own]])
         if joint is not None and within_reach(placed[k], joint, beside, limb_start=limb_start):
             placed[k] = joint
     return body.local(placed)

@@ -20,7 +20,8 @@ Roles are whole bones; named joints are points (:func:`named_joints`: where each
 digit): point}``), placed along the chains where the artists' rigs have them rather than at the nearest bone end
 (:func:`joint_places`, at recognition, stored in ``BodyPlan.joints``): on a leg the ankle where it comes down to
 ``ankle_height``, the hip joint at ``hip_rise`` of the height from there to where the leg hangs (on the thigh's line
-when the thigh stands upright; a front leg's shoulder joint no higher than where its upper arm's bones begin), the
+when the thigh stands upright; a front leg's shoulder joint no higher than where its upper arm's bones begin; a
+humanoid's no higher above its crotch than the leg lies off the mirror plane there), the
 knee ``knee_at`` of the way between (a bend there, below where the thigh's bones begin, winning) and the ball of
 the foot ``toe_at`` of the way to the toes' tip; on an arm the shoulder joint where the arm leaves the torso, the
 elbow and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the hand (the mesh beyond the
@@ -693,7 +694,8 @@ def joint_places(skeleton, body, layout, paths, tuning=RoleTuning()):
         side = _limb_side(skeleton, graph, limb, left)
         path = paths[k]
         arc = arc_lengths(path.points)
-        found = _leg_places(body, path, arc, layout.front[k], tuning) if part == "leg" else \
+        crotch = _crotch(body, path, tuning) if part == "leg" and layout.plan.kind == "humanoid" else None
+        found = _leg_places(body, path, arc, layout.front[k], tuning, crotch) if part == "leg" else \
             _arm_places(body, limb, path, arc, tuning)
         for role, spots in found.items():
             places[(role, side, None)] = _on_bones(graph, ends, list(limb.main), arc, spots)
@@ -783,10 +785,13 @@ def _down_to(heights, arc, level):
     return float(arc[i - 1] + (arc[i] - arc[i - 1]) * (heights[i - 1] - level) / max(drop, 1e-300))
 
 
-def _leg_places(body, path, arc, front, tuning):
+def _leg_places(body, path, arc, front, tuning, crotch=None):
     """{role: spots} along a leg's path: the ankle where it comes down to ``ankle_height``, the hip joint at
-    ``hip_rise`` of the height from the ankle to where the leg hangs (a front leg's shoulder joint no higher than
-    where its path turns down, :func:`_thigh_start`: a bear's runs along its shoulder blade first), on the line of
+    ``hip_rise`` of the height from the ankle to where the leg hangs (with a ``crotch``, a height, no higher above it
+    than the leg lies off the mirror plane where it comes down to it: a gingerbread man's legs hang from the middle
+    of his chest, a heavy golem's stubby legs stand wide apart under a belly that hides his thighs; a front leg's
+    shoulder joint no higher than where its path turns down, :func:`_thigh_start`: a bear's runs along its shoulder
+    blade first), on the line of
     the thigh when that stands within ``thigh_lean`` of up (the path from the knee halfway up to the hip, carried on
     up: the path may reach the hip slanting in from the body's middle; a bent hind leg's thigh line leads
     elsewhere), the knee at ``knee_at`` of the way between (a bend near there, below where the thigh's bones begin,
@@ -796,6 +801,9 @@ def _leg_places(body, path, arc, front, tuning):
     ankle = _down_to(heights, arc, tuning.ankle_height)
     ankle_height = float(np.interp(ankle, arc, heights))
     hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
+    if crotch is not None:  # no higher above the crotch than the leg, where it leaves the body, lies off the plane
+        beside = abs(float(body.plane.distance(_along(points, arc, _down_to(heights, arc, crotch)))))
+        hip_height = min(hip_height, crotch + beside / (body.high - body.low))
     hip = _down_to(heights, arc, hip_height)
     thigh_from = float(arc[_thigh_start(body, points, tuning)])  # above, the path runs in the body
     if front and thigh_from < ankle:  # no higher than where the upper arm's bones begin (a bear's blade)
@@ -818,6 +826,34 @@ def _leg_places(body, path, arc, front, tuning):
     if heel is not None:
         places["heel"] = heel
     return places
+
+
+def _crotch(body, path, tuning):
+    """The height (a share of the mesh's) of the crotch beside a leg: the lowest point, above the ankles and below
+    where the leg hangs, where the mesh's cut by the mirror plane (``Body.midsection``) comes within the leg's
+    half-width of the upright line on the plane level with the leg; None when it comes nowhere near (a dress open
+    below, a body without a plane)."""
+    section = body.midsection
+    if not len(section):
+        return None
+    forward = np.cross(body.plane.normal, body.up)
+    forward /= np.linalg.norm(forward)
+    along = section @ forward - float(np.mean(path.points @ forward))  # (S, 2): off the line, along the body
+    heights = body.height(section)
+    reach = float(np.median(path.radius))
+    step = along[:, 1] - along[:, 0]
+    flat = np.abs(step) < 1e-12
+    safe = np.where(flat, 1.0, step)
+    low = np.where(flat, 0.0, np.minimum((-reach - along[:, 0]) / safe, (reach - along[:, 0]) / safe))
+    high = np.where(flat, 1.0, np.maximum((-reach - along[:, 0]) / safe, (reach - along[:, 0]) / safe))
+    near = ~flat | (np.abs(along[:, 0]) <= reach)
+    low, high = np.clip(low, 0.0, 1.0), np.clip(high, 0.0, 1.0)
+    near &= low < high
+    rise = heights[:, 1] - heights[:, 0]
+    lowest = heights[:, 0] + rise * np.where(rise > 0, low, high)  # the clipped piece's lowest end
+    leg = body.height(path.points)
+    candidates = lowest[near & (lowest > tuning.ankle_height) & (lowest < leg[0])]
+    return float(candidates.min()) if len(candidates) else None
 
 
 def _heel(body, points, arc, knee, ankle, tip, tuning):
