@@ -260,6 +260,23 @@ def test_a_thigh_starts_at_the_hip_joint_wherever_the_skeleton_s_leg_began(name)
         assert bones.tails[thigh] == pytest.approx(bones.heads[bones.names.index(f"{word}Leg")])
 
 
+def test_a_short_torso_s_spine_runs_up_from_the_hips_below_where_the_legs_hang_and_carries_the_arms():
+    """woody's legs and arms all leave one junction of his skeleton, at 0.56 of his height, in his chest. The game's
+    Hips began there and his arms hung from it: twisting his spine left his arms be. His Hips begin at the hips
+    joint below, his spine runs up through the junction, his arms hang from it and his legs from the Hips."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "woody.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    joints, bones = named_joints(skeleton), game_skeleton(skeleton, vertices).skeleton
+    names, up = list(bones.names), np.asarray(skeleton.body_plan.up)
+    hips = names.index("Hips")
+    assert bones.heads[hips] == pytest.approx(joints[("hips", None, None)])
+    for side in ("Left", "Right"):
+        shoulder = names.index(f"{side}Shoulder")
+        assert names[bones.parents[shoulder]].startswith("Spine")
+        assert bones.heads[hips] @ up < bones.heads[shoulder] @ up - 0.1 * np.ptp(vertices @ up)
+        assert names[bones.parents[names.index(f"{side}UpLeg")]] == "Hips"
+
+
 def test_a_leg_too_short_to_bend_gets_a_shin_from_its_knee():
     """cheburashka's stubby legs are one thigh bone each down to the ankle: the game rig had an UpLeg and nothing
     below, warned of the missing Leg and Foot, and no motion could walk it. The thigh is split at the named knee;

@@ -5,7 +5,8 @@ The naming scheme (one for every body plan; the README says the same for users):
 
 - ``root``: the hierarchy's single root, on the ground under the hips (the mesh's lowest point along the plan's up),
   pointing up; it deforms nothing. ``Hips`` hangs from it and everything else from ``Hips``.
-- The trunk, from the hips joint (where the legs hang) to where the neck begins: ``Hips`` up to the spine joint (the
+- The trunk, from the hips joint (where the legs hang; the named hips joint when that lies lower, in a short torso
+  whose legs and arms all leave one joint high in it) to where the neck begins: ``Hips`` up to the spine joint (the
   named joint where the ``spine`` role begins), then ``Spine``, ``Spine1``, ``Spine2``, the last from the chest joint
   (where ``chest`` begins). A missing joint is put where Mixamo's humanoids have it: the spine joint at ``SPINE_AT``
   and the chest joint at ``CHEST_AT`` of the trunk's length; ``Spine1`` halfway between them.
@@ -321,9 +322,14 @@ class _Bones:
         """Hips, Spine, Spine1, Spine2 along the trunk chain (see the module docstring)."""
         graph, roles = self.graph, self.graph.skeleton.roles
         points = graph.points[chain.nodes]
+        role_at = [roles[graph.edges[edge][2]].role if graph.edges[edge][2] >= 0 else None for edge in chain.edges]
+        hips = self.joints.get(("hips", None, None))
+        up = np.asarray(graph.skeleton.body_plan.up, dtype=np.float64)
+        lower = hips is not None and (points[0] - hips) @ up > MERGE_TOLERANCE * graph.skeleton.extent
+        if lower:  # the legs hang from high in a short torso: the trunk begins at the hips below
+            points, role_at = np.vstack([hips, points]), [None] + role_at
         arc = arc_lengths(points)
         total = arc[-1]
-        role_at = [roles[graph.edges[edge][2]].role if graph.edges[edge][2] >= 0 else None for edge in chain.edges]
 
         def begins(names, share):
             named = next((self.joints[(name, None, None)] for name in names if (name, None, None) in self.joints),
@@ -342,11 +348,12 @@ class _Bones:
                  ("Spine2", BoneRole("chest"))]
         made = [self._add(base, None, "", at[k], at[k + 1], role, chain.nodes[0] if k == 0 else None, id(chain),
                           [], []) for k, (base, role) in enumerate(names)]
+        shift = int(lower)
         for k, edge in enumerate(chain.edges):
-            middle = 0.5 * (arc[k] + arc[k + 1])
+            middle = 0.5 * (arc[k + shift] + arc[k + shift + 1])
             self.edge_owner[edge] = made[int(np.searchsorted(cuts[1:-1], middle))]
         for k, node in enumerate(chain.nodes):  # a node at a cut holds the bone that ends there
-            self.node_owner[node] = made[min(int(np.searchsorted(cuts[1:-1], arc[k], side="left")), 3)]
+            self.node_owner[node] = made[min(int(np.searchsorted(cuts[1:-1], arc[k + shift], side="left")), 3)]
         self.hips = made[0]
 
     def chain(self, chain):
@@ -449,8 +456,8 @@ class _Bones:
         parents = []
         hips = self.hips
         for index, bone in enumerate(self.bones):
-            if bone["start"] is None:  # the next bone of a chain
-                parents.append(index - 1)
+            if bone["start"] is None or index == hips:  # the next bone of a chain; the Hips, under the root
+                parents.append(index - 1 if index != hips else -1)
                 continue
             owner = self._holder(bone["start"], arriving, index)
             if owner is None:
@@ -471,7 +478,8 @@ class _Bones:
                 if owner is not None and owner != index:
                     return owner
             node = self.graph.other_end(edge, node)
-        return None
+        owner = self.node_owner.get(node)  # the hips node, which a trunk begun below it holds
+        return owner if owner is not None and owner != index else None
 
     def owners(self, count):
         """The game bone owning each of Rigger's ``count`` bones."""
