@@ -21,9 +21,9 @@ digit): point}``), placed along the chains where the artists' rigs have them rat
 (:func:`joint_places`, at recognition, stored in ``BodyPlan.joints``): on a leg the ankle where it comes down to
 ``ankle_height``, the hip joint at ``hip_rise`` of the height from there to where the leg hangs (on the thigh's line
 when the thigh stands upright; a front leg's shoulder joint no higher than where its upper arm's bones begin; a
-humanoid's no higher above its crotch than the leg lies off the mirror plane there), the
-knee ``knee_at`` of the way between (a bend there, below where the thigh's bones begin, winning) and the ball of
-the foot ``toe_at`` of the way to the toes' tip; on an arm the shoulder joint where the arm leaves the torso, the
+humanoid's no higher above its crotch than the leg lies off the mirror plane there), the knee ``knee_at`` of the way
+between (a bend there, below where the thigh's bones begin, winning) and the ball of the foot ``toe_at`` of the way
+to the toes' tip; on an arm the shoulder joint where the arm leaves the torso, the
 elbow and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the hand (the mesh beyond the
 last joint included; a bend winning for the elbow), the collarbone's start ``clavicle_at`` of the way in; on an upright
 humanoid's spine the hips, spine, chest and neck at ``hips_at`` ... ``neck_at`` of the height from the hip joints to
@@ -791,11 +791,10 @@ def _leg_places(body, path, arc, front, tuning, crotch=None):
     than the leg lies off the mirror plane where it comes down to it: a gingerbread man's legs hang from the middle
     of his chest, a heavy golem's stubby legs stand wide apart under a belly that hides his thighs; a front leg's
     shoulder joint no higher than where its path turns down, :func:`_thigh_start`: a bear's runs along its shoulder
-    blade first), on the line of
-    the thigh when that stands within ``thigh_lean`` of up (the path from the knee halfway up to the hip, carried on
-    up: the path may reach the hip slanting in from the body's middle; a bent hind leg's thigh line leads
-    elsewhere), the knee at ``knee_at`` of the way between (a bend near there, below where the thigh's bones begin,
-    winning), the toe at ``toe_at`` of the way from the ankle to the tip."""
+    blade first), on the line of the thigh when that stands within ``thigh_lean`` of up (the path from the knee
+    halfway up to the hip, carried on up: the path may reach the hip slanting in from the body's middle; a bent hind
+    leg's thigh line leads elsewhere), the knee at ``knee_at`` of the way between (a bend near there, below where
+    the thigh's bones begin, winning), the toe at ``toe_at`` of the way from the ankle to the tip."""
     points = path.points
     heights = body.height(points)
     ankle = _down_to(heights, arc, tuning.ankle_height)
@@ -834,9 +833,9 @@ def _crotch(body, path, tuning):
     half-width of the upright line on the plane level with the leg; None when it comes nowhere near (a dress open
     below, a body without a plane)."""
     section = body.midsection
-    if not len(section):
+    forward = np.cross(body.plane.normal, body.up) if len(section) else np.zeros(3)
+    if not np.linalg.norm(forward) > 1e-9:  # no cut, or a plane across up: no line on it to look along
         return None
-    forward = np.cross(body.plane.normal, body.up)
     forward /= np.linalg.norm(forward)
     along = section @ forward - float(np.mean(path.points @ forward))  # (S, 2): off the line, along the body
     heights = body.height(section)
