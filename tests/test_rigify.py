@@ -244,6 +244,18 @@ def test_a_thigh_starts_at_the_hip_joint_wherever_the_skeleton_s_leg_began(metar
         assert np.linalg.norm(fit.frame @ fit.heads[f"thigh.{side}"] - hip) < 1e-3 * size
 
 
+def test_a_short_torso_s_spine_starts_at_the_hips_below_where_the_legs_hang(metarigs):
+    """woody's legs and arms all leave one joint of his skeleton, at 0.56 of his height, in his chest: Rigify's spine
+    began there, no spine bone below it and his hips control at his chest. It begins at the hips' named joint."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "woody.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    fit = fit_metarig(skeleton, (vertices, triangles), "basic_human", metarigs["basic_human"])
+    joints, size = named_joints(skeleton), float(np.ptp(vertices, axis=0).max())
+    assert np.linalg.norm(fit.frame @ fit.heads["spine"] - joints[("hips", None, None)]) < 1e-3 * size
+    up = np.asarray(skeleton.body_plan.up)
+    assert fit.frame @ fit.heads["spine"] @ up < fit.frame @ fit.heads["upper_arm.L"] @ up - 0.1 * size
+
+
 def test_a_hind_leg_bends_at_its_hock_where_the_skeleton_does(metarigs):
     """The fox's hind leg bends back at its hock, high above the paw, but its roles start the foot near the ground:
     Rigify's shin ran straight from the knee to the paw, most of it outside the leg, and a paw lifted by IK moved

@@ -18,7 +18,9 @@ How the bones are placed, in order:
   sides swapped: Rigify's ``.L`` bones go on the character's left.
 - Chains: each :class:`Chain` of a metarig is a run of its bones with the roles each takes. The skeleton's bones of
   those roles (of that side; fingers of that digit) form a path, ordered from the body outwards; where the path has
-  branches or pieces, the longest piece (on the chain's side, the one farthest out on it) is taken.
+  branches or pieces, the longest piece (on the chain's side, the one farthest out on it) is taken. The torso's path
+  begins at the hips' named joint when that lies lower (a short torso whose legs and arms all leave one joint high
+  in it).
 - On that path, a metarig joint between bones of two roles sits where the skeleton's next role begins (a knee where
   the shin begins), or where the one before ends when the next is missing; where the role has a named joint
   (``core.roles.named_joints``) the joint sits at the path's point nearest it, and on it when that is within reach
@@ -505,6 +507,10 @@ def _fit_chain(body, chain, side, names, meta, tuning):
             rank.setdefault(role, index + offset / len(group))
     points, steps = body.path(bones, lambda bone: rank[body.roles[bone].role], skeleton_side)
     step_roles = [body.roles[bone].role for bone in steps]
+    hips = body.joints.get(("hips", None, None)) if groups[0][0] == "hips" and side is None else None
+    if hips is not None and (points[0] - hips) @ body.up > tuning.merge * body.size:
+        points = np.vstack([hips, points])  # a short torso whose legs and arms leave one joint high in it
+        step_roles = ["hips"] + step_roles
     if groups[0] == ("palm",):
         wrist = _wrist(body, skeleton_side, points[0])
         if wrist is None:
