@@ -185,6 +185,30 @@ def test_a_gingerbread_man_s_legs_hang_from_his_hips_not_his_chest():
     assert joints[("hips", None, None)][2] < joints[("upper_arm", "L", None)][2] - 0.1 * height
 
 
+def test_feet_meeting_under_a_big_headed_figure_are_no_crotch():
+    """cheburashka's big feet meet under him, just above his ankles' height: read as his crotch, it pulled his hip
+    joints down his short legs and his knees to within 0.035 of his height of his ankles (the retargeted walk's knees
+    then bent backwards in some frames). A crotch lies above the ankles."""
+    vertices, triangles, _, _ = load_blender_frame("cheburashka")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    joints, height = named_joints(skeleton), np.ptp(vertices[:, 2])
+    for side in "LR":
+        assert joints[("shin", side, None)][2] - joints[("foot", side, None)][2] > 0.045 * height
+
+
+def test_a_gingerbread_man_s_head_sits_on_the_joint_his_arms_and_legs_leave():
+    """woody's arms and legs all leave one joint, at 0.56 of his height: his trunk's first bones above it were
+    read as his torso, up into his round head, and his head began at 0.83, at his eyes. A cut-out's half-width is
+    the distance to its outline (the nearest vertex may lie anywhere on the sheet): his neck is the narrowing under
+    his head, at 0.69, and his head begins there."""
+    vertices, triangles, _, _ = load_blender_frame("woody")
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    height = np.ptp(vertices[:, 2])
+    head = (named_joints(skeleton)[("head", None, None)][2] - vertices[:, 2].min()) / height
+    assert 0.66 < head < 0.72
+    assert [role.role for role in skeleton.roles if role.side is None][:2] == ["hips", "neck"]
+
+
 @pytest.mark.parametrize("blender", [False, True])
 def test_a_big_headed_figure_s_short_legs_and_arms_are_legs_and_arms_and_its_ears_are_ears(blender):
     """cheburashka in its file's frame (Y up) and as Blender imports it (Z up): a head as wide as the figure is tall

@@ -1,4 +1,6 @@
 """The game target's skeleton (``rigger.core.game``) and the mocap mapping (``rigger.core.retarget``), bpy-free."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -356,11 +358,15 @@ def test_a_hand_resting_on_the_hip_ends_at_its_fingertips_not_in_the_pelvis():
 
 
 def test_a_neck_running_into_a_round_head_gets_a_head():
-    """woody's neck bone runs into the middle of its round head and no bone goes on: the game rig's Head hangs from the
-    Neck's end and reaches the top of the head, as Mixamo's do."""
+    """A neck bone running into the middle of a round head with no bone going on (woody's skeleton with its head
+    bones read as neck): the game rig's Head hangs from the Neck's end and reaches the top of the head, as Mixamo's
+    do."""
     vertices, triangles = load_obj(shared_path("models", "nogt", "woody.obj"))
     skeleton = rigger.rig_mesh(vertices, triangles)
-    bones = game_skeleton(skeleton, vertices).skeleton
+    roles = [replace(role, role="neck") if role.role == "head" else role for role in skeleton.roles]
+    necked = Skeleton(skeleton.names, skeleton.heads, skeleton.tails, skeleton.parents, roles=roles,
+                      body_plan=skeleton.body_plan)
+    bones = game_skeleton(necked, vertices).skeleton
     names = list(bones.names)
     neck, head = names.index("Neck"), names.index("Head")
     assert bones.parents[head] == neck and bones.roles[head].role == "head"

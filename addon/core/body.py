@@ -293,10 +293,10 @@ class Body:
     ``high`` extent along ``up``, the mirror ``plane`` (or None), a sample of the mesh's ``vertices``, the ``spine``
     (joints along the midline's longest path), the ``limbs`` with the spine joint each hangs from (``bases``; through
     ``connectors``, midline joints off the spine, each with the spine joint it leaves), the ``radius`` (local
-    half-thickness of the mesh) at each joint, each limb's ``flatness`` (the mesh around it: thin across over wide
-    across, 1 for a round limb, near 0 for a wing or a fin; 1 on a flat mesh), how up was found
-    (``up_evidence``: "legs", "flat" or "preferred") and the ``midsection``: the mesh cut by the mirror plane, as
-    (S, 2, 3) segments (none without a plane)."""
+    half-thickness of the mesh; a flat cut-out's half-width, to its outline) at each joint, each limb's ``flatness``
+    (the mesh around it: thin across over wide across, 1 for a round limb, near 0 for a wing or a fin; 1 on a flat
+    mesh), how up was found (``up_evidence``: "legs", "flat" or "preferred") and the ``midsection``: the mesh cut by
+    the mirror plane, as (S, 2, 3) segments (none without a plane)."""
 
     graph: JointGraph
     size: float
@@ -335,7 +335,7 @@ def read_body(skeleton, mesh, tuning=BodyTuning(), plane=None, prefer_up=AXES[2]
     size = mesh.scale
     graph = joint_graph(skeleton, tuning.joint_merge * size)
     vertices = _sampled(mesh.used_vertices, tuning.sample_vertices)
-    radius = _radii(graph.points, vertices)
+    radius = _radii(graph.points, _outline(mesh) if mesh.flat_normal is not None else vertices)
     found = _mirror(skeleton, graph, mesh, size, tuning, plane)
     spine, limbs, bases, connectors = _midline_and_limbs(graph, found, size, tuning)
     limbs = _paired(limbs, graph, skeleton, found, size, tuning)
@@ -687,6 +687,17 @@ def _swapped(names):
 
 
 # The mesh around the skeleton.
+
+def _outline(mesh):
+    """The vertices on a flat mesh's open edges (those of one triangle), its outline: a cut-out's half-width at a
+    joint is the distance to it, while the nearest vertex may lie anywhere on the sheet; all its vertices when it
+    has none (a closed sheet)."""
+    triangles = mesh.triangles
+    edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]), axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    ends = np.unique(unique[counts == 1])
+    return mesh.vertices[ends] if len(ends) else mesh.used_vertices
+
 
 def _radii(points, vertices):
     """Distance from each joint to the nearest mesh vertex: the local half-thickness of a joint inside the mesh."""

@@ -2,9 +2,9 @@
 first bone), given the plan's layout of the body (``core.bodyplan``). Bones keep their names; roles sit beside them.
 
 Along the spine, from the tail end to the head end: tail (or root, a bone rising from the ground to the hips),
-hips, spine, chest up to where the arms, wings or front legs hang, then neck up to the spine's thinnest joint above
-them and head beyond (one bone there is the neck: it pivots where a neck does; a fish: head, spine and tail by
-length). A leg: hips (its bones from the mirror plane until it
+hips, spine, chest up to where the arms, wings or front legs hang (a humanoid's arms hanging where its legs do: one
+bone), then neck up to the spine's thinnest joint above them and head beyond (one bone there is the neck: it pivots
+where a neck does; a fish: head, spine and tail by length). A leg: hips (its bones from the mirror plane until it
 leaves it and turns down; shoulder for a front leg), thigh, shin from the knee (a bend near ``knee_at``, else the
 joint nearest it), foot from the joint nearest an ankle's height, and toe (the last bone when the foot has two or
 more); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up to where it leaves the torso, then
@@ -312,7 +312,12 @@ def _spine_roles(body, layout, tuning):
         return ["tail" if at < tuning.tail_share else "head" if at > 1 - tuning.head_share else "spine"
                 for at in middle]
     hips = max(layout.hips, 0)
-    chest = layout.chest if layout.chest > hips else min(count, hips + max(1, round(0.65 * (count - hips))))
+    if layout.chest > hips:
+        chest = layout.chest
+    elif kind == "humanoid":  # arms hanging where the legs do (a gingerbread man): the head sits on that joint
+        chest = min(count, hips + 1)
+    else:
+        chest = min(count, hips + max(1, round(0.65 * (count - hips))))
     names = []
     behind = arc[hips]
     if hips > 0:
@@ -694,9 +699,8 @@ def joint_places(skeleton, body, layout, paths, tuning=RoleTuning()):
         side = _limb_side(skeleton, graph, limb, left)
         path = paths[k]
         arc = arc_lengths(path.points)
-        crotch = _crotch(body, path, tuning) if part == "leg" and layout.plan.kind == "humanoid" else None
-        found = _leg_places(body, path, arc, layout.front[k], tuning, crotch) if part == "leg" else \
-            _arm_places(body, limb, path, arc, tuning)
+        found = _leg_places(body, path, arc, layout.front[k], tuning, layout.plan.kind == "humanoid") \
+            if part == "leg" else _arm_places(body, limb, path, arc, tuning)
         for role, spots in found.items():
             places[(role, side, None)] = _on_bones(graph, ends, list(limb.main), arc, spots)
     spine = list(layout.spine)
@@ -785,21 +789,22 @@ def _down_to(heights, arc, level):
     return float(arc[i - 1] + (arc[i] - arc[i - 1]) * (heights[i - 1] - level) / max(drop, 1e-300))
 
 
-def _leg_places(body, path, arc, front, tuning, crotch=None):
+def _leg_places(body, path, arc, front, tuning, humanoid=False):
     """{role: spots} along a leg's path: the ankle where it comes down to ``ankle_height``, the hip joint at
-    ``hip_rise`` of the height from the ankle to where the leg hangs (with a ``crotch``, a height, no higher above it
-    than the leg lies off the mirror plane where it comes down to it: a gingerbread man's legs hang from the middle
-    of his chest, a heavy golem's stubby legs stand wide apart under a belly that hides his thighs; a front leg's
-    shoulder joint no higher than where its path turns down, :func:`_thigh_start`: a bear's runs along its shoulder
-    blade first), on the line of the thigh when that stands within ``thigh_lean`` of up (the path from the knee
-    halfway up to the hip, carried on up: the path may reach the hip slanting in from the body's middle; a bent hind
-    leg's thigh line leads elsewhere), the knee at ``knee_at`` of the way between (a bend near there, below where
-    the thigh's bones begin, winning), the toe at ``toe_at`` of the way from the ankle to the tip."""
+    ``hip_rise`` of the height from the ankle to where the leg hangs (a ``humanoid``'s no higher above its crotch,
+    :func:`_crotch`, than the leg lies off the mirror plane where it comes down to it: a gingerbread man's legs hang
+    from the middle of his chest, a heavy golem's stubby legs stand wide apart under a belly that hides his thighs;
+    a front leg's shoulder joint no higher than where its path turns down, :func:`_thigh_start`: a bear's runs along
+    its shoulder blade first), on the line of the thigh when that stands within ``thigh_lean`` of up (the path from
+    the knee halfway up to the hip, carried on up: the path may reach the hip slanting in from the body's middle; a
+    bent hind leg's thigh line leads elsewhere), the knee at ``knee_at`` of the way between (a bend near there, below
+    where the thigh's bones begin, winning), the toe at ``toe_at`` of the way from the ankle to the tip."""
     points = path.points
     heights = body.height(points)
     ankle = _down_to(heights, arc, tuning.ankle_height)
     ankle_height = float(np.interp(ankle, arc, heights))
     hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
+    crotch = _crotch(body, path, ankle_height) if humanoid else None
     if crotch is not None:  # no higher above the crotch than the leg, where it leaves the body, lies off the plane
         beside = abs(float(body.plane.distance(_along(points, arc, _down_to(heights, arc, crotch)))))
         hip_height = min(hip_height, crotch + beside / (body.high - body.low))
@@ -827,11 +832,11 @@ def _leg_places(body, path, arc, front, tuning, crotch=None):
     return places
 
 
-def _crotch(body, path, tuning):
-    """The height (a share of the mesh's) of the crotch beside a leg: the lowest point, above the ankles and below
-    where the leg hangs, where the mesh's cut by the mirror plane (``Body.midsection``) comes within the leg's
-    half-width of the upright line on the plane level with the leg; None when it comes nowhere near (a dress open
-    below, a body without a plane)."""
+def _crotch(body, path, ankle):
+    """The height (a share of the mesh's) of the crotch beside a leg: the lowest point, above its ``ankle`` (a height:
+    feet meeting under a big-headed figure are no crotch) and below where the leg hangs, where the mesh's cut by the
+    mirror plane (``Body.midsection``) comes within the leg's half-width of the upright line on the plane level with
+    the leg; None when it comes nowhere near (a dress open below, a body without a plane)."""
     section = body.midsection
     forward = np.cross(body.plane.normal, body.up) if len(section) else np.zeros(3)
     if not np.linalg.norm(forward) > 1e-9:  # no cut, or a plane across up: no line on it to look along
@@ -851,7 +856,7 @@ def _crotch(body, path, tuning):
     rise = heights[:, 1] - heights[:, 0]
     lowest = heights[:, 0] + rise * np.where(rise > 0, low, high)  # the clipped piece's lowest end
     leg = body.height(path.points)
-    candidates = lowest[near & (lowest > tuning.ankle_height) & (lowest < leg[0])]
+    candidates = lowest[near & (lowest > ankle) & (lowest < leg[0])]
     return float(candidates.min()) if len(candidates) else None
 
 
