@@ -358,8 +358,9 @@ def _section(mesh, plane):
     corners on both sides, or with an edge on it, gives the points where its edges cross it or lie on it."""
     if plane is None:
         return np.zeros((0, 2, 3))
-    corners = mesh.vertices[mesh.triangles]  # (T, 3, 3)
-    offsets = plane.distance(corners)
+    offsets = plane.distance(mesh.vertices)[mesh.triangles]
+    touching = (offsets.min(axis=1) <= 0) & (offsets.max(axis=1) >= 0)
+    corners, offsets = mesh.vertices[mesh.triangles[touching]], offsets[touching]  # (T, 3, 3), (T, 3)
     ends = np.full((len(corners), 3, 3), np.nan)
     for k in range(3):
         a, b = offsets[:, k], offsets[:, (k + 1) % 3]
