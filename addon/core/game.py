@@ -5,8 +5,8 @@ The naming scheme (one for every body plan; the README says the same for users):
 
 - ``root``: the hierarchy's single root, on the ground under the hips (the mesh's lowest point along the plan's up),
   pointing up; it deforms nothing. ``Hips`` hangs from it and everything else from ``Hips``.
-- The trunk, from the hips joint (where the legs hang; the named hips joint when that lies lower, in a short torso
-  whose legs and arms all leave one joint high in it) to where the neck begins: ``Hips`` up to the spine joint (the
+- The trunk, from the hips joint (where the legs hang; the named hips joint when that lies lower,
+  ``core.roles.hips_below``) to where the neck begins: ``Hips`` up to the spine joint (the
   named joint where the ``spine`` role begins), then ``Spine``, ``Spine1``, ``Spine2``, the last from the chest joint
   (where ``chest`` begins). A missing joint is put where Mixamo's humanoids have it: the spine joint at ``SPINE_AT``
   and the chest joint at ``CHEST_AT`` of the trunk's length; ``Spine1`` halfway between them.
@@ -45,7 +45,7 @@ import numpy as np
 from .facing import facing, foot_ahead
 from .mesh import validated_vertices
 from .polyline import arc_lengths, arc_nearest, point_at, segment_distances
-from .roles import LIMB_STARTS, BoneRole, landmarks, named_joints, within_reach
+from .roles import LIMB_STARTS, BoneRole, hips_below, landmarks, named_joints, within_reach
 from .skeleton import Skeleton
 
 ROOT = "root"
@@ -323,10 +323,10 @@ class _Bones:
         graph, roles = self.graph, self.graph.skeleton.roles
         points = graph.points[chain.nodes]
         role_at = [roles[graph.edges[edge][2]].role if graph.edges[edge][2] >= 0 else None for edge in chain.edges]
-        hips = self.joints.get(("hips", None, None))
-        up = np.asarray(graph.skeleton.body_plan.up, dtype=np.float64)
-        lower = hips is not None and (points[0] - hips) @ up > MERGE_TOLERANCE * graph.skeleton.extent
-        if lower:  # the legs hang from high in a short torso: the trunk begins at the hips below
+        hips = hips_below(self.joints, points[0], np.asarray(graph.skeleton.body_plan.up, dtype=np.float64),
+                          MERGE_TOLERANCE * graph.skeleton.extent)
+        lower = hips is not None
+        if lower:
             points, role_at = np.vstack([hips, points]), [None] + role_at
         arc = arc_lengths(points)
         total = arc[-1]

@@ -19,8 +19,7 @@ How the bones are placed, in order:
 - Chains: each :class:`Chain` of a metarig is a run of its bones with the roles each takes. The skeleton's bones of
   those roles (of that side; fingers of that digit) form a path, ordered from the body outwards; where the path has
   branches or pieces, the longest piece (on the chain's side, the one farthest out on it) is taken. The torso's path
-  begins at the hips' named joint when that lies lower (a short torso whose legs and arms all leave one joint high
-  in it).
+  begins at the hips' named joint when that lies lower (``core.roles.hips_below``).
 - On that path, a metarig joint between bones of two roles sits where the skeleton's next role begins (a knee where
   the shin begins), or where the one before ends when the next is missing; where the role has a named joint
   (``core.roles.named_joints``) the joint sits at the path's point nearest it, and on it when that is within reach
@@ -60,7 +59,7 @@ import numpy as np
 
 from .facing import TORSO, bones_middle, facing, foot_ahead, role_bones
 from .polyline import arc_lengths, arc_nearest, point_at
-from .roles import CHAINS, LIMB_STARTS, BoneRole, RoleTuning, mesh_reach, named_joints, within_reach
+from .roles import CHAINS, LIMB_STARTS, BoneRole, RoleTuning, hips_below, mesh_reach, named_joints, within_reach
 from .rotations import about, between
 from .tuning import TuningTable, tuned
 
@@ -507,10 +506,10 @@ def _fit_chain(body, chain, side, names, meta, tuning):
             rank.setdefault(role, index + offset / len(group))
     points, steps = body.path(bones, lambda bone: rank[body.roles[bone].role], skeleton_side)
     step_roles = [body.roles[bone].role for bone in steps]
-    hips = body.joints.get(("hips", None, None)) if groups[0][0] == "hips" and side is None else None
-    if hips is not None and (points[0] - hips) @ body.up > tuning.merge * body.size:
-        points = np.vstack([hips, points])  # a short torso whose legs and arms leave one joint high in it
-        step_roles = ["hips"] + step_roles
+    hips = hips_below(body.joints, points[0], body.up, tuning.merge * body.size) \
+        if groups[0][0] == "hips" and side is None else None
+    if hips is not None:
+        points, step_roles = np.vstack([hips, points]), ["hips"] + step_roles
     if groups[0] == ("palm",):
         wrist = _wrist(body, skeleton_side, points[0])
         if wrist is None:

@@ -582,6 +582,14 @@ def within_reach(joint, named, ends, tuning=RoleTuning(), limb_start=False):
                for end, length in zip(ends, lengths))
 
 
+def hips_below(joints, start, up, tolerance):
+    """The hips' named joint in ``joints`` when it lies lower along ``up`` than a target's trunk ``start`` (by more
+    than ``tolerance``), else None: a short torso whose legs and arms all leave one joint high in it (a gingerbread
+    man) has its hips below that joint, and the target's trunk begins there."""
+    hips = joints.get(("hips", None, None))
+    return hips if hips is not None and (np.asarray(start) - hips) @ up > tolerance else None
+
+
 def named_joints(skeleton, roles=None):
     """{(role, side, digit): point}: where each role begins on ``skeleton``. With its own roles (``roles`` None, or
     equal to them) the places its body plan found (``BodyPlan.joints``, see the module docstring); else, and for
