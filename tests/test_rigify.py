@@ -253,6 +253,8 @@ def test_a_short_torso_s_spine_starts_at_the_hips_below_where_the_legs_hang(meta
     joints, size = named_joints(skeleton), float(np.ptp(vertices, axis=0).max())
     up = np.asarray(skeleton.body_plan.up)  # the spine's head on the midline, level with the hips' joint
     assert abs((fit.frame @ fit.heads["spine"] - joints[("hips", None, None)]) @ up) < 1e-3 * size
+    torso = [fit.frame @ fit.heads[name] @ up for name in ("spine", "spine.001", "spine.002", "spine.003", "spine.004")]
+    assert torso == sorted(torso)  # up from the hips to the neck, not back down the one bone above the joint
     assert fit.frame @ fit.heads["spine"] @ up < fit.frame @ fit.heads["upper_arm.L"] @ up - 0.1 * size
 
 

@@ -506,9 +506,12 @@ def _fit_chain(body, chain, side, names, meta, tuning):
             rank.setdefault(role, index + offset / len(group))
     points, steps = body.path(bones, lambda bone: rank[body.roles[bone].role], skeleton_side)
     step_roles = [body.roles[bone].role for bone in steps]
-    hips = hips_below(body.joints, points[0], body.up, tuning.merge * body.size) \
+    heights = points @ body.up
+    hips = hips_below(body.joints, points[np.argmin(heights)], body.up, tuning.merge * body.size) \
         if groups[0][0] == "hips" and side is None else None
     if hips is not None:
+        if heights[-1] < heights[0]:  # a torso of one bone may read either way: up from the hips
+            points, step_roles = points[::-1], step_roles[::-1]
         points, step_roles = np.vstack([hips, points]), ["hips"] + step_roles
     if groups[0] == ("palm",):
         wrist = _wrist(body, skeleton_side, points[0])
