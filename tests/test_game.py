@@ -279,6 +279,21 @@ def test_a_short_torso_s_spine_runs_up_from_the_hips_below_where_the_legs_hang_a
         assert names[bones.parents[names.index(f"{side}UpLeg")]] == "Hips"
 
 
+def test_a_leg_s_shin_begins_at_its_knee_not_at_a_turn_of_its_trousers_hem():
+    """rignet_smith's trouser hem zigzags his leg's path just above the ankle. Seen from the leg's first and last
+    joints that turn was taken for his knee: the game's Leg began at the hem, 0.12 of his height, while the knee's
+    named joint lies at 0.22 (the artist's at 0.24). A leg's shin begins at the joint nearest the knee's place."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_smith", "rignet_smith.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    joints, bones = named_joints(skeleton), game_skeleton(skeleton, vertices).skeleton
+    up = np.asarray(skeleton.body_plan.up)
+    low, height = float((vertices @ up).min()), float(np.ptp(vertices @ up))
+    for side, word in (("L", "Left"), ("R", "Right")):
+        knee = bones.heads[bones.names.index(f"{word}Leg")]
+        assert np.linalg.norm(knee - joints[("shin", side, None)]) < 0.01 * height
+        assert (knee @ up - low) / height > 0.18
+
+
 def test_a_leg_too_short_to_bend_gets_a_shin_from_its_knee():
     """cheburashka's stubby legs are one thigh bone each down to the ankle: the game rig had an UpLeg and nothing
     below, warned of the missing Leg and Foot, and no motion could walk it. The thigh is split at the named knee;

@@ -5,8 +5,8 @@ Along the spine, from the tail end to the head end: tail (or root, a bone rising
 hips, spine, chest up to where the arms, wings or front legs hang (a humanoid's arms hanging where its legs do: one
 bone), then neck up to the spine's thinnest joint above them and head beyond (one bone there is the neck: it pivots
 where a neck does; a fish: head, spine and tail by length). A leg: hips (its bones from the mirror plane until it
-leaves it and turns down; shoulder for a front leg), thigh, shin from the knee (a bend near ``knee_at``, else the
-joint nearest it), foot from the joint nearest an ankle's height, and toe (the last bone when the foot has two or
+leaves it and turns down; shoulder for a front leg), thigh, shin from the joint nearest the knee's named place
+(below), foot from the joint nearest an ankle's height, and toe (the last bone when the foot has two or
 more); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up to where it leaves the torso, then
 upper_arm, forearm and hand by shares of the rest of its reach where the artists' humanoids have an elbow and a
 wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the one that leaves earliest
@@ -174,7 +174,8 @@ def assign_roles(skeleton, body, layout, paths, tuning=RoleTuning()):
         part = layout.parts[k]
         path = paths[k]
         if part == "leg":
-            _leg(body, limb, path.points, layout.front[k], tuning, lambda nodes, names: put(nodes, names, side))
+            _leg(body, limb, path, layout.front[k], layout.plan.kind == "humanoid", tuning,
+                 lambda nodes, names: put(nodes, names, side))
         elif part == "arm":
             _arm(body, limb, path, tuning, lambda nodes, names: put(nodes, names, side))
         elif part == "wing":  # its bones in the body are a shoulder, as an arm's: the wing turns where it leaves
@@ -356,18 +357,21 @@ def _connector_role(spine, names, base):
 
 # Limbs.
 
-def _leg(body, limb, points, front, tuning, put):
-    """Roles along a leg's main path (``points``): hips (or shoulder), thigh, shin, foot, toe (front legs: shoulder,
-    upper_arm, forearm, hand)."""
-    nodes = list(limb.main)
+def _leg(body, limb, path, front, humanoid, tuning, put):
+    """Roles along a leg's main ``path``: hips (or shoulder), thigh, shin, foot, toe (front legs: shoulder,
+    upper_arm, forearm, hand); the shin from the joint nearest the knee's named place (:func:`_leg_places`)."""
+    nodes, points = list(limb.main), path.points
     last = len(nodes) - 1
     thigh = _thigh_start(body, points, tuning)
     heights = body.height(points)
     low = [i for i in range(thigh + 2, last + 1) if heights[i] <= tuning.foot_height]
     ankle = min(low, key=lambda i: abs(heights[i] - tuning.ankle_height)) if low else last
     toe = last - 1 if last - ankle >= 2 else last
-    knee = _pick(points, thigh + 1, ankle - 1, tuning.knee_at, tuning, thigh, ankle) if ankle - thigh >= 2 \
-        else ankle
+    knee = ankle
+    if ankle - thigh >= 2:
+        arc = arc_lengths(points)
+        at = _leg_places(body, path, arc, front, tuning, humanoid)["forearm" if front else "shin"][0][0]
+        knee = min(range(thigh + 1, ankle), key=lambda i: abs(arc[i] - at))
     names = (["shoulder", "upper_arm", "forearm", "hand", "hand"] if front else
              ["hips", "thigh", "shin", "foot", "toe"])
     roles = _segments(names, [thigh, knee, ankle, toe, last])
