@@ -361,7 +361,8 @@ def _weigh_idle_bones(mesh_obj, armature_obj, bone_names, bones, weld, report):
     idle = np.setdiff1d(np.arange(count), dominant)
     if not len(idle):
         return
-    joined = {bone: _joined(armature_obj, bone_names, bone) for bone in idle.tolist()}
+    index = {name: k for k, name in enumerate(bone_names)}
+    joined = {bone: _joined(armature_obj, bone_names, index, bone) for bone in idle.tolist()}
     near = np.flatnonzero(np.isin(dominant, np.concatenate(list(joined.values()))))  # welded vertices to weigh
     joins = np.zeros((len(near), count), dtype=bool)  # the idle bones joined to each one's dominant bone (or it)
     for bone, others in joined.items():
@@ -390,10 +391,9 @@ def _weigh_idle_bones(mesh_obj, armature_obj, bone_names, bones, weld, report):
     report.stages.append(stage)
 
 
-def _joined(armature_obj, bone_names, bone):
-    """Indices (into ``bone_names``, the deforming bones) of ``bone`` and of the deforming bones it joins: its
-    parent and its children."""
-    index = {name: k for k, name in enumerate(bone_names)}
+def _joined(armature_obj, bone_names, index, bone):
+    """Indices (into ``bone_names``, the deforming bones; ``index`` maps their names to them) of ``bone`` and of the
+    deforming bones it joins: its parent and its children."""
     data = armature_obj.data.bones[bone_names[bone]]
     return [bone] + [index[other.name] for other in [data.parent, *data.children]
                      if other is not None and other.name in index]

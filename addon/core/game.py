@@ -325,8 +325,8 @@ class _Bones:
         role_at = [roles[graph.edges[edge][2]].role if graph.edges[edge][2] >= 0 else None for edge in chain.edges]
         hips = hips_below(self.joints, points[0], np.asarray(graph.skeleton.body_plan.up, dtype=np.float64),
                           MERGE_TOLERANCE * graph.skeleton.extent)
-        lower = hips is not None
-        if lower:
+        shift = int(hips is not None)  # the points before the chain's own
+        if shift:
             points, role_at = np.vstack([hips, points]), [None] + role_at
         arc = arc_lengths(points)
         total = arc[-1]
@@ -348,7 +348,6 @@ class _Bones:
                  ("Spine2", BoneRole("chest"))]
         made = [self._add(base, None, "", at[k], at[k + 1], role, chain.nodes[0] if k == 0 else None, id(chain),
                           [], []) for k, (base, role) in enumerate(names)]
-        shift = int(lower)
         for k, edge in enumerate(chain.edges):
             middle = 0.5 * (arc[k + shift] + arc[k + shift + 1])
             self.edge_owner[edge] = made[int(np.searchsorted(cuts[1:-1], middle))]

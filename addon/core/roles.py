@@ -359,7 +359,7 @@ def _connector_role(spine, names, base):
 
 def _leg(body, limb, path, front, humanoid, tuning, put):
     """Roles along a leg's main ``path``: hips (or shoulder), thigh, shin, foot, toe (front legs: shoulder,
-    upper_arm, forearm, hand); the shin from the joint nearest the knee's named place (:func:`_leg_places`)."""
+    upper_arm, forearm, hand); the shin from the joint nearest the knee's named place (:func:`_leg_joints`)."""
     nodes, points = list(limb.main), path.points
     last = len(nodes) - 1
     thigh = _thigh_start(body, points, tuning)
@@ -370,7 +370,7 @@ def _leg(body, limb, path, front, humanoid, tuning, put):
     knee = ankle
     if ankle - thigh >= 2:
         arc = arc_lengths(points)
-        at = _leg_places(body, path, arc, front, tuning, humanoid)["forearm" if front else "shin"][0][0]
+        at = _leg_joints(body, path, arc, front, tuning, humanoid)[2]
         knee = min(range(thigh + 1, ankle), key=lambda i: abs(arc[i] - at))
     names = (["shoulder", "upper_arm", "forearm", "hand", "hand"] if front else
              ["hips", "thigh", "shin", "foot", "toe"])
@@ -802,30 +802,13 @@ def _down_to(heights, arc, level):
 
 
 def _leg_places(body, path, arc, front, tuning, humanoid=False):
-    """{role: spots} along a leg's path: the ankle where it comes down to ``ankle_height``, the hip joint at
-    ``hip_rise`` of the height from the ankle to where the leg hangs (a ``humanoid``'s no higher above its crotch,
-    :func:`_crotch`, than the leg lies off the mirror plane where it comes down to it: a gingerbread man's legs hang
-    from the middle of his chest, a heavy golem's stubby legs stand wide apart under a belly that hides his thighs;
-    a front leg's shoulder joint no higher than where its path turns down, :func:`_thigh_start`: a bear's runs along
-    its shoulder blade first), on the line of the thigh when that stands within ``thigh_lean`` of up (the path from
-    the knee halfway up to the hip, carried on up: the path may reach the hip slanting in from the body's middle; a
-    bent hind leg's thigh line leads elsewhere), the knee at ``knee_at`` of the way between (a bend near there, below
-    where the thigh's bones begin, winning), the toe at ``toe_at`` of the way from the ankle to the tip."""
+    """{role: spots} along a leg's path: the hip joint, knee and ankle as :func:`_leg_joints` finds them, the hip
+    joint on the line of the thigh when that stands within ``thigh_lean`` of up (the path from the knee halfway up
+    to the hip, carried on up: the path may reach the hip slanting in from the body's middle; a bent hind leg's thigh
+    line leads elsewhere), the toe at ``toe_at`` of the way from the ankle to the tip, and the heel."""
     points = path.points
     heights = body.height(points)
-    ankle = _down_to(heights, arc, tuning.ankle_height)
-    ankle_height = float(np.interp(ankle, arc, heights))
-    hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
-    crotch = _crotch(body, path, ankle_height) if humanoid else None
-    if crotch is not None:  # no higher above the crotch than the leg, where it leaves the body, lies off the plane
-        beside = abs(float(body.plane.distance(_along(points, arc, _down_to(heights, arc, crotch)))))
-        hip_height = min(hip_height, crotch + beside / (body.high - body.low))
-    hip = _down_to(heights, arc, hip_height)
-    thigh_from = float(arc[_thigh_start(body, points, tuning)])  # above, the path runs in the body
-    if front and thigh_from < ankle:  # no higher than where the upper arm's bones begin (a bear's blade)
-        hip = max(hip, thigh_from)
-        hip_height = float(np.interp(hip, arc, heights))
-    knee = _bent(points, arc, max(hip, thigh_from), hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
+    hip, hip_height, knee, ankle = _leg_joints(body, path, arc, front, tuning, humanoid)
     tip = arc[-1] + path.reach
     toe = ankle + tuning.toe_at * (tip - ankle)
     thigh = 0.5 * (hip + knee)
@@ -844,6 +827,32 @@ def _leg_places(body, path, arc, front, tuning, humanoid=False):
     return places
 
 
+def _leg_joints(body, path, arc, front, tuning, humanoid=False):
+    """(hip, its height, knee, ankle) along a leg's path (arc positions; the height a share of the mesh's): the ankle
+    where it comes down to ``ankle_height``, the hip joint at ``hip_rise`` of the height from the ankle to where the
+    leg hangs (a ``humanoid``'s no higher above its crotch, :func:`_crotch`, than the leg lies off the mirror plane
+    where it comes down to it: a gingerbread man's legs hang from the middle of his chest, a heavy golem's stubby
+    legs stand wide apart under a belly that hides his thighs; a front leg's shoulder joint no higher than where its
+    path turns down, :func:`_thigh_start`: a bear's runs along its shoulder blade first), the knee at ``knee_at`` of
+    the way between (a bend near there, below where the thigh's bones begin, winning)."""
+    points = path.points
+    heights = body.height(points)
+    ankle = _down_to(heights, arc, tuning.ankle_height)
+    ankle_height = float(np.interp(ankle, arc, heights))
+    hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
+    crotch = _crotch(body, path, ankle_height) if humanoid else None
+    if crotch is not None:  # no higher above the crotch than the leg, where it leaves the body, lies off the plane
+        beside = abs(float(body.plane.distance(_along(points, arc, _down_to(heights, arc, crotch)))))
+        hip_height = min(hip_height, crotch + beside / (body.high - body.low))
+    hip = _down_to(heights, arc, hip_height)
+    thigh_from = float(arc[_thigh_start(body, points, tuning)])  # above, the path runs in the body
+    if front and thigh_from < ankle:  # no higher than where the upper arm's bones begin (a bear's blade)
+        hip = max(hip, thigh_from)
+        hip_height = float(np.interp(hip, arc, heights))
+    knee = _bent(points, arc, max(hip, thigh_from), hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
+    return hip, hip_height, knee, ankle
+
+
 def _crotch(body, path, ankle):
     """The height (a share of the mesh's) of the crotch beside a leg: the lowest point, above its ``ankle`` (a height:
     feet meeting under a big-headed figure are no crotch) and below where the leg hangs, where the mesh's cut by the
@@ -859,12 +868,10 @@ def _crotch(body, path, ankle):
     reach = float(np.median(path.radius))
     step = along[:, 1] - along[:, 0]
     flat = np.abs(step) < 1e-12
-    safe = np.where(flat, 1.0, step)
-    low = np.where(flat, 0.0, np.minimum((-reach - along[:, 0]) / safe, (reach - along[:, 0]) / safe))
-    high = np.where(flat, 1.0, np.maximum((-reach - along[:, 0]) / safe, (reach - along[:, 0]) / safe))
-    near = ~flat | (np.abs(along[:, 0]) <= reach)
-    low, high = np.clip(low, 0.0, 1.0), np.clip(high, 0.0, 1.0)
-    near &= low < high
+    edges = (np.array([[-reach], [reach]]) - along[:, 0]) / np.where(flat, 1.0, step)  # where it meets |off| = reach
+    low = np.clip(np.where(flat, 0.0, edges.min(axis=0)), 0.0, 1.0)
+    high = np.clip(np.where(flat, 1.0, edges.max(axis=0)), 0.0, 1.0)
+    near = (~flat | (np.abs(along[:, 0]) <= reach)) & (low < high)
     rise = heights[:, 1] - heights[:, 0]
     lowest = heights[:, 0] + rise * np.where(rise > 0, low, high)  # the clipped piece's lowest end
     leg = body.height(path.points)
