@@ -167,56 +167,80 @@ def best_offset(vertices, plane, size, tuning):
     Searched in eighths of the tolerance with a quarter of the ``plane_samples`` probes, against at most 16 times
     that many vertices, and distances up to ``rough_match`` of the ``size`` (a coarse mesh's vertices mirror only that
     closely), then in ``rough_step`` about the best with all probes and vertices and distances up to twice the
-    median found, scaled to the denser vertices' spacing (few neighbours to compare on a dense mesh), doubled until
-    the best median is under half of it."""
+    median found, scaled to the denser vertices' spacing (few neighbours to compare on a dense mesh), and when the
+    best median reaches that cap (half the distances cut short), again up to twice the first search's median
+    (``_least_median``)."""
     (axis, around), reach = plane, tuning.twin_tolerance * size
     probe = vertices[::max(1, len(vertices) // tuning.plane_samples)]
-
-    def best(offsets, probe, nearest):
-        medians = [np.median(nearest.distances(mirrored(probe, (axis, offset)))) for offset in offsets]
-        return offsets[int(np.argmin(medians))], min(medians)
-
     sparse = vertices[::max(1, len(vertices) // (16 * tuning.plane_samples))]
-    centre, median = best(around + np.linspace(-reach, reach, 17), probe[::4],
-                          _Nearest(sparse, tuning.rough_match * size))
+    centre, rough = _least_median(around + np.linspace(-reach, reach, 17), probe[::4], sparse, axis,
+                                  tuning.rough_match * size)
     step = tuning.rough_step * size
     fine = centre + step * np.arange(-np.ceil(reach / 8 / step), np.ceil(reach / 8 / step) + 1)
-    cap = max(2 * median * np.sqrt(len(sparse) / len(vertices)), step)
+    cap = max(2 * rough * np.sqrt(len(sparse) / len(vertices)), step)
     while True:
-        offset, median = best(fine, probe, _Nearest(vertices, cap))
-        if median < cap / 2 or cap >= tuning.rough_match * size:
+        offset, median = _least_median(fine, probe, vertices, axis, cap)
+        if median < cap or cap >= tuning.rough_match * size:
             return float(offset)
-        cap *= 2
+        cap = min(max(2 * cap, 2 * rough), tuning.rough_match * size)
 
 
-class _Nearest:
-    """The distance from points to the nearest of ``vertices``, up to ``reach`` (farther ones read ``reach``):
-    vertices hashed to a grid of cells ``reach`` wide, each point compared with those in its 27 cells."""
+CROWD = 16  # vertices per grid cell, about, that _least_median compares with (a dense mesh's cells hold more)
+CROWD_SAMPLE = 20_000  # vertices sampled to count how many a cell holds
 
-    def __init__(self, vertices, reach):
-        self.reach, self.origin = reach, vertices.min(axis=0) - 2 * reach
-        self.span = np.floor((vertices.max(axis=0) - self.origin) / reach).astype(np.int64) + 3
-        keys = _cell_keys(self._cells(vertices), self.span)
-        order = np.argsort(keys, kind="stable")
-        self.keys, self.vertices = keys[order], vertices[order]
 
-    def _cells(self, points):
-        return np.clip(np.floor((points - self.origin) / self.reach).astype(np.int64), 1, self.span - 2)
+def _least_median(offsets, probe, vertices, axis, cap):
+    """(offset, median) of the ``offsets`` along ``axis`` where the median over the ``probe`` points of the distance
+    from their mirror image to the nearest of the ``vertices``, at most ``cap``, is least.
 
-    def distances(self, points):
-        around = (self._cells(points)[:, None, :] + _NEIGHBOURS[None]).reshape(-1, 3)
-        keys = _cell_keys(around, self.span)
-        starts, ends = np.searchsorted(self.keys, keys), np.searchsorted(self.keys, keys, side="right")
-        counts = ends - starts
-        at = np.repeat(starts - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
-        per_point = counts.reshape(len(points), -1).sum(axis=1)
-        found = per_point > 0
-        squares = ((self.vertices[at] - np.repeat(points, per_point, axis=0)) ** 2).sum(axis=1)
-        result = np.full(len(points), self.reach)
-        if found.any():
-            first = (np.cumsum(per_point) - per_point)[found]
-            result[found] = np.minimum(np.sqrt(np.minimum.reduceat(squares, first)), self.reach)
-        return result
+    Each probe's candidates are gathered once for all offsets (a mirror image moves only along the axis): the vertices
+    in a grid of cells ``cap`` wide within ``cap`` of the segment its images run along. Where those cells hold more
+    than ``CROWD`` vertices on average, an even share of them (picked by a hash of their index) stands for the rest,
+    so the work is bounded on a dense mesh whose images lie far from it (a hand-made body): the median is then
+    several times the thinned vertices' spacing, and thinning moves it little."""
+    offsets = np.asarray(offsets, dtype=float)
+    low, high = float(offsets.min()), float(offsets.max())
+    origin = vertices.min(axis=0) - 2 * cap
+    origin[axis] = min(origin[axis], 2 * low - probe[:, axis].max() - 2 * cap)
+    top = vertices.max(axis=0) + 2 * cap
+    top[axis] = max(top[axis], 2 * high - probe[:, axis].min() + 2 * cap)
+    span = np.floor((top - origin) / cap).astype(np.int64) + 1
+
+    reach = int(np.ceil((high - low) / cap)) + 1  # cells along the axis either side of the middle image's
+    shifts = np.zeros((2 * reach + 1, 3), np.int64)
+    shifts[:, axis] = np.arange(-reach, reach + 1)
+    around = (_NEIGHBOURS[_NEIGHBOURS[:, axis] == 0][:, None, :] + shifts[None]).reshape(-1, 3)
+    images = np.floor((mirrored(probe, (axis, 0.5 * (low + high))) - origin) / cap).astype(np.int64)
+    looked = _cell_keys((images[:, None, :] + around[None]).reshape(-1, 3), span)
+
+    keys = _cell_keys(np.floor((vertices - origin) / cap).astype(np.int64), span)
+    near = _CellSet(looked, span).holds(keys)
+    vertices, keys = vertices[near], keys[near]
+    sample = keys[::max(1, len(keys) // CROWD_SAMPLE)]
+    crowd = len(keys) / max(len(np.unique(sample)), 1)  # vertices per cell, when the sample fills them
+    if crowd > CROWD:
+        index = np.flatnonzero(near).astype(np.uint64)
+        keep = (index * np.uint64(2654435761)) % np.uint64(1 << 32) < np.uint64(CROWD / crowd * (1 << 32))
+        vertices, keys = vertices[keep], keys[keep]
+    order = np.argsort(keys, kind="stable")
+    vertices, keys = vertices[order], keys[order]
+
+    starts, ends = np.searchsorted(keys, looked), np.searchsorted(keys, looked, side="right")
+    counts = ends - starts
+    at = np.repeat(starts - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
+    owner = np.repeat(np.arange(len(probe)), counts.reshape(len(probe), -1).sum(axis=1))
+    across = np.delete(np.arange(3), axis)
+    squares = ((vertices[at][:, across] - probe[owner][:, across]) ** 2).sum(axis=1)
+    sums = vertices[at, axis] + probe[owner, axis]  # a vertex lies sums - 2 * offset along the axis from an image
+    close = (squares < cap * cap) & (sums > 2 * low - cap) & (sums < 2 * high + cap)
+    squares, sums, owner = squares[close], sums[close], owner[close]
+    nearest = np.full((len(probe), len(offsets)), cap * cap)
+    if len(owner):
+        firsts = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+        gaps = squares[:, None] + (sums[:, None] - 2 * offsets[None]) ** 2
+        nearest[owner[firsts]] = np.minimum(np.minimum.reduceat(gaps, firsts, axis=0), cap * cap)
+    medians = np.median(np.sqrt(nearest), axis=0)
+    return offsets[int(np.argmin(medians))], float(medians.min())
 
 
 _NEIGHBOURS = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)])
