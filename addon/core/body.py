@@ -358,9 +358,10 @@ def _section(mesh, plane):
     corners on both sides, or with an edge on it, gives the points where its edges cross it or lie on it."""
     if plane is None:
         return np.zeros((0, 2, 3))
-    offsets = plane.distance(mesh.vertices)[mesh.triangles]
-    touching = (offsets.min(axis=1) <= 0) & (offsets.max(axis=1) >= 0)
-    corners, offsets = mesh.vertices[mesh.triangles[touching]], offsets[touching]  # (T, 3, 3), (T, 3)
+    distances = plane.distance(mesh.vertices)
+    sides = np.sign(distances).astype(np.int8)[mesh.triangles].sum(axis=1, dtype=np.int8)  # +-3: all on one side
+    touching = mesh.triangles[np.abs(sides) < 3]
+    corners, offsets = mesh.vertices[touching], distances[touching]  # (T, 3, 3), (T, 3)
     ends = np.full((len(corners), 3, 3), np.nan)
     for k in range(3):
         a, b = offsets[:, k], offsets[:, (k + 1) % 3]
