@@ -20,7 +20,7 @@ from ...core.timing import StageClock
 from .bones import BoneBuilder
 from .depth import Blob, Placing, SideAxis, placed_islands
 from .rules import Rules
-from .second_view import hidden_limbs
+from .second_view import HiddenLimbs
 from .tree import pruned_tree, removed_links
 from .tuning import Tuning
 from .views import AXIS_NAMES, mirror_in_depth, perpendicular_views, primary_view, view_frame
@@ -112,12 +112,13 @@ class SilhouetteMethod(RigMethod):
         placing = Placing(tuning, speck=tuning.speck * rules.unit, side_axis=side, split=params.split_layers,
                           mirror=mirror)
         islands = list(placed_islands(sil, graph, alive, kept, placing))
-        builder = _bones(sil, islands, other_views, rules, rules.symmetry)
+        hidden = [HiddenLimbs(sil, view, rules) for view in other_views]
+        builder = _bones(sil, islands, hidden, rules, rules.symmetry)
         sides = rules.symmetry
         if sides is None:  # a body with a left and a right that is no exact mirror image: twins get one bone count
             sides = sided_symmetry(mesh.used_vertices, mesh.bbox, mesh.scale, builder.lines, tuning)
             if sides is not None:
-                builder = _bones(sil, islands, other_views, rules, sides)
+                builder = _bones(sil, islands, hidden, rules, sides)
         clock.lap("depth_bones")
 
         heads, tails, parents = builder.arrays()
@@ -145,15 +146,15 @@ class SilhouetteMethod(RigMethod):
         return Skeleton(names, heads, tails, parents, stages=stages, timings=clock.laps)
 
 
-def _bones(sil, islands, other_views, rules, symmetry):
+def _bones(sil, islands, hidden, rules, symmetry):
     """A ``BoneBuilder`` with the bones of the placed ``islands`` (``Blob`` or ``PlacedIsland`` each) and of the limbs
-    the ``other_views`` find hidden, twins across ``symmetry``."""
+    the other views find hidden (``hidden``: a ``HiddenLimbs`` each), twins across ``symmetry``."""
     builder = BoneBuilder(rules.cutting, symmetry, rules.tuning)
     for placed in islands:
         if isinstance(placed, Blob):
             builder.add_blob(sil, placed.point, placed.radius)
         else:
             builder.add_island(placed.root_point, placed.chains, sil)
-    for view_of in other_views:
-        builder.add_limbs(hidden_limbs(sil, view_of, builder.lines, rules), (sil, view_of.sil))
+    for limbs in hidden:
+        builder.add_limbs(limbs.limbs(builder.lines), (sil, limbs.view.sil))
     return builder

@@ -8,6 +8,8 @@ point the primary skeleton comes within ``reach`` of is added, from the first no
 node's depth is the body's, often a merged blob's centre far behind the limb). Parts both views show (a wing seen
 edge-on) are never doubled.
 """
+from functools import cached_property
+
 import numpy as np
 
 from ...core.polyline import length, segment_distances
@@ -15,31 +17,43 @@ from .depth import PlacedIsland, Placing, placed_islands
 from .tree import islands, pruned_tree
 
 
-def hidden_limbs(sil, view, lines, rules):
-    """Limbs the primary view (``sil``) hides behind the body, from the perpendicular ``View`` ``view``'s pruned tree,
-    compared with the primary skeleton's chains ``lines``; the view's chains are placed in depth only when a leaf tip
-    lies off the primary skeleton. Its tree is pruned at ``hidden_prune`` of ``prune``, with the mirror plane when the
-    view looks across it (a wolf's ears, seen end-on, are kept as a pair)."""
-    params, tuning = rules.params, rules.tuning
-    pruning = rules.pruning(view.sil, tuning.hidden_prune * params.prune)
-    view_graph, alive, _, kept = pruned_tree(view.axis_graph, params.merge, pruning)
-    kept = _without_bumps(view_graph, alive, kept, pruning.min_reach)
-    if not len(kept):
-        return []
-    ends, count = np.unique(kept, return_counts=True)
-    tips = view_graph.points[ends[count == 1]]
-    across = rules.plane is not None and abs(view.sil.direction[rules.plane[0]]) <= tuning.along_plane
-    cover = Cover(lines, view.sil.direction, tuning.hidden_reach * rules.unit, rules.symmetry if across else None)
-    if cover.covered(view.sil.lift(tips, 0.0)).all():
-        return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
-    view.sil.share_parts(sil)  # the mesh's welded parts, found once for the primary view, give the view's layers
-    limbs = []
-    # placed without the plane: only the limbs off the skeleton are kept, and add_limbs completes their mirror pairs
-    placing = Placing(tuning, speck=tuning.speck * rules.unit, split=params.split_layers)
-    for placed in placed_islands(view.sil, view_graph, alive, kept, placing):
-        if isinstance(placed, PlacedIsland):
-            limbs += uncovered_limbs(placed.chains, cover, sil, pruning.min_reach, tuning)
-    return limbs
+class HiddenLimbs:
+    """The limbs the primary view (``sil``) hides behind the body that the perpendicular ``View`` ``view`` shows:
+    its tree, pruned at ``hidden_prune`` of ``prune`` (with the mirror plane when the view looks across it: a wolf's
+    ears, seen end-on, are kept as a pair), is built once; its chains are placed in depth when first needed, when a
+    leaf tip lies off the primary skeleton."""
+
+    def __init__(self, sil, view, rules):
+        self.sil, self.view, self.rules = sil, view, rules
+        params, tuning = rules.params, rules.tuning
+        self.pruning = rules.pruning(view.sil, tuning.hidden_prune * params.prune)
+        self.graph, self.alive, _, kept = pruned_tree(view.axis_graph, params.merge, self.pruning)
+        self.kept = _without_bumps(self.graph, self.alive, kept, self.pruning.min_reach)
+        ends, count = np.unique(self.kept, return_counts=True)
+        self.tips = view.sil.lift(self.graph.points[ends[count == 1]], 0.0) if len(self.kept) else None
+        self.across = rules.plane is not None and abs(view.sil.direction[rules.plane[0]]) <= tuning.along_plane
+
+    def limbs(self, lines):
+        """The hidden limbs, compared with the primary skeleton's chains ``lines``."""
+        if not len(self.kept):
+            return []
+        tuning = self.rules.tuning
+        cover = Cover(lines, self.view.sil.direction, tuning.hidden_reach * self.rules.unit,
+                      self.rules.symmetry if self.across else None)
+        if cover.covered(self.tips).all():
+            return []  # every leaf tip is on the primary skeleton: no need to place the view's chains in depth
+        return [limb for chains in self._placed for limb in
+                uncovered_limbs(chains, cover, self.sil, self.pruning.min_reach, tuning)]
+
+    @cached_property
+    def _placed(self):
+        """The placed chains of each of the view's islands (``PlacedIsland.chains``)."""
+        self.view.sil.share_parts(self.sil)  # the mesh's welded parts, found once for the primary view
+        # placed without the plane: only the limbs off the skeleton are kept, and add_limbs completes their pairs
+        tuning = self.rules.tuning
+        placing = Placing(tuning, speck=tuning.speck * self.rules.unit, split=self.rules.params.split_layers)
+        return [placed.chains for placed in placed_islands(self.view.sil, self.graph, self.alive, self.kept, placing)
+                if isinstance(placed, PlacedIsland)]
 
 
 def _without_bumps(graph, alive, links, min_reach):
