@@ -34,7 +34,12 @@ def nearest_on_segments(points, starts, ends):
 
 def segment_distances(points, starts, ends):
     """(P, S) distances from each of the (P, 3) ``points`` to each segment ``starts[k]``–``ends[k]``."""
-    return np.linalg.norm(points[:, None, :] - nearest_on_segments(points, starts, ends), axis=2)
+    seg = ends - starts
+    length2 = np.maximum((seg * seg).sum(axis=1), 1e-300)
+    apart = points[:, None, :] - starts[None]
+    t = np.clip(np.einsum("psk,sk->ps", apart, seg) / length2, 0.0, 1.0)
+    apart -= t[..., None] * seg[None]
+    return np.sqrt(np.einsum("psk,psk->ps", apart, apart))
 
 
 def arc_nearest(line, arc, point):
