@@ -156,6 +156,18 @@ def test_the_bone_the_ears_hang_from_is_the_head():
     assert "neck" in {role.role for role in roles}
 
 
+def test_a_deer_s_head_begins_where_its_neck_turns_into_the_skull():
+    """The deer's neck rises to its skull and its head points forward from there, 90 degrees on. Its neck was
+    narrowest one joint lower, so its head began 0.16 of the size below the artist's Head joint, under the jaw, and
+    Rigify's head control nodded it from the upper neck. A quadruped's head begins at a sharp turn past the neck's
+    narrowest joint."""
+    vertices, triangles, rig = load_ground_truth(shared_path("models", "gt", "Quaternius_Deer"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    size = np.ptp(vertices, axis=0).max()
+    head = named_joints(skeleton)[("head", None, None)]
+    assert np.linalg.norm(head - rig.positions[rig.names.index("Head")]) < 0.03 * size
+
+
 def test_arms_reaching_out_from_where_the_legs_hang_are_arms():
     """woody, a gingerbread figure, has one junction for a torso: its arms leave it where its legs do. Arms that reach
     out level, not down to the ground, are arms there too."""

@@ -1,20 +1,21 @@
 """Bone roles: what each bone of a skeleton is in its body plan (a thigh, the second spine bone, the left index finger's
 first bone), given the plan's layout of the body (``core.bodyplan``). Bones keep their names; roles sit beside them.
 
-Along the spine, from the tail end to the head end: tail (or root, a bone rising from the ground to the hips),
-hips, spine, chest up to where the arms, wings or front legs hang (a humanoid's arms hanging where its legs do: one
-bone), then neck up to the spine's thinnest joint above them and head beyond (one bone there is the neck: it pivots
-where a neck does; a fish: head, spine and tail by length). A leg: hips (its bones from the mirror plane until it
-leaves it and turns down; shoulder for a front leg), thigh, shin from the joint nearest the knee's named place
-(below), foot from the joint nearest an ankle's height, and toe (the last bone when the foot has two or
-more); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up to where it leaves the torso, then
-upper_arm, forearm and hand by shares of the rest of its reach where the artists' humanoids have an elbow and a
-wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the one that leaves earliest
-and points most away the thumb, the others index, middle, ring and pinky in order across the hand. Twins are cut at
-the same joints (on their mirror-averaged points). A wing: shoulder up to where it leaves the body, as an arm's,
-then wing. Fins, ears, tails and jaws take their part's role for every bone. A body plan that is ``other`` gives
-every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when a limb's bones have them, else the side of the
-mirror plane, left being the character's left when its front is known (Blender's +X for a character facing -Y).
+Along the spine, from the tail end to the head end: tail (or root, a bone rising from the ground to the hips), hips,
+spine, chest up to where the arms, wings or front legs hang (a humanoid's arms hanging where its legs do: one bone),
+then neck up to the spine's thinnest joint above them (a quadruped's: or a sharp turn past it, ``head_bend``) and head
+beyond (one bone there is the neck: it pivots where a neck does; a fish: head, spine and tail by length). A leg: hips
+(its bones from the mirror plane until it leaves it and turns down; shoulder for a front leg), thigh, shin from the
+joint nearest the knee's named place (below), foot from the joint nearest an ankle's height, and toe (the last bone
+when the foot has two or more); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up to where it
+leaves the torso, then upper_arm, forearm and hand by shares of the rest of its reach where the artists' humanoids
+have an elbow and a wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the one that
+leaves earliest and points most away the thumb, the others index, middle, ring and pinky in order across the hand.
+Twins are cut at the same joints (on their mirror-averaged points). A wing: shoulder up to where it leaves the body,
+as an arm's, then wing. Fins, ears, tails and jaws take their part's role for every bone. A body plan that is
+``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when a limb's bones have them, else
+the side of the mirror plane, left being the character's left when its front is known (Blender's +X for a character
+facing -Y).
 
 Roles are whole bones; named joints are points (:func:`named_joints`: where each role begins, ``{(role, side,
 digit): point}``), placed along the chains where the artists' rigs have them rather than at the nearest bone end
@@ -126,6 +127,9 @@ class RoleTuning(TuningTable):
     head_below: float = tuned(0.6, "a humanoid's head begins no farther than this share of the way from the neck's "
                                    "base to the head's top (the artists' 0.24 to 0.46): above, the mesh is thin for "
                                    "the crown, not for a neck")
+    head_bend: float = tuned(60.0, "degrees: a quadruped's spine turning this much at or past its neck's narrowest "
+                                   "joint turns into the head there (a deer's 90, where a dog's neck runs on into "
+                                   "its head)")
     spine_fall: float = tuned(0.02, "... on its spine up to where it falls this share of the height (a hunched "
                                     "figure's head hanging forward)")
     other_part: float = tuned(0.01, "a share of the size: the mesh beyond a limb's end lying more than this nearer "
@@ -336,6 +340,8 @@ def _spine_roles(body, layout, tuning):
             low = chest + 2 + int(np.count_nonzero(arc[chest + 2:count] - arc[chest] <= tuning.head_below
                                                    * (top - arc[chest])))
         thinnest = chest + 1 + int(np.argmin(body.radius[spine[chest + 1:low]]))
+        if kind == "quadruped":  # a head carried at an angle to the neck (a deer's) begins at the bend: the skull
+            thinnest = _skull_bend(points, thinnest, low, tuning.head_bend)
         # the ears are on the skull: a bone they hang from (all but the first above the chest) is the head's
         ears = [spine.index(body.bases[k]) for k, part in enumerate(layout.parts) if part == "ear"
                 and body.bases[k] in spine]
@@ -344,6 +350,17 @@ def _spine_roles(body, layout, tuning):
     else:
         names += ["neck", "head"][:above]  # one bone into the head pivots at the neck
     return names
+
+
+def _skull_bend(points, start, stop, least):
+    """The joint among ``start`` .. ``stop`` - 1 of a spine (``points``) where it turns most, when by at least
+    ``least`` degrees, else ``start``."""
+    before = points[start:stop] - points[start - 1:stop - 1]
+    after = points[start + 1:stop + 1] - points[start:stop]
+    lengths = np.linalg.norm(before, axis=1) * np.linalg.norm(after, axis=1)
+    cosines = np.where(lengths > 0, (before * after).sum(axis=1) / np.maximum(lengths, 1e-300), 1.0)
+    turns = np.degrees(np.arccos(np.clip(cosines, -1.0, 1.0)))  # none where two joints coincide
+    return start + int(np.argmax(turns)) if len(turns) and turns.max() >= least else start
 
 
 def _connector_role(spine, names, base):
