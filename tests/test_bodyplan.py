@@ -246,6 +246,18 @@ def test_an_unknown_plan_keeps_plain_roles_and_says_why(rigged, name):
         assert plan.warning.startswith("body plan not recognised (") and plan.reason in plan.warning
 
 
+def test_a_plan_recognised_without_much_confidence_says_so():
+    """The flat alligator, all its vertices in one plane, is read as a fish with a confidence of 0.44, and the CLI
+    said nothing. A plan recognised with a confidence under 0.5 now comes with a warning; a sure one with none."""
+    vertices, triangles, _, _ = load_blender_frame("alligator")
+    plan = rigger.rig_mesh(vertices, triangles).body_plan
+    assert plan.recognised and plan.confidence < 0.5
+    assert plan.warning.startswith(f"body plan {plan.kind} recognised with a low confidence") and plan.reason in \
+        plan.warning
+    sure = BodyPlan("quadruped", 0.9, "4 legs standing front and back under a body")
+    assert sure.warning is None
+
+
 @pytest.mark.parametrize("name", ["humanoid", "quadruped", "octopus"])
 def test_twins_get_twin_roles(rigged, name):
     """Every role on one side has its twin on the other, index for index."""

@@ -36,6 +36,7 @@ from .stages import MirrorPlane
 from .tuning import tuned
 
 KINDS = ("humanoid", "quadruped", "bird", "fish", "other")
+UNSURE = 0.5  # a plan recognised with less confidence than this comes with a warning
 PARTS = ("leg", "arm", "wing", "fin", "ear", "tail", "jaw", "other")
 
 
@@ -104,9 +105,14 @@ class BodyPlan:
 
     @property
     def warning(self):
-        """Why the plan was not recognised, for reports (None when it was)."""
-        return None if self.recognised else (f"body plan not recognised ({self.reason}); the rig stays plain, every "
-                                             f"bone's role 'other'")
+        """Why the plan was not recognised, or that it was only with a confidence under ``UNSURE``, for reports
+        (None when it was surely)."""
+        if not self.recognised:
+            return f"body plan not recognised ({self.reason}); the rig stays plain, every bone's role 'other'"
+        if self.confidence < UNSURE:
+            return (f"body plan {self.kind} recognised with a low confidence, {self.confidence:.2f} ({self.reason}): "
+                    f"check the bone roles, or take the plain target, which names no parts")
+        return None
 
     def summary(self):
         """One line: "humanoid (0.99): 2 legs under ..."."""
