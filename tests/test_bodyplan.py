@@ -156,6 +156,18 @@ def test_the_bone_the_ears_hang_from_is_the_head():
     assert "neck" in {role.role for role in roles}
 
 
+def test_ears_hung_just_past_the_start_of_the_head_leave_the_spine_in_the_head():
+    """The Shiba Inu in its file's frame: its ears hang from the snout bone, a hair past its start. The joint graph
+    linked them to that bone's end, so the spine ran out along the snout and back to the ears' base, and the snout
+    bone, taken for the last bone before the head, was a neck: the dog had no head. Hung at the bone's start, the
+    spine ends at the snout and the bone the ears hang from is the head."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "Quaternius_ShibaInu", "Quaternius_ShibaInu.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    roles = skeleton.roles
+    ears = [b for b, role in enumerate(roles) if role.role == "ear" and roles[skeleton.parents[b]].role != "ear"]
+    assert ears and {roles[skeleton.parents[b]].role for b in ears} == {"head"}
+
+
 def test_a_deer_s_head_begins_where_its_neck_turns_into_the_skull():
     """The deer's neck rises to its skull and its head points forward from there, 90 degrees on. Its neck was
     narrowest one joint lower, so its head began 0.16 of the size below the artist's Head joint, under the jaw, and

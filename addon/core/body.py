@@ -153,7 +153,8 @@ class JointGraph:
 def joint_graph(skeleton, tolerance):
     """The :class:`JointGraph` of ``skeleton``. A bone's head is its parent's tail (or head), and the head of a
     sibling (or of another root), when they lie within ``tolerance`` / 100 (exporters round); the two ends of a bone
-    shorter than ``tolerance`` are one joint."""
+    shorter than ``tolerance`` are one joint. A bone hung from its parent elsewhere is linked to the parent's tail,
+    or to its head when it starts within ``tolerance`` of it (ears hung just past the start of a head's bone)."""
     count = len(skeleton)
     heads, tails, parents = skeleton.heads, skeleton.tails, skeleton.parents
     same = tolerance / 100
@@ -178,7 +179,8 @@ def joint_graph(skeleton, tolerance):
     links = [(int(head_node[b]), int(tail_node[b]), b) for b in range(count) if head_node[b] != tail_node[b]]
     for bone, parent in enumerate(parents.tolist()):
         if parent >= 0 and tail_node[parent] != head_node[bone] and head_node[parent] != head_node[bone]:
-            links.append((int(tail_node[parent]), int(head_node[bone]), -1))
+            near_head = np.linalg.norm(heads[bone] - heads[parent]) < tolerance
+            links.append((int((head_node if near_head else tail_node)[parent]), int(head_node[bone]), -1))
     neighbours = _spanning_tree(points, links)
     return JointGraph(points, neighbours, head_node, tail_node)
 
