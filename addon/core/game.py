@@ -202,25 +202,13 @@ class _Graph:
 
         sided = [end for end in ends if hips_at(end)]
         if len(sided) == 1:
-            return self._legs_at(path if path[0] == sided[0] else path[::-1])
+            return sided[0]
         heads = [self.points[self.edges[edge][0]] for edge, (_, _, bone, key) in enumerate(self.edges)
                  if key[0] in ("neck", "head") and bone >= 0]
         if heads:
             centre = np.mean(heads, axis=0)
             return max(ends, key=lambda end: np.linalg.norm(self.points[end] - centre))
         return ends[0]
-
-    def _legs_at(self, path):
-        """The first node of a trunk ``path`` (from its hips end) where a leg's hips bones leave it, along its hips
-        bones (a round rump's end behind the legs: the Hips' too); its first node when there is none."""
-        roles = self.skeleton.roles
-        for node, following in zip(path, path[1:]):
-            if any(self.edges[edge][3][0] == "pelvis" for _, edge in self.neighbours[node]):
-                return node
-            edge = next(edge for other, edge in self.neighbours[node] if other == following)
-            if self.edges[edge][2] < 0 or roles[self.edges[edge][2]].role != "hips":
-                break
-        return path[0]
 
     def _longest_path(self, edges):
         """The longest path (by length) through the edge set ``edges`` (a forest), as nodes."""

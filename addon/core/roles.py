@@ -108,8 +108,7 @@ class RoleTuning(TuningTable):
     wrist_at: float = tuned(0.73, "a wrist's share of that way (0.65 to 0.79, median 0.74)")
     head_share: float = tuned(0.25, "a fish's head: this share of its spine's length from the head end")
     tail_share: float = tuned(0.35, "a fish's tail: this share from the tail end")
-    tail_length: float = tuned(0.08, "spine behind the hips running on this far (a share of the size) past the hips' "
-                                     "disc is a tail; less is the hips' (a round rump)")
+    tail_length: float = tuned(0.08, "spine behind the hips this long (a share of the size) is a tail, not hips")
     hip_rise: float = tuned(0.89, "a leg's hip joint lies this share of the height from its ankle up to where the "
                                   "leg hangs from the spine")
     heel_width: float = tuned(0.03, "the heel is the hindmost point of the mesh this close to the foot's line "
@@ -329,8 +328,7 @@ def _spine_roles(body, layout, tuning):
     if hips > 0:
         lowest = spine[0]
         grounded = body.touches(lowest, 0.05) and body.height(points[0]) < body.height(points[hips])
-        beyond = _beyond_disc(points[hips::-1], behind - arc[hips::-1], body.radius[spine[hips]])
-        name = "root" if grounded else "tail" if beyond >= tuning.tail_length * body.size else "hips"
+        name = "root" if grounded else "tail" if behind >= tuning.tail_length * body.size else "hips"
         names += [name] * hips
     torso = chest - hips
     names += (["hips"] + ["spine"] * (torso - 2) + ["chest"]) if torso >= 3 else ["hips", "spine"][:torso]
@@ -352,19 +350,6 @@ def _spine_roles(body, layout, tuning):
     else:
         names += ["neck", "head"][:above]  # one bone into the head pivots at the neck
     return names
-
-
-def _beyond_disc(points, arc, radius):
-    """How far a path (``points`` from a node outwards, ``arc`` their arc lengths from it) runs on past the node's
-    disc of ``radius``, from where it first leaves it: a tail sticks out of the body, a spine's end in a round rump
-    does not."""
-    apart = np.linalg.norm(points - points[0], axis=1)
-    out = np.flatnonzero(apart > radius)
-    if not len(out):
-        return 0.0
-    k = int(out[0])  # apart[k - 1] <= radius < apart[k]
-    share = (radius - apart[k - 1]) / max(apart[k] - apart[k - 1], 1e-300)
-    return float(arc[-1] - arc[k - 1] - share * (arc[k] - arc[k - 1]))
 
 
 def _skull_bend(points, start, stop, least):
