@@ -324,7 +324,7 @@ def _continued(chains, meta, body):
         first = merged[before]
         merged[before] = Chain(first.bones + chain.bones, first.roles + chain.roles)
         absorbed.add(k)
-        body.notes.append(f"the model shows no {'/'.join(dict.fromkeys(chain.roles))}: the metarig's "
+        body.notes.append(f"no {'/'.join(dict.fromkeys(chain.roles))} found on the model: the metarig's "
                           f"{', '.join(chain.bones)} go on from {first.bones[-1]} in its proportions")
     return [chain for k, chain in enumerate(merged) if k not in absorbed]
 
@@ -925,8 +925,8 @@ def _notes(spec, fit, body):
                 sides, bones = missing.setdefault(part, ([], []))
                 sides.append(side)
                 bones.extend(names)
-    notes = [f"the model shows no {part}{' (' + ' and '.join(sides) + ')' if sides != [None] else ''}: removed the "
-             f"metarig's {', '.join(bones)}" for part, (sides, bones) in missing.items()]
+    notes = [f"no {part}{' (' + ' and '.join(sides) + ')' if sides != [None] else ''} found on the model: "
+             f"removed the metarig's {', '.join(bones)}" for part, (sides, bones) in missing.items()]
     notes += body.notes
     if body.side_map["L"] == "R":
         notes.append("the skeleton's .L limbs are on the character's right: Rigify's .L bones went to its left")
