@@ -164,15 +164,15 @@ def best_offset(vertices, plane, size, tuning):
     ``vertices`` mirror best about: where the median distance from mirrored vertices to the nearest vertex is least.
     A median: a raised arm or a prop on one side does not pull the plane, as it pulls a posed body's box or spine.
 
-    Searched in eighths of the tolerance with a quarter of the ``plane_samples`` probes, against at most 16 times
-    that many vertices, and distances up to ``rough_match`` of the ``size`` (a coarse mesh's vertices mirror only that
-    closely), then in ``rough_step`` about the best with all probes and vertices and distances up to twice the
-    median found, scaled to the denser vertices' spacing (few neighbours to compare on a dense mesh), and when the
+    Searched in eighths of the tolerance with a quarter of the ``plane_samples`` probes, against at most 4 times
+    ``plane_samples`` vertices, and distances up to ``rough_match`` of the ``size`` (a coarse mesh's vertices mirror
+    only that closely), then in ``rough_step`` about the best with all probes and vertices and distances up to twice
+    the median found, scaled to the denser vertices' spacing (few neighbours to compare on a dense mesh), and when the
     best median reaches that cap (half the distances cut short), again up to twice the first search's median
     (``_least_median``)."""
     (axis, around), reach = plane, tuning.twin_tolerance * size
     probe = vertices[::max(1, len(vertices) // tuning.plane_samples)]
-    sparse = vertices[::max(1, len(vertices) // (16 * tuning.plane_samples))]
+    sparse = vertices[::max(1, len(vertices) // (4 * tuning.plane_samples))]
     centre, rough = _least_median(around + np.linspace(-reach, reach, 17), probe[::4], sparse, axis,
                                   tuning.rough_match * size)
     step = tuning.rough_step * size
