@@ -4,7 +4,8 @@ and its limbs, and how thick and how flat the mesh is around them. Bone names ma
 The pieces, in the order :func:`read_body` finds them:
 
 - the joint graph: bone ends closer than ``joint_merge`` are one joint; a bone whose head is not its parent's tail
-  hangs from it by a link without a bone, and parts of a forest hang from the nearest joint of the largest part;
+  hangs from it by a link without a bone (from the parent's head when it starts that near it), and parts of a
+  forest hang from the nearest joint of the largest part;
 - the mirror plane: the method's own (its ``mirror_plane`` stage), else the mesh's (``core.mirror.mirror_plane``),
   else the axis plane that pairs the most leaf tips of the skeleton with mirror images and runs along the body (a
   posed or hand-made figure, whose mesh is not symmetric within 1%);
@@ -154,7 +155,8 @@ def joint_graph(skeleton, tolerance):
     """The :class:`JointGraph` of ``skeleton``. A bone's head is its parent's tail (or head), and the head of a
     sibling (or of another root), when they lie within ``tolerance`` / 100 (exporters round); the two ends of a bone
     shorter than ``tolerance`` are one joint. A bone hung from its parent elsewhere is linked to the parent's tail,
-    or to its head when it starts within ``tolerance`` of it (ears hung just past the start of a head's bone)."""
+    or to its head when it starts within ``tolerance`` of it and nearer it (ears hung just past the start of a head's
+    bone)."""
     count = len(skeleton)
     heads, tails, parents = skeleton.heads, skeleton.tails, skeleton.parents
     same = tolerance / 100
@@ -179,7 +181,8 @@ def joint_graph(skeleton, tolerance):
     links = [(int(head_node[b]), int(tail_node[b]), b) for b in range(count) if head_node[b] != tail_node[b]]
     for bone, parent in enumerate(parents.tolist()):
         if parent >= 0 and tail_node[parent] != head_node[bone] and head_node[parent] != head_node[bone]:
-            near_head = np.linalg.norm(heads[bone] - heads[parent]) < tolerance
+            from_head = np.linalg.norm(heads[bone] - heads[parent])
+            near_head = from_head < tolerance and from_head < np.linalg.norm(heads[bone] - tails[parent])
             links.append((int((head_node if near_head else tail_node)[parent]), int(head_node[bone]), -1))
     neighbours = _spanning_tree(points, links)
     return JointGraph(points, neighbours, head_node, tail_node)

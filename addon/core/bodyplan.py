@@ -111,7 +111,7 @@ class BodyPlan:
             return f"body plan not recognised ({self.reason}); the rig stays plain, every bone's role 'other'"
         if self.confidence < UNSURE:
             return (f"body plan {self.kind} recognised with a low confidence, {self.confidence:.2f} ({self.reason}): "
-                    f"check the bone roles, or take the plain target, which names no parts")
+                    f"check the bone roles (the game and rigify targets name and place bones by them)")
         return None
 
     def summary(self):

@@ -164,12 +164,12 @@ def best_offset(vertices, plane, size, tuning):
     ``vertices`` mirror best about: where the median distance from mirrored vertices to the nearest vertex is least.
     A median: a raised arm or a prop on one side does not pull the plane, as it pulls a posed body's box or spine.
 
-    Searched in eighths of the tolerance with a quarter of the ``plane_samples`` probes, against at most 4 times
-    ``plane_samples`` vertices, and distances up to ``rough_match`` of the ``size`` (a coarse mesh's vertices mirror
-    only that closely), then in ``rough_step`` about the best with all probes and vertices and distances up to twice
-    the median found, scaled to the denser vertices' spacing (few neighbours to compare on a dense mesh), and when the
-    best median reaches that cap (half the distances cut short), again up to twice the first search's median
-    (``_least_median``)."""
+    Searched in eighths of the tolerance with a quarter of the ``plane_samples`` probes, against every k-th vertex
+    (some 4 to 8 times ``plane_samples`` of them), and distances up to ``rough_match`` of the ``size`` (a coarse mesh's
+    vertices mirror only that closely), then in ``rough_step`` about the best with all probes and vertices and
+    distances up to twice the median found, scaled to the denser vertices' spacing (few neighbours to compare on a
+    dense mesh); while the best median reaches that cap (half the distances cut short), again with the cap doubled,
+    at least twice the first search's median, up to ``rough_match`` (``_least_median``)."""
     (axis, around), reach = plane, tuning.twin_tolerance * size
     probe = vertices[::max(1, len(vertices) // tuning.plane_samples)]
     sparse = vertices[::max(1, len(vertices) // (4 * tuning.plane_samples))]
@@ -186,7 +186,7 @@ def best_offset(vertices, plane, size, tuning):
 
 
 CROWD = 16  # vertices per grid cell, about, that _least_median compares with (a dense mesh's cells hold more)
-CROWD_SAMPLE = 20_000  # vertices sampled to count how many a cell holds
+CROWD_SAMPLE = 20_000  # nearby vertices sampled to count the cells they occupy
 
 
 def _least_median(offsets, probe, vertices, axis, cap):
@@ -211,18 +211,18 @@ def _least_median(offsets, probe, vertices, axis, cap):
     shifts[:, axis] = np.arange(-reach, reach + 1)
     around = (_NEIGHBOURS[_NEIGHBOURS[:, axis] == 0][:, None, :] + shifts[None]).reshape(-1, 3)
     images = np.floor((mirrored(probe, (axis, 0.5 * (low + high))) - origin) / cap).astype(np.int64)
-    looked = _cell_keys((images[:, None, :] + around[None]).reshape(-1, 3), span)
+    looked = _cell_keys(np.clip((images[:, None, :] + around[None]).reshape(-1, 3), 0, span - 1), span)
 
     keys = _cell_keys(np.floor((vertices - origin) / cap).astype(np.int64), span)
     near = _CellSet(looked, span).holds(keys)
     vertices, keys = vertices[near], keys[near]
-    sample = keys[::max(1, len(keys) // CROWD_SAMPLE)]
-    crowd = len(keys) / max(len(np.unique(sample)), 1)  # vertices per cell, when the sample fills them
+    step = max(1, len(keys) // CROWD_SAMPLE)
+    crowd = len(keys) / _occupied(len(np.unique(keys[::step])), len(keys), 1.0 / step)
     if crowd > CROWD:
         index = np.flatnonzero(near).astype(np.uint64)
         keep = (index * np.uint64(2654435761)) % np.uint64(1 << 32) < np.uint64(CROWD / crowd * (1 << 32))
         vertices, keys = vertices[keep], keys[keep]
-    order = np.argsort(keys, kind="stable")
+    order = np.argsort(keys)  # the nearest of a cell's vertices is the same in any order
     vertices, keys = vertices[order], keys[order]
 
     starts, ends = np.searchsorted(keys, looked), np.searchsorted(keys, looked, side="right")
@@ -240,7 +240,21 @@ def _least_median(offsets, probe, vertices, axis, cap):
         gaps = squares[:, None] + (sums[:, None] - 2 * offsets[None]) ** 2
         nearest[owner[firsts]] = np.minimum(np.minimum.reduceat(gaps, firsts, axis=0), cap * cap)
     medians = np.median(np.sqrt(nearest), axis=0)
-    return offsets[int(np.argmin(medians))], float(medians.min())
+    best = int(np.lexsort((np.abs(offsets - 0.5 * (low + high)), medians))[0])  # of equals, the middlemost
+    return offsets[best], float(medians[best])
+
+
+def _occupied(hit, count, share):
+    """How many cells ``count`` points occupy, about, when a ``share`` of them sampled hit ``hit`` cells: the cells
+    C with C * (1 - (1 - share) ** (count / C)) = hit (as many points in each), by bisection."""
+    low, high = float(max(hit, 1)), float(max(count, 1))
+    for _ in range(50):
+        cells = 0.5 * (low + high)
+        if cells * (1.0 - (1.0 - share) ** (count / cells)) < hit:
+            low = cells
+        else:
+            high = cells
+    return high
 
 
 _NEIGHBOURS = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)])
