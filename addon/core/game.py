@@ -455,13 +455,13 @@ class _Bones:
         parents = []
         hips = self.hips
         for index, bone in enumerate(self.bones):
-            if bone["start"] is None or index == hips:  # the next bone of a chain; the Hips, under the root
-                parents.append(index - 1 if index != hips else -1)
-                continue
-            owner = self._holder(bone["start"], arriving, index)
-            if owner is None:
-                owner = hips if hips is not None and hips != index else -1
-            parents.append(owner)
+            if index == hips:  # under the root
+                parents.append(-1)
+            elif bone["start"] is None:  # the next bone of a chain
+                parents.append(index - 1)
+            else:
+                owner = self._holder(bone["start"], arriving, index)
+                parents.append(owner if owner is not None else -1 if hips is None else hips)
         heads = np.array([bone["head"] for bone in self.bones])
         tails = np.array([bone["tail"] for bone in self.bones])
         return names, heads, tails, parents, [bone["role"] for bone in self.bones]

@@ -353,14 +353,11 @@ def _spine_roles(body, layout, tuning):
 
 
 def _skull_bend(points, start, stop, least):
-    """The joint among ``start`` .. ``stop`` - 1 of a spine (``points``) where it turns most, when by at least
-    ``least`` degrees, else ``start``."""
-    before = points[start:stop] - points[start - 1:stop - 1]
-    after = points[start + 1:stop + 1] - points[start:stop]
-    lengths = np.linalg.norm(before, axis=1) * np.linalg.norm(after, axis=1)
-    cosines = np.where(lengths > 0, (before * after).sum(axis=1) / np.maximum(lengths, 1e-300), 1.0)
-    turns = np.degrees(np.arccos(np.clip(cosines, -1.0, 1.0)))  # none where two joints coincide
-    return start + int(np.argmax(turns)) if len(turns) and turns.max() >= least else start
+    """The joint among ``start`` .. ``stop`` - 1 of a spine (``points``) where it turns most (:func:`_bend`), when by
+    at least ``least`` degrees, else ``start``."""
+    turns = [_bend(points[i], points[i - 1], points[i + 1]) for i in range(start, stop)]
+    sharpest = int(np.argmax(turns)) if turns else 0
+    return start + sharpest if turns and turns[sharpest] >= least else start
 
 
 def _connector_role(spine, names, base):
