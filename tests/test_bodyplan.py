@@ -699,6 +699,23 @@ def test_a_knee_bends_below_where_the_thigh_begins():
         assert rise @ up > np.cos(np.radians(30)) * np.linalg.norm(rise)  # the thigh stands up from the knee
 
 
+def test_a_quadruped_s_hind_leg_stands_on_its_toes(rigged):
+    """The sample dog's hind leg bends forward at its knee (the stifle, 0.35 m up) and back at its hock (0.14 m up),
+    and stands on its paw. Its roles were a human leg's: the knee at the hock, the ankle on the ground, so the game
+    skeleton's thigh ran straight through the stifle and could not bend there. A quadruped's hind ankle is its hock:
+    the foot begins there and the knee lies between it and the hip joint."""
+    skeleton = rigged["quadruped"]
+    vertices, _ = load_character("quadruped")
+    size = np.ptp(vertices, axis=0).max()
+    position = {joint.name: np.array(joint.position) for joint in samples.character_joints("quadruped")}
+    joints = named_joints(skeleton)
+    for side in ("L", "R"):
+        assert np.linalg.norm(joints[("shin", side, None)] - position[f"thigh.{side}"]) <= 0.03 * size
+        assert np.linalg.norm(joints[("foot", side, None)] - position[f"shin.{side}"]) <= 0.03 * size
+        foot = next(bone for bone, role in enumerate(skeleton.roles) if role.role == "foot" and role.side == side)
+        assert np.linalg.norm(skeleton.heads[foot] - position[f"shin.{side}"]) <= 0.03 * size
+
+
 def test_an_arm_turning_at_its_deltoid_has_its_elbow_farther_down():
     """The ogre's arm turns by 26 degrees under its deltoid, a fifth of the way from the shoulder joint to the hand's
     end, and by 25 at its elbow, a third of the way: the sharper was taken for the elbow, and bending the forearm

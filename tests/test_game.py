@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 
 import rigger
+from rigger import samples
 from characters import load_character
 from conftest import shared_path
-from rigdata import load_obj
+from rigdata import load_ground_truth, load_obj
 from rigger.core.bodyplan import recognise
 from rigger.core.game import game_skeleton, missing_humanoid_bones
 from rigger.core.retarget import Clip, RetargetError, aliases, captured, map_joints, normalised, sole_points
@@ -84,6 +85,37 @@ def test_a_quadruped_follows_the_same_scheme_from_its_hips():
     assert bones.roots == (bones.names.index("root"),)
     assert bones.parents[bones.names.index("Hips")] == bones.names.index("root")
     assert bones.parents[bones.names.index("Tail1")] == bones.names.index("Hips")
+
+
+def test_a_quadruped_s_hind_leg_bends_at_its_knee_and_its_hock():
+    """The sample dog's game hind leg was an UpLeg running from the hip through the stifle (its knee) down to the hock,
+    and a Leg from there to the paw: lifting the paw could not bend the knee. Now UpLeg, Leg and Foot meet at the knee
+    and the hock (a share of the size)."""
+    _, game, vertices = rigged("quadruped")
+    bones = game.skeleton
+    size = np.ptp(vertices, axis=0).max()
+    position = {joint.name: np.array(joint.position) for joint in samples.character_joints("quadruped")}
+    for side, word in (("L", "Left"), ("R", "Right")):
+        thigh, shin, foot = (bones.names.index(f"{word}{part}") for part in ("UpLeg", "Leg", "Foot"))
+        assert bones.parents[shin] == thigh and bones.parents[foot] == shin
+        assert np.linalg.norm(bones.heads[shin] - position[f"thigh.{side}"]) <= 0.03 * size
+        assert np.linalg.norm(bones.heads[foot] - position[f"shin.{side}"]) <= 0.03 * size
+
+
+def test_an_animal_s_neck_bends_along_its_length_and_its_ears_turn_with_its_head():
+    """The deer's neck, three bones of Rigger's from the withers up to the skull, was one game bone, so it could only
+    turn stiffly at its base; and its ears, which begin beside the head bone's start, hung from that Neck, so nodding
+    the head left them behind. An animal's neck keeps its joints (Neck, Neck1, Neck2, as Mixamo numbers its spine) and
+    ears hang from the Head."""
+    vertices, triangles, _ = load_ground_truth(shared_path("models", "gt", "Quaternius_Deer"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    parent = {name: bones.names[p] if p >= 0 else None for name, p in zip(bones.names, bones.parents)}
+    necks = sum(role.role == "neck" for role in skeleton.roles)
+    assert necks >= 2
+    assert [name for name in bones.names if name.startswith("Neck")] == ["Neck"] + [f"Neck{k}" for k in range(1, necks)]
+    assert parent["Head"] == f"Neck{necks - 1}"
+    assert parent["LeftEar1"] == parent["RightEar1"] == "Head"
 
 
 @pytest.mark.parametrize("turn", [np.eye(3), np.diag([-1.0, 1.0, -1.0])])

@@ -15,7 +15,9 @@ The naming scheme (one for every body plan; the README says the same for users):
   ``UpLeg`` (thigh), ``Leg`` (shin), ``Foot``, ``ToeBase``; sided ones get ``Left`` / ``Right`` before the word
   (``LeftForeArm``), by the character's own side (``core.facing``: a character facing +Y has its ``.L`` bones on its
   right, and its ``Left`` bones on its left). A quadruped's front legs have the roles, so the names, of arms and its
-  hind legs those of legs. A leg's ``hips`` bones (from the body's middle to the hip joint) are the pelvis: they
+  hind legs those of legs. The neck of any plan but a humanoid's keeps Rigger's joints: ``Neck``, ``Neck1``,
+  ``Neck2``, ..., as Mixamo numbers its spine (an animal's long neck bends along its length; engines' humanoids have
+  one ``Neck``). A leg's ``hips`` bones (from the body's middle to the hip joint) are the pelvis: they
   merge into ``Hips``.
 - A humanoid's forearm (shin, neck) that ends without a hand (foot, head) gets one: ``_completed_ends``; an upper
   arm (thigh) without a forearm (shin) after it is split at the elbow (knee): ``_split_middles``.
@@ -34,7 +36,9 @@ upper arm's up the Rigger bone the limb hangs from, or down its own, counts as n
 with it.
 
 The hierarchy is Rigger's read from the hips outwards (Rigger may root a quadruped at its neck): a chain hangs from the
-game bone that holds the joint it starts from, else the nearest joint on its way to the hips. Twins hang from one bone
+game bone that holds the joint it starts from, else the nearest joint on its way to the hips; a chain Rigger hangs
+beside its parent bone's end rather than at it (a deer's ears, near where its head bone begins) hangs from the game
+bone that took that parent over. Twins hang from one bone
 or from twins, and twins (``Left…`` and ``Right…`` bones that mirror each other within ``TWIN_TOLERANCE`` of the size)
 get exactly mirrored points across the mirror plane.
 """
@@ -171,7 +175,8 @@ class _Graph:
             return index[key]
 
         self.ends = [(node(head), node(tail)) for head, tail in zip(skeleton.heads, skeleton.tails)]
-        self.edges = []  # (a, b, bone index or -1 for a link, chain key)
+        self.edges = []  # (a, b, bone index or -1 for a link, chain key); a bone's edge has the bone's index
+        self.link_parent = {}  # link edge -> the parent bone it leaves
         keys = [_key(role) for role in skeleton.roles]
         for bone, (a, b) in enumerate(self.ends):
             self.edges.append((a, b, bone, keys[bone]))
@@ -179,6 +184,7 @@ class _Graph:
             if parent >= 0 and self.ends[bone][0] not in self.ends[parent]:
                 head = skeleton.heads[bone]
                 end = min(self.ends[parent], key=lambda n: np.linalg.norm(np.asarray(points[n]) - head))
+                self.link_parent[len(self.edges)] = parent
                 self.edges.append((end, self.ends[bone][0], -1, keys[bone]))
         self.points = np.array(points)
         self.neighbours = [[] for _ in points]
@@ -307,11 +313,11 @@ class _Bones:
         self.node_owner = {}  # graph node -> the game bone that holds it (children hang from it)
         self.hips = None  # the Hips bone, once the trunk made it
 
-    def _add(self, base, side, number, head, tail, role, start, chain, edges, end_nodes):
+    def _add(self, base, side, number, head, tail, role, start, chain, edges, end_nodes, hang=None):
         index = len(self.bones)
         self.bones.append({"base": base, "side": side, "number": number, "head": np.asarray(head, float),
                            "tail": np.asarray(tail, float), "role": role, "start": start, "chain": chain,
-                           "suffix": ""})
+                           "suffix": "", "hang": hang})
         for edge in edges:
             self.edge_owner[edge] = index
         for node in end_nodes:
@@ -371,10 +377,11 @@ class _Bones:
             role_name = "other"
         bones = [graph.edges[edge][2] for edge in chain.edges]
         first = graph.skeleton.roles[next((bone for bone in bones if bone >= 0), bones[0])]
+        jointed = role_name == "neck" and graph.skeleton.body_plan.kind != "humanoid"
         if role_name == "finger":
             spans = _finger_spans(graph.points[chain.nodes], [bone >= 0 for bone in bones])
             base = "Hand" + DIGIT_WORDS[digit]
-        elif role_name in NUMBERED:
+        elif role_name in NUMBERED or jointed:
             spans = [(k, k + 1) for k, bone in enumerate(bones) if bone >= 0] or [(0, len(bones))]
             base = WORDS[role_name]
         else:  # from the first bone's head: a link before it (a limb beside its parent's joint) is no bone's
@@ -382,11 +389,13 @@ class _Bones:
             spans = [(real[0], real[-1] + 1)] if real else [(0, len(bones))]
             base = WORDS[role_name]
         numbered = role_name == "finger" or role_name in NUMBERED
+        hang = graph.link_parent.get(chain.edges[0]) if chain.nodes[1] == graph.edges[chain.edges[0]][1] else None
         for number, (low, high) in enumerate(spans, start=1):
-            role = BoneRole(first.role, first.side, number - 1 if numbered else 0, first.digit)
-            self._add(base, side, str(number) if numbered else "", graph.points[chain.nodes[low]],
-                      graph.points[chain.nodes[high]], role, chain.nodes[0] if number == 1 else None, id(chain),
-                      chain.edges[low:high], chain.nodes[low + 1:high + 1])
+            role = BoneRole(first.role, first.side, number - 1 if numbered or jointed else 0, first.digit)
+            text = str(number) if numbered else str(number - 1) if number > 1 else ""
+            self._add(base, side, text, graph.points[chain.nodes[low]], graph.points[chain.nodes[high]], role,
+                      chain.nodes[0] if number == 1 else None, id(chain), chain.edges[low:high],
+                      chain.nodes[low + 1:high + 1], hang if number == 1 else None)
 
     def name_instances(self, up):
         """``_2``, ``_3`` after the names that several chains share: ordered by the number of the bone each hangs
@@ -459,8 +468,10 @@ class _Bones:
                 parents.append(-1)
             elif bone["start"] is None:  # the next bone of a chain
                 parents.append(index - 1)
-            else:
-                owner = self._holder(bone["start"], arriving, index)
+            else:  # a chain hung beside its parent bone's end (ears near a head's start): from that bone's owner
+                owner = self.edge_owner.get(bone["hang"]) if bone["hang"] is not None else None
+                if owner is None or owner == index:
+                    owner = self._holder(bone["start"], arriving, index)
                 parents.append(owner if owner is not None else -1 if hips is None else hips)
         heads = np.array([bone["head"] for bone in self.bones])
         tails = np.array([bone["tail"] for bone in self.bones])

@@ -7,10 +7,12 @@ then neck up to the spine's thinnest joint above them (a quadruped's: or a sharp
 beyond (one bone there is the neck: it pivots where a neck does; a fish: head, spine and tail by length). A leg: hips
 (its bones from the mirror plane until it leaves it and turns down; shoulder for a front leg), thigh, shin from the
 joint nearest the knee's named place (below), foot from the joint nearest an ankle's height, and toe (the last bone
-when the foot has two or more); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up to where it
-leaves the torso, then upper_arm, forearm and hand by shares of the rest of its reach where the artists' humanoids
-have an elbow and a wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the one that
-leaves earliest and points most away the thumb, the others index, middle, ring and pinky in order across the hand.
+when the foot has two or more; a quadruped's hind leg stands on its toes: its foot from the joint nearest its hock's
+named place, its toe from the ankle's height); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up
+to where it leaves the torso, then upper_arm, forearm and hand by shares of the rest of its reach where the artists'
+humanoids have an elbow and a wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the
+one that leaves earliest and points most away the thumb, the others index, middle, ring and pinky in order across the
+hand.
 Twins are cut at the same joints (on their mirror-averaged points). A wing: shoulder up to where it leaves the body,
 as an arm's, then wing. Fins, ears, tails and jaws take their part's role for every bone. A body plan that is
 ``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when a limb's bones have them, else
@@ -24,7 +26,9 @@ digit): point}``), placed along the chains where the artists' rigs have them rat
 when the thigh stands upright; a front leg's shoulder joint no higher than where its upper arm's bones begin; a
 humanoid's no higher above its crotch than the leg lies off the mirror plane there), the knee ``knee_at`` of the way
 between (a bend there, below where the thigh's bones begin, winning) and the ball of the foot ``toe_at`` of the way
-to the toes' tip; on an arm the shoulder joint where the arm leaves the torso, the
+to the toes' tip (a quadruped's hind leg, on its toes: the ankle is its hock, at ``hock_at`` of its hip joint's
+height, a bend there winning; the knee ``knee_at`` of the way down to it; the ball where it comes down to
+``ankle_height``); on an arm the shoulder joint where the arm leaves the torso, the
 elbow and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the hand (the mesh beyond the
 last joint included; a bend winning for the elbow), the collarbone's start ``clavicle_at`` of the way in; on an upright
 humanoid's spine the hips, spine, chest and neck at ``hips_at`` ... ``neck_at`` of the height from the hip joints to
@@ -95,7 +99,9 @@ class RoleTuning(TuningTable):
     bend: float = tuned(25.0, "degrees: a limb joint turning this much near where an elbow or a knee belongs is one")
     bend_window: float = tuned(0.2, "a bend counts within this share of the limb's length of where the joint belongs")
     knee_at: float = tuned(0.47, "a knee's share of the way from the hip to the ankle (the artists' humanoids: 0.38 "
-                                 "to 0.49, median 0.47)")
+                                 "to 0.49, median 0.47; their animals' from the hip to the hock: 0.41 to 0.56)")
+    hock_at: float = tuned(0.42, "a quadruped's hind leg stands on its toes: its ankle, the hock, at this share of its "
+                               "hip joint's height (the artists' animals and Rigify's: 0.34 to 0.53)")
     shoulder_thickness: float = tuned(1.3, "an arm's shoulder joint is its first joint where the mesh is at most this "
                                            "many times as thick as along the arm (the torso is thicker) ...")
     arm_from: float = tuned(0.3, "... the arm's thickness being the median at its joints from this share of its "
@@ -178,8 +184,7 @@ def assign_roles(skeleton, body, layout, paths, tuning=RoleTuning()):
         part = layout.parts[k]
         path = paths[k]
         if part == "leg":
-            _leg(body, limb, path, layout.front[k], layout.plan.kind == "humanoid", tuning,
-                 lambda nodes, names: put(nodes, names, side))
+            _leg(body, limb, path, layout.front[k], kind, tuning, lambda nodes, names: put(nodes, names, side))
         elif part == "arm":
             _arm(body, limb, path, tuning, lambda nodes, names: put(nodes, names, side))
         elif part == "wing":  # its bones in the body are a shoulder, as an arm's: the wing turns where it leaves
@@ -371,9 +376,10 @@ def _connector_role(spine, names, base):
 
 # Limbs.
 
-def _leg(body, limb, path, front, humanoid, tuning, put):
+def _leg(body, limb, path, front, kind, tuning, put):
     """Roles along a leg's main ``path``: hips (or shoulder), thigh, shin, foot, toe (front legs: shoulder,
-    upper_arm, forearm, hand); the shin from the joint nearest the knee's named place (:func:`_leg_joints`)."""
+    upper_arm, forearm, hand); the shin from the joint nearest the knee's named place and, on a quadruped's hind leg,
+    the foot from the joint nearest its hock's (:func:`_leg_joints`)."""
     nodes, points = list(limb.main), path.points
     last = len(nodes) - 1
     thigh = _thigh_start(body, points, tuning)
@@ -384,7 +390,11 @@ def _leg(body, limb, path, front, humanoid, tuning, put):
     knee = ankle
     if ankle - thigh >= 2:
         arc = arc_lengths(points)
-        at = _leg_joints(body, path, arc, front, tuning, humanoid)[2]
+        _, _, at, hock = _leg_joints(body, path, arc, front, tuning, kind)
+        if _on_toes(front, kind) and ankle - thigh >= 3:  # the foot from the hock, the toes from the ground
+            hock = min(range(thigh + 2, ankle + 1), key=lambda i: abs(arc[i] - hock))
+            toe = ankle if ankle > hock else last
+            ankle = hock
         knee = min(range(thigh + 1, ankle), key=lambda i: abs(arc[i] - at))
     names = (["shoulder", "upper_arm", "forearm", "hand", "hand"] if front else
              ["hips", "thigh", "shin", "foot", "toe"])
@@ -394,6 +404,11 @@ def _leg(body, limb, path, front, humanoid, tuning, put):
         split = _fork(path, nodes)
         put(path[split:], ["toe" if split >= ankle else roles[min(split, len(roles) - 1)] if roles else "other"]
             * (len(path) - 1 - split))
+
+
+def _on_toes(front, kind):
+    """Whether a leg stands on its toes, its ankle (the hock) high above the ground: a quadruped's hind leg."""
+    return kind == "quadruped" and not front
 
 
 def _thigh_start(body, points, tuning):
@@ -725,8 +740,8 @@ def joint_places(skeleton, body, layout, paths, tuning=RoleTuning()):
         side = _limb_side(skeleton, graph, limb, left)
         path = paths[k]
         arc = arc_lengths(path.points)
-        found = _leg_places(body, path, arc, layout.front[k], tuning, layout.plan.kind == "humanoid") \
-            if part == "leg" else _arm_places(body, limb, path, arc, tuning)
+        found = _leg_places(body, path, arc, layout.front[k], tuning, layout.plan.kind) if part == "leg" \
+            else _arm_places(body, limb, path, arc, tuning)
         for role, spots in found.items():
             places[(role, side, None)] = _on_bones(graph, ends, list(limb.main), arc, spots)
     spine = list(layout.spine)
@@ -815,16 +830,18 @@ def _down_to(heights, arc, level):
     return float(arc[i - 1] + (arc[i] - arc[i - 1]) * (heights[i - 1] - level) / max(drop, 1e-300))
 
 
-def _leg_places(body, path, arc, front, tuning, humanoid=False):
+def _leg_places(body, path, arc, front, tuning, kind):
     """{role: spots} along a leg's path: the hip joint, knee and ankle as :func:`_leg_joints` finds them, the hip
     joint on the line of the thigh when that stands within ``thigh_lean`` of up (the path from the knee halfway up
     to the hip, carried on up: the path may reach the hip slanting in from the body's middle; a bent hind leg's thigh
-    line leads elsewhere), the toe at ``toe_at`` of the way from the ankle to the tip, and the heel."""
+    line leads elsewhere), the toe at ``toe_at`` of the way from the ankle to the tip (a leg on its toes: where it
+    comes down to ``ankle_height``), and the heel."""
     points = path.points
     heights = body.height(points)
-    hip, hip_height, knee, ankle = _leg_joints(body, path, arc, front, tuning, humanoid)
+    hip, hip_height, knee, ankle = _leg_joints(body, path, arc, front, tuning, kind)
     tip = arc[-1] + path.reach
-    toe = ankle + tuning.toe_at * (tip - ankle)
+    ball = _down_to(heights, arc, tuning.ankle_height)
+    toe = ball if _on_toes(front, kind) else ankle + tuning.toe_at * (tip - ankle)
     thigh = 0.5 * (hip + knee)
     line = _along(points, arc, thigh) - _along(points, arc, knee)
     rise = float(line @ body.up)
@@ -835,26 +852,29 @@ def _leg_places(body, path, arc, front, tuning, humanoid=False):
         ("thigh", "shin", "foot", "toe", "toe_tip")
     places = {name: spots for name, spots in zip(names, (hip_spots, ((knee, 1.0),), ((ankle, 1.0),), ((toe, 1.0),),
                                                          ((tip, 1.0),))) if name}
-    heel = None if front else _heel(body, points, arc, knee, ankle, tip, tuning)
+    heel = None if front else _heel(body, points, arc, ankle, ball, tip, tuning) if _on_toes(front, kind) \
+        else _heel(body, points, arc, knee, ankle, tip, tuning)
     if heel is not None:
         places["heel"] = heel
     return places
 
 
-def _leg_joints(body, path, arc, front, tuning, humanoid=False):
-    """(hip, its height, knee, ankle) along a leg's path (arc positions; the height a share of the mesh's): the ankle
-    where it comes down to ``ankle_height``, the hip joint at ``hip_rise`` of the height from the ankle to where the
-    leg hangs (a ``humanoid``'s no higher above its crotch, :func:`_crotch`, than the leg lies off the mirror plane
-    where it comes down to it: a gingerbread man's legs hang from the middle of his chest, a heavy golem's stubby
-    legs stand wide apart under a belly that hides his thighs; a front leg's shoulder joint no higher than where its
-    path turns down, :func:`_thigh_start`: a bear's runs along its shoulder blade first), the knee at ``knee_at`` of
-    the way between (a bend near there, below where the thigh's bones begin, winning)."""
+def _leg_joints(body, path, arc, front, tuning, kind):
+    """(hip, its height, knee, ankle) along a leg's path (arc positions; the height a share of the mesh's) of a body
+    plan of ``kind``: the ankle where it comes down to ``ankle_height`` (a leg on its toes, :func:`_on_toes`: its
+    hock at ``hock_at`` of the hip joint's height, a bend near there seen from mid-leg winning), the hip joint at
+    ``hip_rise`` of the height from the ankle on the ground to where the leg hangs (a humanoid's no higher above its
+    crotch, :func:`_crotch`, than the leg lies off the mirror plane where it comes down to it: a gingerbread man's
+    legs hang from the middle of his chest, a heavy golem's stubby legs stand wide apart under a belly that hides his
+    thighs; a front leg's shoulder joint no higher than where its path turns down, :func:`_thigh_start`: a bear's runs
+    along its shoulder blade first), the knee at ``knee_at`` of the way between (a bend near there, below where the
+    thigh's bones begin, winning)."""
     points = path.points
     heights = body.height(points)
     ankle = _down_to(heights, arc, tuning.ankle_height)
     ankle_height = float(np.interp(ankle, arc, heights))
     hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
-    crotch = _crotch(body, path, ankle_height) if humanoid else None
+    crotch = _crotch(body, path, ankle_height) if kind == "humanoid" else None
     if crotch is not None:  # no higher above the crotch than the leg, where it leaves the body, lies off the plane
         beside = abs(float(body.plane.distance(_along(points, arc, _down_to(heights, arc, crotch)))))
         hip_height = min(hip_height, crotch + beside / (body.high - body.low))
@@ -863,6 +883,9 @@ def _leg_joints(body, path, arc, front, tuning, humanoid=False):
     if front and thigh_from < ankle:  # no higher than where the upper arm's bones begin (a bear's blade)
         hip = max(hip, thigh_from)
         hip_height = float(np.interp(hip, arc, heights))
+    if _on_toes(front, kind):  # the hock, its bend seen from the middle of the leg (the knee may lie above it)
+        ankle = _bent(points, arc, hip + tuning.knee_at * (ankle - hip),
+                      _down_to(heights, arc, tuning.hock_at * hip_height), ankle, ankle - hip, tuning)
     knee = _bent(points, arc, max(hip, thigh_from), hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
     return hip, hip_height, knee, ankle
 
