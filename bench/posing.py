@@ -4,8 +4,9 @@ Random poses of each artist rig deform the mesh with the artist's weights (the t
 fitted to every target (its bones rotate about their heads, parents first) and deforms the mesh with its own weights;
 the leftover vertex error, in units of the mesh's largest bounding-box extent, says how well the rig can pose that
 character. Rigs: the artist's own (a check: ≈ 0), the artist's skeleton skinned by Rigger, Rigger's skeleton skinned
-by Rigger (the product), a 3-joint stick with nearest-bone weights (the floor). Also measured: seam cracks, limb
-recall, mirror twins and unsided bones of Rigger's skeleton. Writes posing.md, posing.png and posing.json.
+by Rigger (the product), a 3-joint stick with nearest-bone weights (the floor), and the ``game`` output target as the
+add-on builds and skins it, where the body plan fills it. Also measured: seam cracks, limb recall, mirror twins and
+unsided bones of Rigger's skeleton. Writes posing.md, posing.png and posing.json.
 
     .venv/bin/python bench/posing.py [--models NAME ...] [--seed S] [--one-seed] [--jobs N] [--compare OLD.json]
                                      [--blender-frame]
@@ -42,6 +43,7 @@ from benchkit import (REPO, SHARED_MODELS, cpu_model, described_commit, markdown
 from bodyplan import blender_turn  # noqa: E402
 from quality import principal_stick  # noqa: E402
 from rigger.blender.headless import temporary_user_folder  # noqa: E402  (bpy-free)
+from rigger.core.targets import TARGETS  # noqa: E402
 
 MODELS_DIR = SHARED_MODELS / "gt"
 RIGS = {"artist": "artist rig", "artist_skin": "artist skeleton + Rigger skinning",
@@ -77,12 +79,19 @@ def measure(folder, seeds, poses=POSES, max_degrees=MAX_DEGREES, params=None, bl
         record["errors"]["rigger"] = f"rig_mesh: {type(error).__name__}: {error}"
     for kind, skeleton in skeletons.items():
         try:
-            obj, report = rigdata.skinned_mesh(folder.name, vertices, triangles, skeleton)
+            obj, report, _ = rigdata.skinned_mesh(folder.name, vertices, triangles, skeleton)
             rigs[kind] = pm.SkinnedRig.of(skeleton.heads, skeleton.parents,
                                           rigdata.vertex_weights(obj, list(skeleton.names)))
             record["skinning"][kind] = report.summary()
         except Exception as error:
             record["errors"][kind] = f"skinning: {type(error).__name__}: {error}"
+    if "rigger" in skeletons and TARGETS["game"].unfit(skeletons["rigger"].body_plan) is None:
+        try:  # the game target, as the add-on builds and skins it (a failure here is its own, not the product's)
+            obj, report, bones = rigdata.skinned_mesh(folder.name, vertices, triangles, skeletons["rigger"], "game")
+            rigs["game"] = pm.SkinnedRig.of(bones.heads, bones.parents, rigdata.vertex_weights(obj, list(bones.names)))
+            record["game_bones"] = len(bones)
+        except Exception as error:
+            record["game_error"] = f"{type(error).__name__}: {error}"
     stick = principal_stick(vertices, triangles)[0]
     rigs["stick"] = pm.nearest_bone_rig(stick.heads, stick.tails, stick.parents, vertices)
     record["bones"] = {kind: len(skeleton) for kind, skeleton in skeletons.items()}
@@ -117,6 +126,8 @@ def measure(folder, seeds, poses=POSES, max_degrees=MAX_DEGREES, params=None, bl
                 "crack_at": str(joint_names[region[pairs[pair, 0]]]) if gap > 0 else "",
                 "per_pose": errors.mean(axis=1).tolist(), "steps": float(np.mean(steps))}
         seed_record = {"rigs": results}
+        if {"game", "artist_skin"} <= results.keys():
+            seed_record["game_excess"] = results["game"]["mean"] - results["artist_skin"]["mean"]
         if {"rigger", "artist_skin"} <= results.keys():
             seed_record["excess"] = results["rigger"]["mean"] - results["artist_skin"]["mean"]
             seed_record["excess_normal_degrees"] = (results["rigger"]["normal_degrees"]
@@ -219,6 +230,13 @@ def summarise(records, seeds):
         "rigger_bones": sum(r["bones"]["rigger"] for r in good),
         "excess_vs_recall": float(spearmanr([v for _, v in excess], [v for _, v in recall])[0]),
     })
+    games = [r for r in good if "game_excess" in r["seeds"][first]]
+    if games:
+        game = [(r["model"], r["seeds"][first]["game_excess"]) for r in games]
+        summary["game"] = {"models": len(games), "excess_mean": float(np.mean([v for _, v in game])),
+                           "rigger_excess_mean": float(np.mean([r["seeds"][first]["excess"] for r in games])),
+                           "worst": sorted(game, key=lambda pair: -pair[1])[:3],
+                           "failed": [r["model"] for r in good if "game_error" in r]}
     per_pose = [np.subtract(r["seeds"][first]["rigs"]["rigger"]["per_pose"],
                             r["seeds"][first]["rigs"]["artist_skin"]["per_pose"]) for r in good]
     summary["excess_standard_error"] = float(np.mean([np.std(each, ddof=1) / np.sqrt(len(each)) if len(each) > 1
@@ -277,6 +295,27 @@ def target_rows(summary):
                                                [asymmetry[f"{m} {n}"] for m, n in unsided])
          if unsided else "none", verdict(not unsided)],
     ]
+
+
+def game_section(records, summary, seeds):
+    """The game target's lines: its excess beside Rigger's own rig's, on the models whose plan it fills."""
+    game = summary.get("game")
+    if game is None:
+        return []
+    first = str(seeds[0])
+    lines = ["", "## The game target", "",
+             "The `game` output target as the add-on makes it (`rigger.core.game`: one bone per role, Mixamo's names, "
+             f"a root that deforms nothing; bone heat on its own bones, at most 4 weights per vertex), on the "
+             f"{game['models']} models whose body plan it fills, fitted to the same poses (seed {seeds[0]}). Its "
+             f"excess over the artist skeleton with Rigger's skinning is **{game['excess_mean']:.4f}** on average "
+             f"(Rigger's own rig on these models: {game['rigger_excess_mean']:.4f}); worst "
+             f"{worst(game['worst'], digits=4)}. It has fewer bones than Rigger's skeleton (a humanoid's limbs are "
+             f"one bone per role, as engines expect), so it follows the artist's poses less closely."
+             + (f" Failed: {', '.join(game['failed'])}." if game["failed"] else ""), ""]
+    rows = [[r["model"], f"{r['bones']['rigger']} / {r['game_bones']}", f"{r['seeds'][first]['excess']:+.4f}",
+             f"{r['seeds'][first]['game_excess']:+.4f}"]
+            for r in complete(records) if "game_excess" in r["seeds"][first]]
+    return lines + markdown_table(["model", "bones Rigger / game", "excess Rigger", "excess game"], rows)
 
 
 def _where_mirrored(mirrored, count, asymmetries):
@@ -430,6 +469,7 @@ def report(records, summary, run):
               f"{min(r['skeleton']['own_recall'] for r in complete(records)):.2f} at worst (a check)."]
     lines += ["", "## Targets (issue 28)", ""]
     lines += markdown_table(["target", "issue's \"now\"", "measured", ""], target_rows(summary))
+    lines += game_section(records, summary, seeds)
     lines += ["", "![excess error, cracks, limb recall, twins per model](posing.png)", "", "## Per model", "",
               f"Errors in units of size, seed {seeds[0]} (excess also seed {seeds[1]})." if len(seeds) > 1 else
               f"Errors in units of size, seed {seeds[0]}.", ""]

@@ -383,21 +383,28 @@ def dominant_joints(rig):
     return np.where(weighted, weight_owners(rig.parents)[top], -1)
 
 
-def skinned_mesh(name, vertices, triangles, skeleton):
+def skinned_mesh(name, vertices, triangles, skeleton, target="plain"):
     """Blender mesh object ``name`` of ``vertices`` and ``triangles`` (as they are: UV-seam duplicates stay), alone
-    in a fresh scene with an armature of ``skeleton``, skinned by ``rigger.blender.skinning.skin``: (the mesh
-    object, the skinning report). Imports bpy."""
+    in a fresh scene with the armature output target ``target`` builds of ``skeleton`` (``plain``: its bones as they
+    are; ``game``: the game skeleton), skinned by ``rigger.blender.skinning.skin`` and finished as the add-on
+    finishes that target: (the mesh object, the skinning report, the armature's deforming bones as a skeleton).
+    Imports bpy."""
     import bpy
-    from rigger.blender.armature import build_armature
+    from rigger.blender import targets
     from rigger.blender.headless import empty_scene
     from rigger.blender.skinning import skin
+    from rigger.core.targets import TARGETS
 
     empty_scene()
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(np.asarray(vertices).tolist(), [], np.asarray(triangles).tolist())
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
-    return obj, skin(obj, build_armature(skeleton, f"{name}_rig"))
+    built = targets.build(TARGETS[target], skeleton, f"{name}_rig", bpy.context.scene.collection, None,
+                          (np.asarray(vertices, dtype=np.float64), np.asarray(triangles)))
+    report = skin(obj, built.armature)
+    targets.skinned(target, obj, built.armature, report)
+    return obj, report, built.bones
 
 
 def vertex_group_weights(obj, names):

@@ -111,7 +111,7 @@ def skin_model(model, kind):
             skeleton = rigger.rig_mesh(model.vertices, model.triangles.astype(np.int32))
             record["rig_seconds"] = time.perf_counter() - started
             joint_of_bone = model.head_joint[nearest_true_bones(skeleton, model.skeleton)]
-        obj, report = rigdata.skinned_mesh(model.name, model.vertices, model.triangles, skeleton)
+        obj, report, _ = rigdata.skinned_mesh(model.name, model.vertices, model.triangles, skeleton)
         record["seconds"] = report.seconds
         names = list(skeleton.names)
         dominant = dominant_bones(obj, names)

@@ -219,6 +219,17 @@ def test_the_benchmark_measures_every_rig_on_a_real_model():
     assert rigs["artist"]["mean"] < 1e-5 and len(rigs["artist"]["per_pose"]) == 2
     assert rigs["stick"]["mean"] > 3 * max(rigs["artist_skin"]["mean"], rigs["rigger"]["mean"])
     assert record["seeds"]["3"]["excess"] == pytest.approx(rigs["rigger"]["mean"] - rigs["artist_skin"]["mean"])
+    assert "game" not in rigs and "game_error" not in record  # a legless bust's plan: no game target to measure
     skeleton = record["skeleton"]
     assert skeleton["own_recall"] == 1.0 and 0.0 <= skeleton["limb_recall"] <= 1.0
     assert skeleton["plane"]["two_sided"] and set(skeleton["twins"]) and skeleton["unsided"] is not None
+
+
+def test_the_benchmark_measures_the_game_target_where_the_plan_fills_it():
+    pytest.importorskip("bpy")
+    import posing
+
+    record = posing.measure(shared_path("models", "gt", "rignet_2982"), seeds=[3], poses=2)  # a quadruped
+    rigs = record["seeds"]["3"]["rigs"]
+    assert "game_error" not in record and 3 < record["game_bones"] < record["bones"]["rigger"]
+    assert record["seeds"]["3"]["game_excess"] == pytest.approx(rigs["game"]["mean"] - rigs["artist_skin"]["mean"])
