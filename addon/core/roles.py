@@ -26,11 +26,12 @@ digit): point}``), placed along the chains where the artists' rigs have them rat
 when the thigh stands upright; a front leg's shoulder joint no higher than where its upper arm's bones begin; a
 humanoid's no higher above its crotch than the leg lies off the mirror plane there), the knee ``knee_at`` of the way
 between (a bend there, below where the thigh's bones begin, winning) and the ball of the foot ``toe_at`` of the way
-to the toes' tip (a quadruped's hind leg, on its toes: the ankle is its hock, at ``hock_at`` of its hip joint's
+to the toes' tip (a quadruped's hind leg, on its toes: the ankle is its hock, at ``hock_at`` of that hip joint's
 height, a bend there winning; the knee ``knee_at`` of the way down to it; the ball where it comes down to
-``ankle_height``); on an arm the shoulder joint where the arm leaves the torso, the
-elbow and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end of the hand (the mesh beyond the
-last joint included; a bend winning for the elbow), the collarbone's start ``clavicle_at`` of the way in; on an upright
+``ankle_height``; then the hip joint where the thigh's bones begin, atop the rump); on an arm the shoulder joint
+where the arm leaves the torso, the elbow and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end
+of the hand (the mesh beyond the last joint included; a bend winning for the elbow), the collarbone's start
+``clavicle_at`` of the way in; on an upright
 humanoid's spine the hips, spine, chest and neck at ``hips_at`` ... ``neck_at`` of the height from the hip joints to
 the shoulder joints. :func:`landmarks` gives the ends no role begins at, placed the same way: head top, hand and
 toe tips, finger tips, heels. A place is a weighted sum of points on bones, so named joints and landmarks follow
@@ -100,8 +101,9 @@ class RoleTuning(TuningTable):
     bend_window: float = tuned(0.2, "a bend counts within this share of the limb's length of where the joint belongs")
     knee_at: float = tuned(0.47, "a knee's share of the way from the hip to the ankle (the artists' humanoids: 0.38 "
                                  "to 0.49, median 0.47; their animals' from the hip to the hock: 0.41 to 0.56)")
-    hock_at: float = tuned(0.42, "a quadruped's hind leg stands on its toes: its ankle, the hock, at this share of its "
-                               "hip joint's height (the artists' animals and Rigify's: 0.34 to 0.53)")
+    hock_at: float = tuned(0.42, "a quadruped's hind leg stands on its toes: its ankle, the hock, at this share of the "
+                               "height ``hip_rise`` gives a leg's hip joint (the artists' animals and Rigify's: 0.34 "
+                               "to 0.53 of their own hip joints')")
     shoulder_thickness: float = tuned(1.3, "an arm's shoulder joint is its first joint where the mesh is at most this "
                                            "many times as thick as along the arm (the torso is thicker) ...")
     arm_from: float = tuned(0.3, "... the arm's thickness being the median at its joints from this share of its "
@@ -868,7 +870,8 @@ def _leg_joints(body, path, arc, front, tuning, kind):
     legs hang from the middle of his chest, a heavy golem's stubby legs stand wide apart under a belly that hides his
     thighs; a front leg's shoulder joint no higher than where its path turns down, :func:`_thigh_start`: a bear's runs
     along its shoulder blade first), the knee at ``knee_at`` of the way between (a bend near there, below where the
-    thigh's bones begin, winning)."""
+    thigh's bones begin, winning). A leg on its toes then has its hip joint where its thigh's bones begin, atop the
+    rump (the artists' animals' within 0.03 of the height)."""
     points = path.points
     heights = body.height(points)
     ankle = _down_to(heights, arc, tuning.ankle_height)
@@ -883,10 +886,13 @@ def _leg_joints(body, path, arc, front, tuning, kind):
     if front and thigh_from < ankle:  # no higher than where the upper arm's bones begin (a bear's blade)
         hip = max(hip, thigh_from)
         hip_height = float(np.interp(hip, arc, heights))
-    if _on_toes(front, kind):  # the hock, its bend seen from the middle of the leg (the knee may lie above it)
+    toes = _on_toes(front, kind)
+    if toes:  # the hock, its bend seen from mid-leg (the knee lies above it)
         ankle = _bent(points, arc, hip + tuning.knee_at * (ankle - hip),
                       _down_to(heights, arc, tuning.hock_at * hip_height), ankle, ankle - hip, tuning)
     knee = _bent(points, arc, max(hip, thigh_from), hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
+    if toes and thigh_from < knee:  # the hip joint atop the rump, where the thigh's bones begin
+        hip, hip_height = thigh_from, float(np.interp(thigh_from, arc, heights))
     return hip, hip_height, knee, ankle
 
 
