@@ -231,12 +231,13 @@ def summarise(records, seeds):
         "excess_vs_recall": float(spearmanr([v for _, v in excess], [v for _, v in recall])[0]),
     })
     games = [r for r in good if "game_excess" in r["seeds"][first]]
-    if games:
+    failed = [r["model"] for r in good if "game_error" in r]
+    if games or failed:
         game = [(r["model"], r["seeds"][first]["game_excess"]) for r in games]
-        summary["game"] = {"models": len(games), "excess_mean": float(np.mean([v for _, v in game])),
-                           "rigger_excess_mean": float(np.mean([r["seeds"][first]["excess"] for r in games])),
-                           "worst": sorted(game, key=lambda pair: -pair[1])[:3],
-                           "failed": [r["model"] for r in good if "game_error" in r]}
+        summary["game"] = {"models": len(games), "failed": failed,
+                           "excess_mean": float(np.mean([v for _, v in game])) if game else float("nan"),
+                           "rigger_excess_mean": float(np.mean([r["seeds"][first]["excess"] for r in games]))
+                           if games else float("nan"), "worst": sorted(game, key=lambda pair: -pair[1])[:3]}
     per_pose = [np.subtract(r["seeds"][first]["rigs"]["rigger"]["per_pose"],
                             r["seeds"][first]["rigs"]["artist_skin"]["per_pose"]) for r in good]
     summary["excess_standard_error"] = float(np.mean([np.std(each, ddof=1) / np.sqrt(len(each)) if len(each) > 1

@@ -387,7 +387,8 @@ def skinned_mesh(name, vertices, triangles, skeleton, target="plain"):
     """Blender mesh object ``name`` of ``vertices`` and ``triangles`` (as they are: UV-seam duplicates stay), alone
     in a fresh scene with the armature output target ``target`` builds of ``skeleton`` (``plain``: its bones as they
     are; ``game``: the game skeleton), skinned by ``rigger.blender.skinning.skin`` and finished as the add-on
-    finishes that target: (the mesh object, the skinning report, the armature's deforming bones as a skeleton).
+    finishes that target: (the mesh object, the skinning report, the armature's bones as a skeleton: the game's
+    root among them, which deforms nothing).
     Imports bpy."""
     import bpy
     from rigger.blender import targets

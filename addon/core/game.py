@@ -308,7 +308,7 @@ class _Bones:
     def __init__(self, graph, joints):
         self.graph = graph
         self.joints = joints  # named joints, {(role, side, digit): point}
-        self.bones = []  # dicts: base, number, side, points (head, tail), role, start node, chain id
+        self.bones = []  # dicts: base, number, suffix, side, points (head, tail), role, start node, chain id, hang
         self.edge_owner = {}  # graph edge -> game bone index
         self.node_owner = {}  # graph node -> the game bone that holds it (children hang from it)
         self.hips = None  # the Hips bone, once the trunk made it
@@ -457,7 +457,8 @@ class _Bones:
 
     def finished(self, arriving):
         """(names, heads, tails, parents, roles): each bone hangs from the game bone holding the joint its chain
-        starts at (the Hips at the hips node), or from the bone before it in its chain."""
+        starts at (the Hips at the hips node; a chain hung beside its Rigger parent's end, ``hang``: the game bone
+        that took that parent over), or from the bone before it in its chain."""
         names = [f"{SIDE_WORDS[bone['side']]}{bone['base']}{bone['number']}{bone['suffix']}" for bone in self.bones]
         if len(set(names)) != len(names):
             raise ValueError(f"game bone names collide: {sorted(n for n in names if names.count(n) > 1)}")
@@ -470,7 +471,7 @@ class _Bones:
                 parents.append(index - 1)
             else:  # a chain hung beside its parent bone's end (ears near a head's start): from that bone's owner
                 owner = self.edge_owner.get(bone["hang"]) if bone["hang"] is not None else None
-                if owner is None or owner == index:
+                if owner is None:
                     owner = self._holder(bone["start"], arriving, index)
                 parents.append(owner if owner is not None else -1 if hips is None else hips)
         heads = np.array([bone["head"] for bone in self.bones])

@@ -36,11 +36,11 @@ How the bones are placed, in order:
   takes the bend direction from the chain); a limb bent sideways leans at most ``tilt`` from that. An animal's hind
   leg whose first joint bends backward is read one joint down: that joint is its hock, and its knee (hidden in the
   body) goes where the metarig has it relative to the hip and the hock; one whose shin bends back well above the paw
-  (its roles begin the foot near the ground) has its hock, where Rigify's foot begins, at that bend; a hind knee
-  bending forward less than the metarig's (the skeleton runs down the middle of a flank that hides it) goes where
-  the metarig has it too: Rigify's three-bone paw bends the way its chain bends at rest, and a nearly straight knee
-  above a sharp hock folded back. A joint the skeleton bends the wrong way by more than ``bend_move`` stays (the fit
-  says so).
+  (its roles begin the foot near the ground: a leg with too few joints to cut at its hock) has its hock, where
+  Rigify's foot begins, at that bend; a hind knee bending forward less than the metarig's (the skeleton runs down the
+  middle of a flank that hides it: every animal's in ``../shared``) goes where the metarig has it too: Rigify's
+  three-bone paw bends the way its chain bends at rest, and a nearly straight knee above a sharp hock folded back. A
+  joint the skeleton bends the wrong way by more than ``bend_move`` stays (the fit says so).
 - Twins that mirror within ``mirror_tolerance`` of the size are made exact mirror images across the midline.
 - The heel (Rigify's ``heel.02``, the foot's rocking edge) runs across the back of the foot on the ground, from the
   mesh: the foot's vertices below the ankle, their rearmost and their width.
@@ -531,16 +531,17 @@ def _fit_chain(body, chain, side, names, meta, tuning):
     others = [bone for bone in range(len(body.roles)) if bone not in own]
     joints = _joints(body, groups, points, arc, step_roles, lengths, tuning, (skeleton_side, chain.digit), side,
                      others)
-    meta_joints = np.array([meta[name].head for name in names[:3]], dtype=np.float64)
-    if chain.hock and _bent(joints, chain.bend)[0] < 0:  # the first joint bends backward: it is the hock
-        del body.notes[noted:]  # read again from the hock, which notes what it lacks itself
-        joints = _joints(body, _groups(chain.hock), points, arc, step_roles, lengths, tuning, side=side,
-                         others=others)
-        joints[1] = _as_in_metarig(joints, meta_joints, chain.bend)
-    elif chain.hock:
-        _hock(joints, body.local(points), tuning)
-        if _forward_share(joints, chain.bend) < _forward_share(meta_joints, chain.bend):  # a knee in the flank
+    if chain.hock:
+        meta_joints = np.array([meta[name].head for name in names[:3]], dtype=np.float64)
+        if _bent(joints, chain.bend)[0] < 0:  # the first joint bends backward: it is the hock
+            del body.notes[noted:]  # read again from the hock, which notes what it lacks itself
+            joints = _joints(body, _groups(chain.hock), points, arc, step_roles, lengths, tuning, side=side,
+                             others=others)
             joints[1] = _as_in_metarig(joints, meta_joints, chain.bend)
+        else:
+            _hock(joints, body.local(points), tuning)
+            if _forward_share(joints, chain.bend) < _forward_share(meta_joints, chain.bend):  # a knee in the flank
+                joints[1] = _as_in_metarig(joints, meta_joints, chain.bend)
     if groups[0] == ("palm",):
         joints[0] = _palm_head(joints, meta, names, side)
     if chain.bend and not _bend(joints, chain.bend, tuning):

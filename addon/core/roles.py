@@ -380,8 +380,8 @@ def _connector_role(spine, names, base):
 
 def _leg(body, limb, path, front, kind, tuning, put):
     """Roles along a leg's main ``path``: hips (or shoulder), thigh, shin, foot, toe (front legs: shoulder,
-    upper_arm, forearm, hand); the shin from the joint nearest the knee's named place and, on a quadruped's hind leg,
-    the foot from the joint nearest its hock's (:func:`_leg_joints`)."""
+    upper_arm, forearm, hand); the shin from the joint nearest the knee's named place and, on a leg on its toes, the
+    foot from the joint nearest its hock's and the toe from the ground's (:func:`_leg_joints`)."""
     nodes, points = list(limb.main), path.points
     last = len(nodes) - 1
     thigh = _thigh_start(body, points, tuning)
@@ -392,12 +392,12 @@ def _leg(body, limb, path, front, kind, tuning, put):
     knee = ankle
     if ankle - thigh >= 2:
         arc = arc_lengths(points)
-        _, _, at, hock = _leg_joints(body, path, arc, front, tuning, kind)
-        if _on_toes(front, kind) and ankle - thigh >= 3:  # the foot from the hock, the toes from the ground
-            hock = min(range(thigh + 2, ankle + 1), key=lambda i: abs(arc[i] - hock))
-            toe = ankle if ankle > hock else last
+        _, _, knee_arc, ankle_arc, ball_arc = _leg_joints(body, path, arc, front, tuning, kind)
+        if ankle_arc < ball_arc:  # on its toes: the foot from the hock, the toes from the ground
+            hock = min(range(thigh + 2, ankle + 1), key=lambda i: abs(arc[i] - ankle_arc))
+            toe = ankle if ankle > hock else toe
             ankle = hock
-        knee = min(range(thigh + 1, ankle), key=lambda i: abs(arc[i] - at))
+        knee = min(range(thigh + 1, ankle), key=lambda i: abs(arc[i] - knee_arc))
     names = (["shoulder", "upper_arm", "forearm", "hand", "hand"] if front else
              ["hips", "thigh", "shin", "foot", "toe"])
     roles = _segments(names, [thigh, knee, ankle, toe, last])
@@ -408,9 +408,11 @@ def _leg(body, limb, path, front, kind, tuning, put):
             * (len(path) - 1 - split))
 
 
-def _on_toes(front, kind):
-    """Whether a leg stands on its toes, its ankle (the hock) high above the ground: a quadruped's hind leg."""
-    return kind == "quadruped" and not front
+def _on_toes(front, kind, arc, thigh, ground):
+    """Whether a leg stands on its toes, its ankle (the hock) high above the ground: a quadruped's hind leg with
+    room for a knee and a hock, two joints or more between where its thigh begins and the ground (arc positions
+    ``thigh`` and ``ground`` along a path whose joints lie at ``arc``)."""
+    return kind == "quadruped" and not front and np.count_nonzero((arc > thigh) & (arc < ground)) >= 2
 
 
 def _thigh_start(body, points, tuning):
@@ -840,10 +842,10 @@ def _leg_places(body, path, arc, front, tuning, kind):
     comes down to ``ankle_height``), and the heel."""
     points = path.points
     heights = body.height(points)
-    hip, hip_height, knee, ankle = _leg_joints(body, path, arc, front, tuning, kind)
+    hip, hip_height, knee, ankle, ball = _leg_joints(body, path, arc, front, tuning, kind)
     tip = arc[-1] + path.reach
-    ball = _down_to(heights, arc, tuning.ankle_height)
-    toe = ball if _on_toes(front, kind) else ankle + tuning.toe_at * (tip - ankle)
+    toes = ankle < ball
+    toe = ball if toes else ankle + tuning.toe_at * (tip - ankle)
     thigh = 0.5 * (hip + knee)
     line = _along(points, arc, thigh) - _along(points, arc, knee)
     rise = float(line @ body.up)
@@ -854,7 +856,7 @@ def _leg_places(body, path, arc, front, tuning, kind):
         ("thigh", "shin", "foot", "toe", "toe_tip")
     places = {name: spots for name, spots in zip(names, (hip_spots, ((knee, 1.0),), ((ankle, 1.0),), ((toe, 1.0),),
                                                          ((tip, 1.0),))) if name}
-    heel = None if front else _heel(body, points, arc, ankle, ball, tip, tuning) if _on_toes(front, kind) \
+    heel = None if front else _heel(body, points, arc, ankle, ball, tip, tuning) if toes \
         else _heel(body, points, arc, knee, ankle, tip, tuning)
     if heel is not None:
         places["heel"] = heel
@@ -862,38 +864,40 @@ def _leg_places(body, path, arc, front, tuning, kind):
 
 
 def _leg_joints(body, path, arc, front, tuning, kind):
-    """(hip, its height, knee, ankle) along a leg's path (arc positions; the height a share of the mesh's) of a body
-    plan of ``kind``: the ankle where it comes down to ``ankle_height`` (a leg on its toes, :func:`_on_toes`: its
-    hock at ``hock_at`` of the hip joint's height, a bend near there seen from mid-leg winning), the hip joint at
-    ``hip_rise`` of the height from the ankle on the ground to where the leg hangs (a humanoid's no higher above its
-    crotch, :func:`_crotch`, than the leg lies off the mirror plane where it comes down to it: a gingerbread man's
-    legs hang from the middle of his chest, a heavy golem's stubby legs stand wide apart under a belly that hides his
-    thighs; a front leg's shoulder joint no higher than where its path turns down, :func:`_thigh_start`: a bear's runs
-    along its shoulder blade first), the knee at ``knee_at`` of the way between (a bend near there, below where the
-    thigh's bones begin, winning). A leg on its toes then has its hip joint where its thigh's bones begin, atop the
-    rump (the artists' animals' within 0.03 of the height)."""
+    """(hip, its height, knee, ankle, ball) along a leg's path (arc positions; the height a share of the mesh's) of a
+    body plan of ``kind``: the ball where it comes down to ``ankle_height``, the ankle there too (a leg on its toes,
+    :func:`_on_toes`: its hock at ``hock_at`` of the hip joint's height, above the ball, a bend near there seen from
+    mid-leg winning), the hip joint at ``hip_rise`` of the height from the ball to where the leg hangs (a humanoid's
+    no higher above its crotch, :func:`_crotch`, than the leg lies off the mirror plane where it comes down to it: a
+    gingerbread man's legs hang from the middle of his chest, a heavy golem's stubby legs stand wide apart under a
+    belly that hides his thighs; a front leg's shoulder joint no higher than where its path turns down,
+    :func:`_thigh_start`: a bear's runs along its shoulder blade first), the knee at ``knee_at`` of the way between
+    (a bend near there, below where the thigh's bones begin, winning). A leg on its toes then has its hip joint where
+    its thigh's bones begin, atop the rump (the artists' animals' within 0.03 of the height)."""
     points = path.points
     heights = body.height(points)
-    ankle = _down_to(heights, arc, tuning.ankle_height)
-    ankle_height = float(np.interp(ankle, arc, heights))
-    hip_height = ankle_height + tuning.hip_rise * (heights[0] - ankle_height)
-    crotch = _crotch(body, path, ankle_height) if kind == "humanoid" else None
+    ball = _down_to(heights, arc, tuning.ankle_height)
+    ball_height = float(np.interp(ball, arc, heights))
+    hip_height = ball_height + tuning.hip_rise * (heights[0] - ball_height)
+    crotch = _crotch(body, path, ball_height) if kind == "humanoid" else None
     if crotch is not None:  # no higher above the crotch than the leg, where it leaves the body, lies off the plane
         beside = abs(float(body.plane.distance(_along(points, arc, _down_to(heights, arc, crotch)))))
         hip_height = min(hip_height, crotch + beside / (body.high - body.low))
     hip = _down_to(heights, arc, hip_height)
     thigh_from = float(arc[_thigh_start(body, points, tuning)])  # above, the path runs in the body
-    if front and thigh_from < ankle:  # no higher than where the upper arm's bones begin (a bear's blade)
+    if front and thigh_from < ball:  # no higher than where the upper arm's bones begin (a bear's blade)
         hip = max(hip, thigh_from)
         hip_height = float(np.interp(hip, arc, heights))
-    toes = _on_toes(front, kind)
+    ankle = ball
+    toes = _on_toes(front, kind, arc, thigh_from, ball)
     if toes:  # the hock, its bend seen from mid-leg (the knee lies above it)
-        ankle = _bent(points, arc, hip + tuning.knee_at * (ankle - hip),
-                      _down_to(heights, arc, tuning.hock_at * hip_height), ankle, ankle - hip, tuning)
+        ankle = _bent(points, arc, hip + tuning.knee_at * (ball - hip),
+                      min(_down_to(heights, arc, tuning.hock_at * hip_height), ball), ball, ball - hip, tuning)
+        toes = ankle < ball
     knee = _bent(points, arc, max(hip, thigh_from), hip + tuning.knee_at * (ankle - hip), ankle, ankle - hip, tuning)
     if toes and thigh_from < knee:  # the hip joint atop the rump, where the thigh's bones begin
         hip, hip_height = thigh_from, float(np.interp(thigh_from, arc, heights))
-    return hip, hip_height, knee, ankle
+    return hip, hip_height, knee, ankle, ball
 
 
 def _crotch(body, path, ankle):
