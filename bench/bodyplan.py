@@ -146,6 +146,11 @@ NAMED = {
                      "joint_1": "foot", "joint_13": "foot"},
 }
 
+# The animals' hind legs by hand (Quaternius rigs: hip, knee, hock); scored apart from the humanoids' targets. Their
+# front legs are left out: the artist marks a dog's elbow and a deer's carpus as the same joint.
+ANIMAL_LEGS = {f"Quaternius_{animal}": {f"{joint}.{side}": role for side in ("L", "R") for joint, role in
+                                        (("BackLeg", "thigh"), ("BackUpperLeg", "shin"), ("BackLowerLeg", "foot"))}
+               for animal in ("Alpaca", "Deer", "Fox", "Husky", "ShibaInu", "Wolf")}
 
 # Which way each animal's head points as Blender imports the file (the axis, in Blender's world, from the body's
 # middle to its head), from renders and the artists' joints; the humanoids' heads are in the named joints.
@@ -209,6 +214,11 @@ def measure(name):
             record["named"] = {"rigger": joint_errors(found_joints(skeleton, middle, size), truth, size),
                                "nearest": nearest_joints(skeleton, truth, size),
                                "artist_roles": role_agreement(artist, head_joint, rig, NAMED[name], middle, size)}
+        if name in ANIMAL_LEGS:
+            axis = mirror_axis(mesh)
+            middle = (axis, float(rig.positions[rig.names.index(rig.root), axis]))
+            truth = named_truth(rig, ANIMAL_LEGS[name], middle, size)
+            record["animal_legs"] = joint_errors(found_joints(skeleton, middle, size), truth, size)
     return record
 
 
@@ -446,7 +456,29 @@ def report(records, summary, run):
               *markdown_table(["model", "named", "Rigger names", "mean", "max", "worst joint", "artist roles right"], [
                   model_row(record) for record in records if "named" in record]), ""]
     lines += ["## Where it fails and why", "", *failure_notes(records, summary), ""]
+    lines += animal_leg_lines(records)
     return "\n".join(lines) + "\n"
+
+
+def animal_leg_lines(records):
+    """The animals' hind legs: Rigger's named hip joint, knee and hock against the artists' (``ANIMAL_LEGS``)."""
+    legged = [record for record in records if record.get("animal_legs")]
+    if not legged:
+        return []
+    joints = ("thigh", "shin", "foot")
+
+    def mean(of, role):  # over both sides; a joint Rigger names none of counts as missing
+        return float(np.nanmean([np.nan if error is None else error for record in of
+                                 for key, error in record["animal_legs"].items() if key.split(".")[0] == role]))
+
+    rows = [[record["model"], *(f"{mean([record], role):.4f}" for role in joints)] for record in legged]
+    means = [mean(legged, role) for role in joints]
+    return ["## The animals' hind legs", "",
+            "Rigger's named joints where the hind leg's thigh, shin and foot begin (the hip joint, the knee and the "
+            "hock) against the Quaternius artists' joints (``ANIMAL_LEGS``), in mesh sizes, both sides averaged; not "
+            "part of the humanoid targets above.", "",
+            *markdown_table(["model", "hip joint (thigh)", "knee (shin)", "hock (foot)"],
+                            rows + [["**mean**", *(f"**{mean:.4f}**" for mean in means)]]), ""]
 
 
 def mark(record, source):
