@@ -16,7 +16,8 @@ from rigger.core import rooting
 from rigger.core.body import read_body
 from rigger.core.bodyplan import KINDS, BodyPlan, recognise
 from rigger.core.mesh import Mesh
-from rigger.core.roles import LANDMARKS, ROLES, BoneRole, Roles, landmarks, named_joints
+from rigger.core.game import game_skeleton
+from rigger.core.roles import LANDMARKS, ROLES, BoneRole, Roles, landmarks, named_joints, within_reach
 from rigger.core.skeleton import Skeleton
 from rigger.core.stages import Labels, MirrorPlane
 
@@ -714,6 +715,28 @@ def test_a_quadruped_s_hind_leg_stands_on_its_toes(rigged):
         assert np.linalg.norm(joints[("foot", side, None)] - position[f"shin.{side}"]) <= 0.03 * size
         foot = next(bone for bone, role in enumerate(skeleton.roles) if role.role == "foot" and role.side == side)
         assert np.linalg.norm(skeleton.heads[foot] - position[f"shin.{side}"]) <= 0.03 * size
+
+
+def test_a_target_s_knee_moves_up_past_a_stub_of_shin():
+    """The cow's skeleton has a joint just above its hock and none at its knee: the game's knee stayed there, its Leg
+    a stub 0.04 of the height long that squashed the hock when the knee bent, because the named knee lay farther off
+    than the stub's length allows. A stub the move only lengthens does not limit it; a named joint past a short
+    bone's end, or off to the side, stays out of reach."""
+    joint, ends = np.zeros(3), [np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -0.1])]
+    assert within_reach(joint, [0.0, 0.0, 0.3], ends)  # up the long bone: the stub grows
+    assert not within_reach(joint, [0.0, 0.0, 0.9], ends)  # the long bone would shrink to a tenth
+    assert not within_reach(joint, [0.0, 0.0, -0.3], ends)  # past the stub's end
+    assert not within_reach(joint, [0.3, 0.0, 0.0], ends)  # off to the side
+    assert not within_reach(joint, [0.0, 0.0, 0.3], [ends[0], np.array([0.0, 0.0, -0.3])])  # no stub: as before
+    vertices, triangles = load_obj(shared_path("models", "nogt", "cow.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    joints, height = named_joints(skeleton), float(np.ptp(vertices @ np.asarray(skeleton.body_plan.up)))
+    knees = [joints[("shin", side, None)] for side in ("L", "R")]  # the game's Left is the cow's own left
+    for word in ("Left", "Right"):
+        leg = bones.names.index(f"{word}Leg")
+        assert min(np.linalg.norm(bones.heads[leg] - knee) for knee in knees) <= 1e-9 * height
+        assert np.linalg.norm(bones.tails[leg] - bones.heads[leg]) > 0.08 * height
 
 
 def test_an_arm_turning_at_its_deltoid_has_its_elbow_farther_down():

@@ -610,9 +610,15 @@ def within_reach(joint, named, ends, tuning=RoleTuning(), limb_start=False):
     running to ``ends``: only within ``named_reach`` of the shortest of them (of the longest at a ``limb_start``, a
     hip or shoulder joint, which the roles place where the limb leaves the body: up the bone the skeleton's leg
     hangs from when a skirt hid its top), no bone shrinking below 1 - ``named_reach`` of its length. A named joint
-    farther off is another chain's (a second pair of arms) or a guess."""
+    farther off is another chain's (a second pair of arms) or a guess. A stub the move lengthens, shorter than
+    1 - ``named_reach`` of the longest bone it shortens, does not count (a cow's shin between a knee joint just above
+    its hock and the hock: the knee moves up its thigh)."""
     lengths = [float(np.linalg.norm(np.subtract(end, joint))) for end in ends]
-    reach = (max if limb_start else min)(lengths, default=0.0)
+    shortened = [float(np.linalg.norm(np.subtract(named, end))) < length for end, length in zip(ends, lengths)]
+    stub = (1.0 - tuning.named_reach) * max((length for length, short in zip(lengths, shortened) if short),
+                                            default=0.0)
+    counted = [length for length, short in zip(lengths, shortened) if short or length >= stub]
+    reach = (max if limb_start else min)(counted or lengths, default=0.0)
     if float(np.linalg.norm(np.subtract(named, joint))) > tuning.named_reach * reach:
         return False
     return all(np.linalg.norm(np.subtract(named, end)) >= (1.0 - tuning.named_reach) * length
