@@ -207,18 +207,17 @@ def measure(name):
         plan, roles = recognise(artist, mesh)
         artist.body_plan, artist.roles = plan, roles
         record["artist"] = plan_record(plan, artist)
-        if name in NAMED:
+        if name in NAMED or name in ANIMAL_LEGS:
             axis = mirror_axis(mesh)
             middle = (axis, float(rig.positions[rig.names.index(rig.root), axis]))
+            found = found_joints(skeleton, middle, size)
+        if name in NAMED:
             truth = named_truth(rig, NAMED[name], middle, size)
-            record["named"] = {"rigger": joint_errors(found_joints(skeleton, middle, size), truth, size),
+            record["named"] = {"rigger": joint_errors(found, truth, size),
                                "nearest": nearest_joints(skeleton, truth, size),
                                "artist_roles": role_agreement(artist, head_joint, rig, NAMED[name], middle, size)}
         if name in ANIMAL_LEGS:
-            axis = mirror_axis(mesh)
-            middle = (axis, float(rig.positions[rig.names.index(rig.root), axis]))
-            truth = named_truth(rig, ANIMAL_LEGS[name], middle, size)
-            record["animal_legs"] = joint_errors(found_joints(skeleton, middle, size), truth, size)
+            record["animal_legs"] = joint_errors(found, named_truth(rig, ANIMAL_LEGS[name], middle, size), size)
     return record
 
 

@@ -12,9 +12,8 @@ named place, its toe from the ankle's height); a front leg: shoulder, upper_arm,
 to where it leaves the torso, then upper_arm, forearm and hand by shares of the rest of its reach where the artists'
 humanoids have an elbow and a wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the
 one that leaves earliest and points most away the thumb, the others index, middle, ring and pinky in order across the
-hand.
-Twins are cut at the same joints (on their mirror-averaged points). A wing: shoulder up to where it leaves the body,
-as an arm's, then wing. Fins, ears, tails and jaws take their part's role for every bone. A body plan that is
+hand. Twins are cut at the same joints (on their mirror-averaged points). A wing: shoulder up to where it leaves the
+body, as an arm's, then wing. Fins, ears, tails and jaws take their part's role for every bone. A body plan that is
 ``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when a limb's bones have them, else
 the side of the mirror plane, left being the character's left when its front is known (Blender's +X for a character
 facing -Y).
@@ -31,11 +30,10 @@ height, a bend there winning; the knee ``knee_at`` of the way down to it; the ba
 ``ankle_height``; then the hip joint where the thigh's bones begin, atop the rump); on an arm the shoulder joint
 where the arm leaves the torso, the elbow and wrist at ``elbow_at`` and ``wrist_at`` of the way from there to the end
 of the hand (the mesh beyond the last joint included; a bend winning for the elbow), the collarbone's start
-``clavicle_at`` of the way in; on an upright
-humanoid's spine the hips, spine, chest and neck at ``hips_at`` ... ``neck_at`` of the height from the hip joints to
-the shoulder joints. :func:`landmarks` gives the ends no role begins at, placed the same way: head top, hand and
-toe tips, finger tips, heels. A place is a weighted sum of points on bones, so named joints and landmarks follow
-the skeleton when it is moved (``Skeleton.transformed``).
+``clavicle_at`` of the way in; on an upright humanoid's spine the hips, spine, chest and neck at ``hips_at`` ...
+``neck_at`` of the height from the hip joints to the shoulder joints. :func:`landmarks` gives the ends no role
+begins at, placed the same way: head top, hand and toe tips, finger tips, heels. A place is a weighted sum of points
+on bones, so named joints and landmarks follow the skeleton when it is moved (``Skeleton.transformed``).
 """
 from dataclasses import dataclass, replace
 from functools import cached_property
