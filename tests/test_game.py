@@ -102,6 +102,24 @@ def test_a_quadruped_s_hind_leg_bends_at_its_knee_and_its_hock():
         assert np.linalg.norm(bones.heads[foot] - position[f"shin.{side}"]) <= 0.03 * size
 
 
+def test_a_bear_s_head_and_front_paws_get_their_own_bones():
+    """The bear's skeleton ends at its head, where its ears join, by a link of no length: the head role fell on that
+    link, so its game skeleton had Neck to Neck3 and no Head. And its front legs end in a bone running forward along
+    the ground to the paw's tip, but the ankle was the joint nearest the ankle's height, that tip: the paw was part of
+    the ForeArm and could not bend at the wrist."""
+    skeleton, game, _ = rigged("bear")
+    bones = game.skeleton
+    parent = {name: bones.names[p] if p >= 0 else None for name, p in zip(bones.names, bones.parents)}
+    assert parent["Head"].startswith("Neck") and parent["LeftEar1"] == parent["RightEar1"] == "Head"
+    position = {joint.name: np.array(joint.position) for joint in samples.character_joints("bear")}
+    size = np.ptp(load_character("bear")[0], axis=0).max()
+    for side, word in (("L", "Left"), ("R", "Right")):
+        hand = bones.names.index(f"{word}Hand")
+        assert parent[f"{word}Hand"] == f"{word}ForeArm"
+        assert np.linalg.norm(bones.heads[hand] - position[f"front_leg.{side}"]) <= 0.05 * size  # the wrist
+        assert bones.tails[hand][1] < bones.heads[hand][1]  # forward (-Y), along the paw
+
+
 def test_an_animal_s_neck_bends_along_its_length_and_its_ears_turn_with_its_head():
     """The deer's neck, three bones of Rigger's from the withers up to the skull, was one game bone, so it could only
     turn stiffly at its base; and its ears, which begin beside the head bone's start, hung from that Neck, so nodding

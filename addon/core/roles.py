@@ -351,10 +351,17 @@ def _spine_roles(body, layout, tuning):
         ears = [spine.index(body.bases[k]) for k, part in enumerate(layout.parts) if part == "ear"
                 and body.bases[k] in spine]
         start = min([thinnest] + [at - 1 for at in ears if chest + 1 < at <= count])
+        # the head has a bone: a last piece of the spine may be none (a link where the ears join it)
+        start = min(start, max(i for i in range(count) if _is_bone(body.graph, spine[i], spine[i + 1])))
         names += ["neck"] * (start - chest) + ["head"] * (count - start)
     else:
         names += ["neck", "head"][:above]  # one bone into the head pivots at the neck
     return names
+
+
+def _is_bone(graph, a, b):
+    """Whether the graph's piece from node ``a`` to node ``b`` is one of the skeleton's bones."""
+    return any(other == b and bone >= 0 for other, bone in graph.neighbours[a])
 
 
 def _skull_bend(points, start, stop, least):
@@ -386,6 +393,8 @@ def _leg(body, limb, path, front, kind, tuning, put):
     heights = body.height(points)
     low = [i for i in range(thigh + 2, last + 1) if heights[i] <= tuning.foot_height]
     ankle = min(low, key=lambda i: abs(heights[i] - tuning.ankle_height)) if low else last
+    if ankle == last and last - 1 >= thigh + 2 and _along_ground(body, points[-2], points[-1]):
+        ankle = last - 1  # the paw: a last bone running more along the ground than down is the foot
     toe = last - 1 if last - ankle >= 2 else last
     knee = ankle
     if ankle - thigh >= 2:
@@ -404,6 +413,13 @@ def _leg(body, limb, path, front, kind, tuning, put):
         split = _fork(path, nodes)
         put(path[split:], ["toe" if split >= ankle else roles[min(split, len(roles) - 1)] if roles else "other"]
             * (len(path) - 1 - split))
+
+
+def _along_ground(body, head, tail):
+    """Whether a bone from ``head`` to ``tail`` runs more along the ground than down."""
+    step = np.asarray(tail) - np.asarray(head)
+    drop = -float(step @ body.up)
+    return float(np.linalg.norm(step + drop * body.up)) > drop
 
 
 def _on_toes(front, kind, arc, thigh, ground):
