@@ -120,6 +120,22 @@ def test_a_bear_s_head_and_front_paws_get_their_own_bones():
         assert bones.tails[hand][1] < bones.heads[hand][1]  # forward (-Y), along the paw
 
 
+def test_a_cow_s_front_legs_end_in_a_hoof_of_their_own():
+    """The cow's skeleton has no joint above its front hooves, so its game ForeArm ran down to the ground and the hoof
+    could not bend; a humanoid's forearm that ends without a hand got one, a quadruped's did not. Now its Hand runs
+    from the named wrist, low on the leg, to the hoof's tip."""
+    vertices, triangles = load_obj(shared_path("models", "nogt", "cow.obj"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    up = np.asarray(skeleton.body_plan.up)
+    ground, top = (vertices @ up).min(), (vertices @ up).max()
+    for word in ("Left", "Right"):
+        hand = bones.names.index(f"{word}Hand")
+        assert bones.names[bones.parents[hand]] == f"{word}ForeArm"
+        assert bones.heads[hand] @ up - ground <= 0.15 * (top - ground)  # low on the leg
+        assert bones.tails[hand] @ up < bones.heads[hand] @ up  # down to the hoof
+
+
 def test_an_animal_s_neck_bends_along_its_length_and_its_ears_turn_with_its_head():
     """The deer's neck, three bones of Rigger's from the withers up to the skull, was one game bone, so it could only
     turn stiffly at its base; and its ears, which begin beside the head bone's start, hung from that Neck, so nodding

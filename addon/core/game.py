@@ -19,8 +19,9 @@ The naming scheme (one for every body plan; the README says the same for users):
   ``Neck2``, ..., as Mixamo numbers its spine (an animal's long neck bends along its length; engines' humanoids have
   one ``Neck``). A leg's ``hips`` bones (from the body's middle to the hip joint) are the pelvis: they
   merge into ``Hips``.
-- A humanoid's forearm (shin, neck) that ends without a hand (foot, head) gets one: ``_completed_ends``; an upper
-  arm (thigh) without a forearm (shin) after it is split at the elbow (knee): ``_split_middles``.
+- A humanoid's or quadruped's forearm (shin, neck) that ends without a hand (foot, head) gets one:
+  ``_completed_ends``; a humanoid's upper arm (thigh) without a forearm (shin) after it is split at the elbow
+  (knee): ``_split_middles``.
 - Fingers: ``LeftHandThumb1``..``3``, ``Index``, ``Middle``, ``Ring``, ``Pinky``, at most three bones each (Rigger's
   bones merged at the joints nearest the thirds); a finger without a digit is ``LeftHandFinger1``..``3``.
 - Parts without a Mixamo name keep one bone per Rigger bone, numbered from 1 along the chain: ``Tail1``, ``Tail2``,
@@ -123,6 +124,7 @@ def game_skeleton(skeleton, vertices):
     faced = facing(skeleton)
     if skeleton.body_plan.kind == "humanoid":
         names, heads, tails, parents, roles = _split_middles(names, heads, tails, parents, roles, joints)
+    if skeleton.body_plan.kind in ("humanoid", "quadruped"):
         names, heads, tails, parents, roles = _completed_ends(names, heads, tails, parents, roles,
                                                               {**joints, **landmarks(skeleton)}, vertices, faced)
     parents = _twin_parents(names, heads, tails, parents)
@@ -571,21 +573,23 @@ def _well_along(point, head, tail, shares):
 
 
 def _completed_ends(names, heads, tails, parents, roles, places, vertices, faced):
-    """A humanoid's ``Hand`` on every forearm, ``Foot`` on every shin (``Leg``) and ``Head`` on a ``Neck`` that ends
-    without one (fingers forking at the wrist, a leg ending at the ground, a neck bone running into a round head), as
+    """A humanoid's (quadruped's) ``Hand`` on every forearm, ``Foot`` on every shin (``Leg``) and ``Head`` on a
+    ``Neck`` that ends without one (fingers forking at the wrist, a leg ending at the ground, a neck bone running into a
+    round head, a cow's front leg ending at the hoof; a numbered limb, ``LeftForeArm_2``, keeps its end), as
     ``ENDS`` says: from the named wrist (ankle, head joint) in ``places`` when it lies along the bone, which then ends
     there, else from the bone's end; to the hand's reach (the ball of the foot, else its toes' tip; the head's top)
     when that lies beyond, else on along the bone. A foot the mesh shows ahead of the ankle (``core.facing.foot_ahead``,
     the ``vertices`` and the character's facing ``faced``) runs there instead, to its ball, and a ``ToeBase`` on to
-    its tip. The bone's fingers (toes; jaw and ears) hang from it. Game engines' humanoids and mocap need all three."""
+    its tip. The bone's fingers (toes; jaw and ears) hang from it. Game engines' humanoids, animal rigs and mocap need
+    all three."""
     names, heads, tails, parents, roles = list(names), heads.copy(), tails.copy(), list(parents), list(roles)
     for limb in range(len(names)):
         for word, end_word, starts, ends, carried in ENDS:
             parsed = _parsed(names[limb], word, ("Left", "Right", ""))
-            if parsed is None or _named(parsed[0], end_word, parsed[1]) in names:
-                continue
-            side_word, suffix = parsed
-            end_name = _named(side_word, end_word, suffix)
+            if parsed is None or parsed[1] or parsed[0] + end_word in names:
+                continue  # the named places are the first pair's: a numbered limb (a spur, a second arm) keeps its end
+            side_word = parsed[0]
+            end_name = side_word + end_word
             letter = side_word[:1] or None
             head, tail = heads[limb], tails[limb]
             along = tail - head
@@ -610,7 +614,7 @@ def _completed_ends(names, heads, tails, parents, roles, places, vertices, faced
             end = len(names) - 1
             parents.append(limb)
             roles.append(BoneRole(end_word.lower(), letter))
-            toe_name = _named(side_word, "ToeBase", suffix)
+            toe_name = side_word + "ToeBase"
             if foot is not None and toe_name not in names:
                 names.append(toe_name)
                 heads, tails = np.vstack([heads, foot[0]]), np.vstack([tails, foot[1]])

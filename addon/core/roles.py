@@ -4,19 +4,19 @@ first bone), given the plan's layout of the body (``core.bodyplan``). Bones keep
 Along the spine, from the tail end to the head end: tail (or root, a bone rising from the ground to the hips), hips,
 spine, chest up to where the arms, wings or front legs hang (a humanoid's arms hanging where its legs do: one bone),
 then neck up to the spine's thinnest joint above them (a quadruped's: or a sharp turn past it, ``head_bend``) and head
-beyond (one bone there is the neck: it pivots where a neck does; a fish: head, spine and tail by length). A leg: hips
-(its bones from the mirror plane until it leaves it and turns down; shoulder for a front leg), thigh, shin from the
-joint nearest the knee's named place (below), foot from the joint nearest an ankle's height, and toe (the last bone
-when the foot has two or more; a quadruped's hind leg stands on its toes: its foot from the joint nearest its hock's
-named place, its toe from the ankle's height); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up
-to where it leaves the torso, then upper_arm, forearm and hand by shares of the rest of its reach where the artists'
-humanoids have an elbow and a wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the
-one that leaves earliest and points most away the thumb, the others index, middle, ring and pinky in order across the
-hand. Twins are cut at the same joints (on their mirror-averaged points). A wing: shoulder up to where it leaves the
-body, as an arm's, then wing. Fins, ears, tails and jaws take their part's role for every bone. A body plan that is
-``other`` gives every bone the role ``other``. Sides: ``.L`` / ``.R`` bone names when a limb's bones have them, else
-the side of the mirror plane, left being the character's left when its front is known (Blender's +X for a character
-facing -Y).
+beyond, its last bone at least (one bone there is the neck: it pivots where a neck does; a fish: head, spine and tail by
+length). A leg: hips (its bones from the mirror plane until it leaves it and turns down; shoulder for a front leg),
+thigh, shin from the joint nearest the knee's named place (below), foot from the joint nearest an ankle's height (but
+never the leg's tip while its last bone runs along the ground: that is a paw), and toe (the last bone when the foot has
+two or more; a quadruped's hind leg stands on its toes: its foot from the joint nearest its hock's named place, its toe
+from the ankle's height); a front leg: shoulder, upper_arm, forearm, hand. An arm: shoulder up to where it leaves the
+torso, then upper_arm, forearm and hand by shares of the rest of its reach where the artists' humanoids have an elbow
+and a wrist (a bend near the elbow's share wins); each branch beyond the hand is a finger, the one that leaves earliest
+and points most away the thumb, the others index, middle, ring and pinky in order across the hand. Twins are cut at the
+same joints (on their mirror-averaged points). A wing: shoulder up to where it leaves the body, as an arm's, then wing.
+Fins, ears, tails and jaws take their part's role for every bone. A body plan that is ``other`` gives every bone the
+role ``other``. Sides: ``.L`` / ``.R`` bone names when a limb's bones have them, else the side of the mirror plane, left
+being the character's left when its front is known (Blender's +X for a character facing -Y).
 
 Roles are whole bones; named joints are points (:func:`named_joints`: where each role begins, ``{(role, side,
 digit): point}``), placed along the chains where the artists' rigs have them rather than at the nearest bone end
