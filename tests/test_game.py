@@ -136,6 +136,20 @@ def test_a_cow_s_front_legs_end_in_a_hoof_of_their_own():
         assert bones.tails[hand] @ up < bones.heads[hand] @ up  # down to the hoof
 
 
+def test_a_bird_s_one_neck_bone_gets_a_head_after_it():
+    """Turned Z up as Blender imports it, rignet_17872's spine ends in one bone past its chest, a neck, and its game
+    skeleton had no Head: only humanoids' necks were completed. Now every plan's are, on along the neck."""
+    vertices, triangles, _ = load_ground_truth(shared_path("models", "gt", "rignet_17872"))
+    vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])  # Y up to Blender's Z up
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    assert skeleton.body_plan.kind == "bird"
+    head, neck = bones.names.index("Head"), bones.names.index("Neck")
+    assert bones.parents[head] == neck and bones.heads[head] == pytest.approx(bones.tails[neck])
+    along = bones.tails[neck] - bones.heads[neck]
+    assert (bones.tails[head] - bones.heads[head]) @ along > 0
+
+
 def test_an_animal_s_neck_bends_along_its_length_and_its_ears_turn_with_its_head():
     """The deer's neck, three bones of Rigger's from the withers up to the skull, was one game bone, so it could only
     turn stiffly at its base; and its ears, which begin beside the head bone's start, hung from that Neck, so nodding

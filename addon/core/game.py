@@ -19,9 +19,8 @@ The naming scheme (one for every body plan; the README says the same for users):
   ``Neck2``, ..., as Mixamo numbers its spine (an animal's long neck bends along its length; engines' humanoids have
   one ``Neck``). A leg's ``hips`` bones (from the body's middle to the hip joint) are the pelvis: they
   merge into ``Hips``.
-- A humanoid's or quadruped's forearm (shin, neck) that ends without a hand (foot, head) gets one:
-  ``_completed_ends``; a humanoid's upper arm (thigh) without a forearm (shin) after it is split at the elbow
-  (knee): ``_split_middles``.
+- A forearm (shin, neck) that ends without a hand (foot, head) gets one: ``_completed_ends``; a humanoid's upper
+  arm (thigh) without a forearm (shin) after it is split at the elbow (knee): ``_split_middles``.
 - Fingers: ``LeftHandThumb1``..``3``, ``Index``, ``Middle``, ``Ring``, ``Pinky``, at most three bones each (Rigger's
   bones merged at the joints nearest the thirds); a finger without a digit is ``LeftHandFinger1``..``3``.
 - Parts without a Mixamo name keep one bone per Rigger bone, numbered from 1 along the chain: ``Tail1``, ``Tail2``,
@@ -124,9 +123,8 @@ def game_skeleton(skeleton, vertices):
     faced = facing(skeleton)
     if skeleton.body_plan.kind == "humanoid":
         names, heads, tails, parents, roles = _split_middles(names, heads, tails, parents, roles, joints)
-    if skeleton.body_plan.kind in ("humanoid", "quadruped"):
-        names, heads, tails, parents, roles = _completed_ends(names, heads, tails, parents, roles,
-                                                              {**joints, **landmarks(skeleton)}, vertices, faced)
+    names, heads, tails, parents, roles = _completed_ends(names, heads, tails, parents, roles,
+                                                          {**joints, **landmarks(skeleton)}, vertices, faced)
     parents = _twin_parents(names, heads, tails, parents)
     heads, tails = _mirrored_twins(names, heads, tails, skeleton.stages.get("mirror_plane"), size)
     hips = heads[bones.hips] if bones.hips is not None else graph.points[start]
@@ -573,9 +571,9 @@ def _well_along(point, head, tail, shares):
 
 
 def _completed_ends(names, heads, tails, parents, roles, places, vertices, faced):
-    """A humanoid's (quadruped's) ``Hand`` on every forearm, ``Foot`` on every shin (``Leg``) and ``Head`` on a
-    ``Neck`` that ends without one (fingers forking at the wrist, a leg ending at the ground, a neck bone running into a
-    round head, a cow's front leg ending at the hoof; a numbered limb, ``LeftForeArm_2``, keeps its end), as
+    """A ``Hand`` on every forearm, ``Foot`` on every shin (``Leg``) and ``Head`` on a ``Neck`` that ends without
+    one (fingers forking at the wrist, a leg ending at the ground, a neck bone running into a round head, a cow's front
+    leg ending at the hoof, a bird's one neck bone; a numbered limb, ``LeftForeArm_2``, keeps its end), as
     ``ENDS`` says: from the named wrist (ankle, head joint) in ``places`` when it lies along the bone, which then ends
     there, else from the bone's end; to the hand's reach (the ball of the foot, else its toes' tip; the head's top)
     when that lies beyond, else on along the bone. A foot the mesh shows ahead of the ankle (``core.facing.foot_ahead``,
