@@ -76,6 +76,22 @@ def test_twins_mirror_across_the_mirror_plane(name):
             assert points[left] * [-1, 1, 1] == pytest.approx(points[right], abs=1e-6)
 
 
+def test_twin_shoulders_begin_alike_whatever_moved_between_them():
+    """BrainStem's game LeftShoulder began at its named joint and its RightShoulder at the spine's end, 0.02 of the
+    size from the mirror image: the right shoulder, judged first, ended where the spine ends, which had it stay (a
+    shoulder may not move farther than that short bone allows); the neck, judged next, moved the spine's end by a
+    hair, so for the left shoulder no bone ended there. Twins are judged on the bones as they were."""
+    vertices, triangles, _ = load_ground_truth(shared_path("models", "gt", "BrainStem"))
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    plane, size = skeleton.stages["mirror_plane"], float(np.ptp(vertices, axis=0).max())
+    pairs = [(k, bones.names.index("Right" + n[4:])) for k, n in enumerate(bones.names) if n.startswith("Left")]
+    assert len(pairs) >= 8
+    for left, right in pairs:
+        for points in (bones.heads, bones.tails):
+            assert np.linalg.norm(plane.reflect(points[right]) - points[left]) <= 0.005 * size, bones.names[left]
+
+
 def test_a_quadruped_follows_the_same_scheme_from_its_hips():
     _, game, _ = rigged("quadruped")
     names = set(game.skeleton.names)

@@ -434,14 +434,16 @@ class _Bones:
     def at_named_joints(self, tolerance):
         """Move the head of each first bone of a Mixamo name to its role's named joint, with the bones of its side
         ending there (siblings starting there have joints of their own; a sided branch off a midline bone leaves that
-        bone's end on the midline), when it is within reach (``core.roles.within_reach``)."""
+        bone's end on the midline), when it is within reach (``core.roles.within_reach``). Which bones end at a joint
+        is read before any move, so twins are judged alike whatever moved between them (the neck's start, a hair)."""
+        tails = [other["tail"].copy() for other in self.bones]
         for index, bone in enumerate(self.bones):
             role = bone["role"]
             key = (role.role, role.side, None)
             if bone["number"] or bone["suffix"] or role.index or key not in self.joints:
                 continue
             old, new = bone["head"].copy(), np.asarray(self.joints[key], float)
-            ending = [other for other in self.bones if np.linalg.norm(other["tail"] - old) <= tolerance]
+            ending = [other for other, tail in zip(self.bones, tails) if np.linalg.norm(tail - old) <= tolerance]
             ends = [bone["tail"]] + [other["head"] for other in ending]
             limb_start = role.role in LIMB_STARTS
             start = bone["start"]
