@@ -6,6 +6,7 @@ import numpy as np
 
 from .core.bodyplan import recognise
 from .core.mesh import Mesh
+from .core.mirror import square_turn
 from .core.params import resolve
 from .core.registry import RigMethod, check_method, discover
 from .core.roles import Roles
@@ -40,7 +41,9 @@ def rig_mesh(vertices, triangles, method="silhouette", *, axes=None, **params):
             its X, Y and Z: the mesh is turned into that frame for the method and the body plan (whose preferred up
             is then the frame's Z), and the skeleton, its stages and the plan's up turned back; vector parameters (a
             view direction) are directions in the mesh's coordinates and turn with it. The Blender layer passes a
-            rigged object's own axes, so a character turned or tilted rigs as if it stood square to the world.
+            rigged object's own axes, so a character turned or tilted rigs as if it stood square to the world. A mesh
+            (in that frame) that mirrors about a plane off the axes is turned on, square to that plane
+            (``core.mirror.square_turn``), and its plan's reason says so.
         **params: the method's parameters by name; values may be strings as typed on a command line.
 
     Raises ValueError for an unknown method (naming the available ones and any that failed to load), unknown or
@@ -57,6 +60,10 @@ def rig_mesh(vertices, triangles, method="silhouette", *, axes=None, **params):
     rotation = None if axes is None else _rotation(axes)
     if rotation is not None:  # the method, and the body plan (Z up preferred: the object's own), in the frame
         mesh = mesh.with_vertices(mesh.vertices @ rotation.T)
+    square = square_turn(mesh)
+    if square is not None:  # a mirror plane off the axes: rigged square to it
+        mesh = mesh.with_vertices(mesh.vertices @ square.T)
+        rotation = square if rotation is None else square @ rotation
     skeleton = rigging.rig(mesh, **(values if rotation is None else _turned(rigging, values, rotation)))
     if not isinstance(skeleton, Skeleton):
         raise TypeError(f"method {rigging.name!r} returned {type(skeleton).__name__}, not a Skeleton")
@@ -68,6 +75,10 @@ def rig_mesh(vertices, triangles, method="silhouette", *, axes=None, **params):
     body_plan_seconds = time.perf_counter() - recognised
     if rotation is not None:
         skeleton = _turned_back(skeleton, rotation)
+    if square is not None:
+        turn = np.degrees(np.arccos(np.clip(0.5 * (np.trace(square) - 1.0), -1.0, 1.0)))
+        skeleton.body_plan = replace(skeleton.body_plan, reason=f"{skeleton.body_plan.reason}; rigged square to its "
+                                                                f"mirror plane, {turn:.0f} degrees off the mesh's axes")
     skeleton.params = values
     skeleton.stages["roles"] = Roles.of(skeleton, skeleton.roles)
     skeleton.timings["body_plan"] = body_plan_seconds

@@ -135,6 +135,11 @@ class Mesh:
         """Principal variances (ascending) and axes (columns) of the used vertices, at ``unit_factor`` size."""
         return np.linalg.eigh(self._scatter)
 
+    @property
+    def principal_axes(self):
+        """(3, 3) float64: the used vertices' principal axes as unit columns, their spread ascending."""
+        return self._principal[1]
+
     @cached_property
     def flat_normal(self):
         """(3,) unit normal of the plane a flat mesh (a 2D cut-out) lies in, its largest component positive; None

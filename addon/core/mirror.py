@@ -33,6 +33,14 @@ class MirrorTuning(TuningTable):
                                              "twins")
     rough_step: float = tuned(0.001, "on such a body, twins mirror across where the mesh mirrors best, found to "
                                      "this share of the size")
+    square_sample: int = tuned(50000, "whether a mesh mirrors about a plane off the axes is judged on about this "
+                                      "many of its vertices ...")
+    square_probes: int = tuned(300, "... and its plane refined on pairs: this many sample vertices ...")
+    square_pool: int = tuned(1000, "... each paired with the nearest of this many vertices to its mirror image ...")
+    square_rounds: int = tuned(8, "... in this many rounds at most ...")
+    square_near: float = tuned(0.5, "... then, when this share of them pairs, as many rounds with twice the samples "
+                                    "and ...")
+    square_exact_pool: int = tuned(20000, "... the nearest of this many")
 
 
 @dataclass(frozen=True)
@@ -358,3 +366,80 @@ def mirror_completed(limbs, symmetry):
         if symmetry.side(line) != 0 and not paired:
             result.append((images[j], limbs[j][1]))
     return result
+
+
+
+def square_turn(mesh, tuning=MirrorTuning()):
+    """A rotation (rows: the new axes) that turns ``mesh`` (a ``core.mesh.Mesh``) so the plane it mirrors about lies
+    square to the axis nearest its normal, the least turn that does; None when it mirrors about an axis plane already
+    (within ``rough_match`` of its size), or about none. A mirror plane's normal is one of the vertices' principal
+    axes when their spreads differ (mirroring leaves the spread alike on both sides), so each is a first guess, made
+    exact by :func:`_refined_normal`: a character turned about its up axis and saved so rigs as if it faced along an
+    axis, its up kept."""
+    tolerance = tuning.rough_match * mesh.scale
+    vertices = mesh.used_vertices[::max(1, len(mesh.used_vertices) // tuning.square_sample)]
+    if symmetric_planes(vertices, mesh.bbox, tolerance, tuning):
+        return None
+    probe = vertices[::max(1, len(vertices) // (2 * tuning.square_probes))]
+    pool = vertices[::max(1, len(vertices) // tuning.square_exact_pool)]
+    best, least = None, np.inf
+    for guess in mesh.principal_axes.T:
+        normal, centre = _refined_normal(vertices, guess, tolerance, tuning)
+        axis = int(np.argmax(np.abs(normal)))
+        rotation = _turned_onto(normal, np.sign(normal[axis]) * np.eye(3)[axis])
+        turned = vertices @ rotation.T
+        if not symmetric_planes(turned, np.stack([turned.min(axis=0), turned.max(axis=0)]), tolerance, tuning):
+            continue  # squaring one principal axis squares the others: the plane found may be another's
+        misfit = _refitted(probe, pool, normal, centre, tolerance)[3]
+        if misfit < least:  # of planes that hold, the one the mesh mirrors about most closely
+            best, least = rotation, misfit
+    return best
+
+
+def _refined_normal(vertices, normal, tolerance, tuning):
+    """(unit normal, a point on it) of the mirror plane nearest to ``normal`` (a guess): refitted (:func:`_refitted`)
+    up to ``square_rounds`` times to ``square_probes`` sample vertices paired with the nearest of ``square_pool``
+    others to their mirror images; when ``square_near`` of them pair or more (a plane is near), up to
+    ``square_rounds`` more times to twice the samples and up to ``square_exact_pool`` vertices, where a
+    mirror-modelled mesh's exact twins are. An asymmetric mesh costs the first rounds only."""
+    centre, share = vertices.mean(axis=0), 0.0
+    for probes, pool_size in ((tuning.square_probes, tuning.square_pool),
+                              (2 * tuning.square_probes, tuning.square_exact_pool)):
+        if pool_size == tuning.square_exact_pool and share < tuning.square_near:
+            break
+        probe = vertices[::max(1, len(vertices) // probes)]
+        pool = vertices[::max(1, len(vertices) // pool_size)]
+        for _ in range(tuning.square_rounds):
+            refitted, centre, share, _ = _refitted(probe, pool, normal, centre, tolerance)
+            settled = refitted @ normal > 1.0 - 1e-15
+            normal = refitted
+            if settled:
+                break
+    return normal, centre
+
+
+def _refitted(probe, pool, normal, centre, tolerance):
+    """(normal, centre, share, misfit): the ``probe`` points are mirrored across the plane through ``centre`` with
+    unit ``normal`` and paired with the ``pool`` point nearest each image (``misfit``: their mean distance, each at
+    most ``tolerance``; pairs farther apart dropped, ``share`` of them kept); the plane refitted to the pairs is the
+    one along whose normal they lie apart, through their midpoints. The plane as it was when fewer than three pair."""
+    image = probe - 2.0 * ((probe - centre) @ normal)[:, None] * normal
+    ranking = image @ (-2.0 * pool.T)
+    ranking += np.einsum("ij,ij->i", pool, pool)  # the squared distance but the image's own length: same order
+    nearest = np.argmin(ranking, axis=1)
+    distance = np.linalg.norm(image - pool[nearest], axis=1)
+    near = distance <= tolerance
+    misfit = float(np.mean(np.minimum(distance, tolerance)))
+    if np.count_nonzero(near) < 3:
+        return normal, centre, 0.0, misfit
+    apart = probe[near] - pool[nearest[near]]
+    refitted = np.linalg.eigh(apart.T @ apart)[1][:, -1]
+    return (refitted if refitted @ normal >= 0 else -refitted,
+            0.5 * (probe[near] + pool[nearest[near]]).mean(axis=0), float(np.mean(near)), misfit)
+
+
+def _turned_onto(a, b):
+    """The least rotation taking unit vector ``a`` onto unit vector ``b`` (not its opposite): Rodrigues' formula."""
+    cross, dot = np.cross(a, b), float(a @ b)
+    skew = np.array([[0.0, -cross[2], cross[1]], [cross[2], 0.0, -cross[0]], [-cross[1], cross[0], 0.0]])
+    return np.eye(3) + skew + skew @ skew / (1.0 + dot)
