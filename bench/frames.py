@@ -5,8 +5,10 @@ and a decision near its threshold (a branch's reach against ``prune``) may go th
 ../shared/models/gt model is rigged by ``rigger.rig_mesh`` (``axes=``: the mesh turned for the method, the skeleton
 turned back) in its file's own frame, in four frames turned from it (a quarter turn about X, about Y and about Z,
 a half turn about Z), and as Blender's OBJ importer reads it (``bodyplan.MODELS``' up: a Y-up file turned so that
-Z is up). Each skeleton is scored in the file's frame as the quality benchmark scores it (CD-J2J against the
-artist's joints, in its normalised units) and with the posing benchmark's limb recall.
+Z is up); and with its vertices turned 7° and 30° about its up axis (``bodyplan.MODELS``' up), no axes given, as a
+mesh saved turned reaches Rigger (``rig_mesh`` rigs it square to its mirror plane), the skeleton turned back. Each
+skeleton is scored in the file's frame as the quality benchmark scores it (CD-J2J against the artist's joints, in
+its normalised units) and with the posing benchmark's limb recall, and its body plan compared with the file frame's.
 
     .venv/bin/python bench/frames.py [--models NAME ...] [--out DIR]
 
@@ -35,6 +37,7 @@ TURNS = {"file": np.eye(3),
          "Z 90°": np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]]),
          "Z 180°": np.array([[-1.0, 0, 0], [0, -1, 0], [0, 0, 1]])}
 BLENDER = "Blender"  # the frame Blender's OBJ importer reads the file in
+BAKED = {"up 7° baked": 7.0, "up 30° baked": 30.0}  # vertices turned about the model's up by so many degrees
 
 
 def frames_of(name):
@@ -42,18 +45,33 @@ def frames_of(name):
     return {**TURNS, BLENDER: blender_turn(name)}
 
 
+def baked_turn(name, degrees):
+    """The rotation turning model ``name``'s vertices ``degrees`` about its up axis (``bodyplan.MODELS``)."""
+    up = "XYZ".index(MODELS[name][1])
+    a, b = [axis for axis in range(3) if axis != up]
+    angle = np.radians(degrees)
+    turn = np.eye(3)
+    turn[[a, a, b, b], [a, b, a, b]] = np.cos(angle), -np.sin(angle), np.sin(angle), np.cos(angle)
+    return turn
+
+
 def measure(folder):
-    """{frame: (CD-J2J, limb recall, bones)} of one model."""
+    """{frame: (CD-J2J, limb recall, bones, body plan)} of one model."""
     truth = quality.GroundTruth(folder)
     rig = truth.rig.attached()
     size = float(np.ptp(truth.vertices, axis=0).max())
+    triangles = truth.triangles.astype(np.int32)
     result = {}
-    for frame, turn in frames_of(folder.name).items():
-        skeleton = rigger.rig_mesh(truth.vertices, truth.triangles.astype(np.int32), axes=turn)
-        _, scores = quality.scored(truth, rigdata.Bones.of(skeleton))
-        recall, _ = posing_math.limb_recall(rig.positions, rig.parents, skeleton.heads, skeleton.tails,
-                                            skeleton.parents, size)
-        result[frame] = (float(scores["cd_j2j"]), float(recall), len(skeleton))
+    rigs = [(frame, rigger.rig_mesh(truth.vertices, triangles, axes=turn), np.eye(3))
+            for frame, turn in frames_of(folder.name).items()]
+    for frame, degrees in BAKED.items():
+        turn = baked_turn(folder.name, degrees)
+        rigs.append((frame, rigger.rig_mesh(truth.vertices @ turn.T, triangles), turn))
+    for frame, skeleton, turn in rigs:
+        heads, tails = skeleton.heads @ turn, skeleton.tails @ turn  # back in the file's frame
+        _, scores = quality.scored(truth, rigdata.Bones(heads, tails, np.asarray(skeleton.parents)))
+        recall, _ = posing_math.limb_recall(rig.positions, rig.parents, heads, tails, skeleton.parents, size)
+        result[frame] = (float(scores["cd_j2j"]), float(recall), len(skeleton), skeleton.body_plan.kind)
     return result
 
 
@@ -62,6 +80,7 @@ def report(records, run):
     means = {frame: (np.mean([r[frame][0] for r in records.values()]), np.mean([r[frame][1] for r in records.values()]))
              for frame in frames}
     moved = {frame: sum(r[frame][2] != r["file"][2] for r in records.values()) for frame in frames}
+    replanned = {frame: sum(r[frame][3] != r["file"][3] for r in records.values()) for frame in frames}
     spread = {name: max(v[0] for v in r.values()) - min(v[0] for v in r.values()) for name, r in records.items()}
     load = ", ".join(f"{value:.2f}" for value in run["load"])
     lines = ["# Frames: one mesh read in different frames", "",
@@ -72,14 +91,16 @@ def report(records, run):
              f"`{BLENDER}`: as Blender's OBJ importer reads the file (Y-up files turned, Z-up ones read with "
              "`--up Z`).", "", "## Means by frame", ""]
     lines += markdown_table(["frame", "mean CD-J2J", "mean limb recall", "models whose bone count differs from the "
-                             "file frame's"],
-                            [[frame, f"{means[frame][0]:.4f}", f"{means[frame][1]:.3f}", moved[frame]]
-                             for frame in frames])
+                             "file frame's", "models whose body plan differs"],
+                            [[frame, f"{means[frame][0]:.4f}", f"{means[frame][1]:.3f}", moved[frame],
+                              replanned[frame]] for frame in frames])
     turned = [means[frame][0] for frame in TURNS if frame != "file"]
     lines += ["", f"Turned frames: mean CD-J2J {min(turned):.4f} to {max(turned):.4f} against {means['file'][0]:.4f} "
               "in the files' own frames. Per model, the largest CD-J2J minus the smallest over the frames: median "
               f"{np.median(list(spread.values())):.4f}, largest {max(spread.values()):.4f} "
-              f"({max(spread, key=spread.get)}).", "", "![CD-J2J per model and frame](frames.png)", "",
+              f"({max(spread, key=spread.get)}). Turns in the vertices: "
+              + ", ".join(f"{frame} {means[frame][0]:.4f}, recall {means[frame][1]:.3f}, {replanned[frame]} plans "
+                          "changed" for frame in BAKED) + ".", "", "![CD-J2J per model and frame](frames.png)", "",
               "## Per model", "", "CD-J2J / limb recall / bones per frame.", ""]
     lines += markdown_table(["model", *frames, "CD-J2J spread"],
                             [[name, *(f"{r[frame][0]:.4f} / {r[frame][1]:.2f} / {r[frame][2]}" for frame in frames),
@@ -101,7 +122,7 @@ def plot(records, path):
                      s=16, label=frame, marker="D" if frame in ("file", BLENDER) else "o")
     axes.set_xticks(range(len(names)), names, rotation=60, ha="right", fontsize=8)
     axes.set_ylabel("CD-J2J")
-    axes.set_title("Rigger's skeleton of each model read in six frames")
+    axes.set_title(f"Rigger's skeleton of each model read in {len(frames)} frames")
     axes.legend(ncol=len(frames), fontsize=8)
     figure.tight_layout()
     figure.savefig(path, dpi=90)
@@ -123,8 +144,8 @@ def main(argv=None):
     records = {}
     for model in folders:
         records[model.name] = measure(model)
-        print(f"{model.name:30s} " + "  ".join(f"{frame} {cd:.4f}/{recall:.2f}/{bones}"
-                                               for frame, (cd, recall, bones) in records[model.name].items()),
+        print(f"{model.name:30s} " + "  ".join(f"{frame} {cd:.4f}/{recall:.2f}/{bones}/{plan}"
+                                               for frame, (cd, recall, bones, plan) in records[model.name].items()),
               flush=True)
     run["seconds"] = time.perf_counter() - started
     (out / "frames.md").write_text(report(records, run))
