@@ -92,6 +92,26 @@ def test_twin_shoulders_begin_alike_whatever_moved_between_them():
             assert np.linalg.norm(plane.reflect(points[right]) - points[left]) <= 0.005 * size, bones.names[left]
 
 
+def test_numbered_twins_are_numbered_alike_on_both_sides():
+    """rignet_1347, a rock monster, has a spike on each elbow and claws on each hand, all ``Extra`` chains numbered
+    ``_2``, ``_3``...: the left elbow spike was ``LeftExtra1_3``, the right one ``RightExtra1``, so twins went by
+    different names, and making twins' parents alike then hung a right claw from the arm. A right chain mirroring a
+    left one takes its number. (Turned Z up, as Blender imports it.)"""
+    vertices, triangles, _ = load_ground_truth(shared_path("models", "gt", "rignet_1347"))
+    vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])  # Y up to Blender's Z up
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    bones = game_skeleton(skeleton, vertices).skeleton
+    plane, size = skeleton.stages["mirror_plane"], float(np.ptp(vertices, axis=0).max())
+    parent = {name: bones.names[p] if p >= 0 else None for name, p in zip(bones.names, bones.parents)}
+    extras = [name for name in bones.names if name.startswith("LeftExtra") and "Right" + name[4:] in parent]
+    assert len(extras) >= 9
+    for left in extras:
+        right = bones.names.index("Right" + left[4:])
+        for points in (bones.heads, bones.tails):
+            assert np.linalg.norm(plane.reflect(points[right]) - points[bones.names.index(left)]) <= 0.02 * size
+        assert parent["Right" + left[4:]] == "Right" + parent[left][4:]
+
+
 def test_a_quadruped_follows_the_same_scheme_from_its_hips():
     _, game, _ = rigged("quadruped")
     names = set(game.skeleton.names)

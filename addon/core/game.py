@@ -117,7 +117,7 @@ def game_skeleton(skeleton, vertices):
     for chain in chains:
         if chain is not trunk:
             bones.chain(chain)
-    bones.name_instances(up)
+    bones.name_instances(up, skeleton.stages.get("mirror_plane"), TWIN_TOLERANCE * size)
     bones.at_named_joints(MERGE_TOLERANCE * size)
     names, heads, tails, parents, roles = bones.finished(arriving)
     faced = facing(skeleton)
@@ -397,14 +397,17 @@ class _Bones:
                       chain.nodes[0] if number == 1 else None, id(chain), chain.edges[low:high],
                       chain.nodes[low + 1:high + 1], hang if number == 1 else None)
 
-    def name_instances(self, up):
+    def name_instances(self, up, plane=None, tolerance=0.0):
         """``_2``, ``_3`` after the names that several chains share: ordered by the number of the bone each hangs
         from (a forearm on ``LeftArm_2`` is ``LeftForeArm_2``), then the chains going on from that bone's end before
         those branching off it on the way, then from the highest start. Names are numbered from the hips outwards,
-        so a chain's parent is numbered before it."""
-        first_of_chain = {}
+        so a chain's parent is numbered before it. With a mirror ``plane``, a right chain whose ends lie within
+        ``tolerance`` of a left chain's mirror image then takes that chain's number (a rock monster's claws and
+        elbow spikes, numbered alike on both sides whatever order the skeleton met them in)."""
+        first_of_chain, last_of_chain = {}, {}
         for index, bone in enumerate(self.bones):
             first_of_chain.setdefault(bone["chain"], index)
+            last_of_chain[bone["chain"]] = index
         by_name = {}
         for chain, index in first_of_chain.items():
             bone = self.bones[index]
@@ -427,9 +430,34 @@ class _Bones:
                                            -round(float(self.bones[first_of_chain[chain]]["head"] @ up), 9),
                                            first_of_chain[chain]))
             for count, chain in enumerate(chains[1:], start=2):
-                for bone in self.bones:
-                    if bone["chain"] == chain:
-                        bone["suffix"] = f"_{count}"
+                self._suffixed(chain, f"_{count}")
+        if plane is None:
+            return
+
+        def ends(chain):
+            return np.stack([self.bones[first_of_chain[chain]]["head"], self.bones[last_of_chain[chain]]["tail"]])
+
+        for (side, base), rights in by_name.items():
+            lefts = by_name.get(("L", base), []) if side == "R" else []
+            pairs = sorted((float(np.abs(plane.reflect(ends(right)) - ends(left)).max()), k, left)
+                           for k, right in enumerate(rights) for left in lefts)
+            twin = {}
+            for gap, k, left in pairs:
+                if gap <= tolerance and k not in twin and left not in twin.values():
+                    twin[k] = left
+            if not twin:
+                continue
+            taken = {self.bones[first_of_chain[left]]["suffix"] for left in twin.values()}
+            free = iter(suffix for suffix in ["", *(f"_{n}" for n in range(2, len(rights) + len(lefts) + 2))]
+                        if suffix not in taken)
+            for k, right in enumerate(rights):
+                self._suffixed(right, self.bones[first_of_chain[twin[k]]]["suffix"] if k in twin else next(free))
+
+    def _suffixed(self, chain, suffix):
+        """Every bone of ``chain`` numbered with ``suffix``."""
+        for bone in self.bones:
+            if bone["chain"] == chain:
+                bone["suffix"] = suffix
 
     def at_named_joints(self, tolerance):
         """Move the head of each first bone of a Mixamo name to its role's named joint, with the bones of its side
