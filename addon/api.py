@@ -112,7 +112,9 @@ def _turned_back(inside, rotation):
     """The skeleton rigged in the frame whose axes are ``rotation``'s rows, its stages and its plan's up, in the
     mesh's own coordinates (roles and named joints ride on the bones)."""
     placement = Placement(1.0, rotation)
-    plan = replace(inside.body_plan, up=tuple(placement.vector(np.asarray(inside.body_plan.up))))
+    front = inside.body_plan.front
+    plan = replace(inside.body_plan, up=tuple(placement.vector(np.asarray(inside.body_plan.up))),
+                   front=None if front is None else tuple(placement.vector(np.asarray(front))))
     skeleton = Skeleton(inside.names, placement.point(inside.heads), placement.point(inside.tails), inside.parents,
                         {name: stage.mapped(placement) for name, stage in inside.stages.items()}, roles=inside.roles,
                         body_plan=plan)

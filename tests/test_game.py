@@ -112,6 +112,21 @@ def test_numbered_twins_are_numbered_alike_on_both_sides():
         assert parent["Right" + left[4:]] == "Right" + parent[left][4:]
 
 
+@pytest.mark.parametrize("degrees", [90, 180])
+def test_a_figure_whose_skeleton_has_no_feet_keeps_its_own_left_however_it_is_turned(degrees):
+    """rignet_smith's stubby feet get no foot bones, so which way he faces came from Blender's convention, ``.L`` on
+    +X: turned about his up axis, his game ``LeftHand`` went to his right hand. The way his mesh's feet point below
+    his ankles says which way he faces."""
+    vertices, triangles, _ = load_ground_truth(shared_path("models", "gt", "rignet_smith"))
+    angle = np.radians(degrees)
+    turn = np.array([[np.cos(angle), 0.0, np.sin(angle)], [0.0, 1.0, 0.0], [-np.sin(angle), 0.0, np.cos(angle)]])
+    hands = []
+    for points in (vertices, vertices @ turn.T):
+        bones = game_skeleton(rigger.rig_mesh(points, triangles), points).skeleton
+        hands.append(bones.heads[bones.names.index("LeftHand")] @ (np.eye(3) if points is vertices else turn))
+    assert hands[0][0] > 0 and hands[1][0] > 0  # the character's left, facing +Z: +X
+
+
 def test_a_quadruped_follows_the_same_scheme_from_its_hips():
     _, game, _ = rigged("quadruped")
     names = set(game.skeleton.names)

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .body import AXES, BodyTuning, read_body, spreads_across
+from .facing import toes_way
 from .polyline import arc_lengths, length, nearest_on_segments
 from .roles import RoleTuning, assign_roles, joint_places, twin_paths
 from .stages import MirrorPlane
@@ -77,14 +78,17 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
     taper: float = tuned(1.3, "a body whose head end is this many times as thick as its tail end tapers")
     curve: float = tuned(1.15, "a spine this many times as long as its ends are apart curves")
     end_part: float = tuned(0.3, "the share of the spine's length at each end where head and tail are looked for")
+    toes_reach: float = tuned(0.1, "a humanoid's feet point the way its mesh below its ankles lies, within this "
+                                   "share of the size of each ankle across up")
 
 
 @dataclass(frozen=True)
 class BodyPlan:
     """A recognised body plan: ``kind`` (one of ``KINDS``), ``confidence`` in [0, 1], a one-line ``reason``, counts
-    of its ``parts`` ({"legs": 2, "arms": 2, ...}), the world ``up`` it stands along, and where its named joints and
+    of its ``parts`` ({"legs": 2, "arms": 2, ...}), the world ``up`` it stands along, where its named joints and
     landmarks lie on the skeleton it was recognised on (``joints``: ``core.roles.joint_places``; read them with
-    ``core.roles.named_joints`` and ``landmarks``)."""
+    ``core.roles.named_joints`` and ``landmarks``), and for a humanoid the way its mesh's feet point (``front``, a
+    world direction: ``core.facing.toes_way``; None when they show none)."""
 
     kind: str
     confidence: float
@@ -92,6 +96,7 @@ class BodyPlan:
     parts: dict = field(default_factory=dict)
     up: tuple = (0.0, 0.0, 1.0)
     joints: dict = field(default_factory=dict, repr=False)
+    front: tuple = None
 
     def to_dict(self):
         """JSON-ready: kind, confidence, reason and parts (``up`` is in the world's frame, so left out)."""
@@ -164,7 +169,26 @@ def recognise(skeleton, mesh, *, plane=None, prefer_up=AXES[2], tuning=BodyPlanT
     layout = lay_out(body, tuning)
     paths = twin_paths(body, tuning)
     roles = assign_roles(skeleton, body, layout, paths, tuning)
-    return replace(layout.plan, joints=joint_places(at_unit_size, body, layout, paths, tuning)), roles
+    plan = replace(layout.plan, joints=joint_places(at_unit_size, body, layout, paths, tuning))
+    if plan.kind == "humanoid":
+        toes = toes_way(body.vertices, _ankles(at_unit_size, roles, body.up), body.up,
+                        tuning.toes_reach * body.size)
+        plan = replace(plan, front=None if toes is None else tuple(float(v) for v in toes / np.linalg.norm(toes)))
+    return plan, roles
+
+
+def _ankles(skeleton, roles, up):
+    """Per side, where the leg's foot begins, else its leg's lowest bone end."""
+    ankles = []
+    for side in ("L", "R"):
+        feet = [bone for bone, role in enumerate(roles) if role.role == "foot" and role.side == side]
+        legs = [bone for bone, role in enumerate(roles) if role.role in ("thigh", "shin") and role.side == side]
+        if feet:
+            ankles.append(skeleton.heads[feet[0]])
+        elif legs:
+            ends = np.concatenate([skeleton.heads[legs], skeleton.tails[legs]])
+            ankles.append(ends[np.argmin(ends @ up)])
+    return ankles
 
 
 def lay_out(body, tuning=BodyPlanTuning()):

@@ -48,8 +48,8 @@ def facing(skeleton, points=None, head_node=None, tail_node=None):
 
     The front: for an animal, from the torso's middle to its head (else its neck, else from its tail to the torso's
     middle, else from its hips to its chest); for a humanoid, across the line from its ``.R`` limbs to its ``.L`` ones,
-    the way its feet point (else the front of a figure whose ``.L`` side is its left, Blender's convention), else where
-    its feet point; else Blender's -Y."""
+    the way its feet point (its foot bones', else its mesh's: ``BodyPlan.front``; else the front of a figure whose
+    ``.L`` side is its left, Blender's convention), else where its feet point; else Blender's -Y."""
     count = len(skeleton)
     if points is None:
         points = np.concatenate([skeleton.heads, skeleton.tails])
@@ -90,7 +90,8 @@ class _Reading:
                 if front_bones != [] and back_bones != []:
                     candidates.append((self.middle(front_bones) if front_bones else self.centre) -
                                       (self.middle(back_bones) if back_bones else self.centre))
-        feet = self._feet()
+        front = self.skeleton.body_plan.front  # the way the mesh's feet point, when the skeleton's do not show it
+        feet = self._feet() or ([np.asarray(front, dtype=np.float64)] if front is not None else [])
         lefts, rights = (self.bones_of(LIMBS, side) for side in ("L", "R"))
         if lefts and rights:
             across = self._across(np.cross(self.middle(lefts) - self.middle(rights), self.up))
@@ -119,6 +120,22 @@ class _Reading:
                 ankle = ends[np.argmin([np.linalg.norm(leg_ends - end, axis=1).min() for end in ends])]
                 directions.append(ends[np.argmax(np.linalg.norm(ends - ankle, axis=1))] - ankle)
         return [np.sum(directions, axis=0)] if directions else []
+
+
+def toes_way(vertices, ankles, up, reach):
+    """The way a standing figure's feet point, from its mesh: over its ``ankles``, the mean offset across ``up`` of
+    the ``vertices`` within ``reach`` of each across up and no higher than half that above it (a foot runs farther
+    ahead of its ankle than its heel behind; the shin above stands over it), summed; None when no vertex lies
+    there."""
+    total = np.zeros(3)
+    for ankle in ankles:
+        offsets = np.asarray(vertices, dtype=np.float64) - ankle
+        height = offsets @ up
+        across = offsets - height[:, None] * up
+        near = (height < 0.5 * reach) & (np.linalg.norm(across, axis=1) <= reach)
+        if near.any():
+            total += across[near].mean(axis=0)
+    return total if np.linalg.norm(total) > 0 else None
 
 
 def role_bones(bone_roles, roles, side, digit=None):
