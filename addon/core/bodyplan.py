@@ -78,8 +78,8 @@ class BodyPlanTuning(BodyTuning, RoleTuning):
     taper: float = tuned(1.3, "a body whose head end is this many times as thick as its tail end tapers")
     curve: float = tuned(1.15, "a spine this many times as long as its ends are apart curves")
     end_part: float = tuned(0.3, "the share of the spine's length at each end where head and tail are looked for")
-    toes_reach: float = tuned(0.1, "a humanoid's feet point the way its mesh below its ankles lies, within this "
-                                   "share of the size of each ankle across up")
+    toes_reach: float = tuned(0.1, "a humanoid's feet point the way its mesh about its ankles lies: within this "
+                                   "share of the size of each ankle across up, up to half that above it")
 
 
 @dataclass(frozen=True)

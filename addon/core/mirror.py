@@ -368,7 +368,6 @@ def mirror_completed(limbs, symmetry):
     return result
 
 
-
 def square_turn(mesh, tuning=MirrorTuning()):
     """A rotation (rows: the new axes) that turns ``mesh`` (a ``core.mesh.Mesh``) so the plane it mirrors about lies
     square to the axis nearest its normal, the least turn that does; None when it mirrors about an axis plane already
