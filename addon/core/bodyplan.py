@@ -173,7 +173,10 @@ def recognise(skeleton, mesh, *, plane=None, prefer_up=AXES[2], tuning=BodyPlanT
     if plan.kind == "humanoid":
         toes = toes_way(body.vertices, _ankles(at_unit_size, roles, body.up), body.up,
                         tuning.toes_reach * body.size)
-        plan = replace(plan, front=None if toes is None else tuple(float(v) for v in toes / np.linalg.norm(toes)))
+        if toes is not None and body.plane is not None:  # a front lies along the mirror plane: the rest is noise
+            toes = toes - (toes @ body.plane.normal) * body.plane.normal
+        clear = toes is not None and np.linalg.norm(toes) > 1e-9 * body.size  # a flat cut-out's feet point nowhere
+        plan = replace(plan, front=tuple(float(v) for v in toes / np.linalg.norm(toes)) if clear else None)
     return plan, roles
 
 

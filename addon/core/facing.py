@@ -9,6 +9,7 @@ import numpy as np
 from .tuning import TuningTable, tuned
 
 TORSO = ("hips", "spine", "chest")
+CLEAR_FEET = 0.5  # feet within 60 degrees of the front line say which way it faces
 LIMBS = ("upper_arm", "forearm", "hand", "thigh", "shin", "foot")
 
 
@@ -95,8 +96,9 @@ class _Reading:
         lefts, rights = (self.bones_of(LIMBS, side) for side in ("L", "R"))
         if lefts and rights:
             across = self._across(np.cross(self.middle(lefts) - self.middle(rights), self.up))
-            if across is not None:
-                candidates.append(-across if feet and feet[0] @ across < 0 else across)
+            if across is not None:  # feet pointing nearly sideways say nothing (a boot round about its ankle)
+                clear = feet and abs(feet[0] @ across) >= CLEAR_FEET * np.linalg.norm(feet[0])
+                candidates.append(-across if clear and feet[0] @ across < 0 else across)
         for direction in candidates + feet + [np.array([0.0, -1.0, 0.0]), np.array([0.0, 0.0, 1.0])]:
             across = self._across(direction)
             if across is not None:
