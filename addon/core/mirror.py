@@ -33,14 +33,15 @@ class MirrorTuning(TuningTable):
                                              "twins")
     rough_step: float = tuned(0.001, "on such a body, twins mirror across where the mesh mirrors best, found to "
                                      "this share of the size")
-    square_sample: int = tuned(50000, "whether a mesh mirrors about a plane off the axes is judged on about this "
-                                      "many of its vertices ...")
+    square_least: float = tuned(2.0, "degrees: a mirror plane off the axes by less than this is no turn ...")
+    square_sample: int = tuned(50000, "... whether a mesh mirrors about one is judged on about this many of "
+                                      "its vertices ...")
     square_probes: int = tuned(300, "... and its plane refined on pairs: this many sample vertices ...")
     square_pool: int = tuned(1000, "... each paired with the nearest of this many vertices to its mirror image ...")
     square_rounds: int = tuned(8, "... in this many rounds at most ...")
-    square_near: float = tuned(0.5, "... then, when this share of them pairs, as many rounds with twice the samples "
-                                    "and ...")
-    square_exact_pool: int = tuned(20000, "... the nearest of this many")
+    square_near: float = tuned(0.5, "... then, when this share of them pairs, ...")
+    square_exact_rounds: int = tuned(8, "... this many rounds more at most, with twice the samples ...")
+    square_exact_pool: int = tuned(8000, "... pairing with the nearest of this many")
 
 
 @dataclass(frozen=True)
@@ -385,6 +386,8 @@ def square_turn(mesh, tuning=MirrorTuning()):
     for guess in mesh.principal_axes.T:
         normal, centre = _refined_normal(vertices, guess, tolerance, tuning)
         axis = int(np.argmax(np.abs(normal)))
+        if abs(normal[axis]) > np.cos(np.radians(tuning.square_least)):
+            continue  # square already: the axis planes were tried
         rotation = _turned_onto(normal, np.sign(normal[axis]) * np.eye(3)[axis])
         turned = vertices @ rotation.T
         if not symmetric_planes(turned, np.stack([turned.min(axis=0), turned.max(axis=0)]), tolerance, tuning):
@@ -399,19 +402,23 @@ def _refined_normal(vertices, normal, tolerance, tuning):
     """(unit normal, a point on it) of the mirror plane nearest to ``normal`` (a guess): refitted (:func:`_refitted`)
     up to ``square_rounds`` times to ``square_probes`` sample vertices paired with the nearest of ``square_pool``
     others to their mirror images; when ``square_near`` of them pair or more (a plane is near), up to
-    ``square_rounds`` more times to twice the samples and up to ``square_exact_pool`` vertices, where a
-    mirror-modelled mesh's exact twins are. An asymmetric mesh costs the first rounds only."""
+    ``square_exact_rounds`` more times, while no fewer pair, with twice the samples and up to ``square_exact_pool``
+    vertices, where a mirror-modelled mesh's exact twins are."""
     centre, share = vertices.mean(axis=0), 0.0
-    for probes, pool_size in ((tuning.square_probes, tuning.square_pool),
-                              (2 * tuning.square_probes, tuning.square_exact_pool)):
-        if pool_size == tuning.square_exact_pool and share < tuning.square_near:
-            break
+    for probes, pool_size, rounds in ((tuning.square_probes, tuning.square_pool, tuning.square_rounds),
+                                      (2 * tuning.square_probes, tuning.square_exact_pool,
+                                       tuning.square_exact_rounds)):
+        if pool_size == tuning.square_exact_pool and (share < tuning.square_near or np.abs(normal).max() > np.cos(
+                np.radians(tuning.square_least))):
+            break  # no plane near, or one square already (the axis planes do not hold: a snake's S-curve)
         probe = vertices[::max(1, len(vertices) // probes)]
         pool = vertices[::max(1, len(vertices) // pool_size)]
-        for _ in range(tuning.square_rounds):
-            refitted, centre, share, _ = _refitted(probe, pool, normal, centre, tolerance)
+        for _ in range(rounds):
+            refitted, moved, paired, _ = _refitted(probe, pool, normal, centre, tolerance)
+            if pool_size == tuning.square_exact_pool and paired < share:
+                break  # pairing fewer: no nearer plane to find (an asymmetric mesh's wobble)
             settled = refitted @ normal > 1.0 - 1e-15
-            normal = refitted
+            normal, centre, share = refitted, moved, paired
             if settled:
                 break
     return normal, centre
