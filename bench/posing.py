@@ -80,15 +80,14 @@ def measure(folder, seeds, poses=POSES, max_degrees=MAX_DEGREES, params=None, bl
     for kind, skeleton in skeletons.items():
         try:
             obj, report, _ = rigdata.skinned_mesh(folder.name, vertices, triangles, skeleton)
-            rigs[kind] = pm.SkinnedRig.of(skeleton.heads, skeleton.parents,
-                                          rigdata.vertex_weights(obj, list(skeleton.names)))
+            rigs[kind] = pm.skinned_rig(obj, skeleton)
             record["skinning"][kind] = report.summary()
         except Exception as error:
             record["errors"][kind] = f"skinning: {type(error).__name__}: {error}"
     if "rigger" in skeletons and TARGETS["game"].unfit(skeletons["rigger"].body_plan) is None:
         try:  # the game target, as the add-on builds and skins it (a failure here is its own, not the product's)
             obj, report, bones = rigdata.skinned_mesh(folder.name, vertices, triangles, skeletons["rigger"], "game")
-            rigs["game"] = pm.SkinnedRig.of(bones.heads, bones.parents, rigdata.vertex_weights(obj, list(bones.names)))
+            rigs["game"] = pm.skinned_rig(obj, bones)
             record["game_bones"] = len(bones)
         except Exception as error:
             record["game_error"] = f"{type(error).__name__}: {error}"

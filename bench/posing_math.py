@@ -106,6 +106,11 @@ def artist_rig(rig):
                          csr_matrix((skin.data, (skin.row, owners[skin.col])), shape=skin.shape))
 
 
+def skinned_rig(obj, bones):
+    """The rig of ``bones`` (names, heads, parents) with the weights the Blender mesh object ``obj`` holds for them."""
+    return SkinnedRig.of(bones.heads, bones.parents, rigdata.vertex_weights(obj, list(bones.names)))
+
+
 def nearest_bone_rig(heads, tails, parents, vertices):
     """A rig whose every vertex follows only its nearest bone (distance to the bone segment)."""
     nearest = segment_distances(vertices, np.asarray(heads, np.float64), np.asarray(tails, np.float64)).argmin(axis=1)

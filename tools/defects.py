@@ -131,7 +131,7 @@ def posing_summary(name, vertices, triangles, truth, skeleton, size):
     rigs = {}
     for kind, bones in (("truth", truth), ("rigger", skeleton)):
         obj, _, _ = rigdata.skinned_mesh(name, vertices, triangles, bones)
-        rigs[kind] = pm.SkinnedRig.of(bones.heads, bones.parents, rigdata.vertex_weights(obj, list(bones.names)))
+        rigs[kind] = pm.skinned_rig(obj, bones)
     poses = pm.random_poses(rigs["truth"], POSES, MAX_DEGREES, np.random.default_rng(SEED))
     targets = [pm.deformed(rigs["truth"], pose, vertices) for pose in poses]
     errors = {}

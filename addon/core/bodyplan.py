@@ -30,7 +30,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .body import AXES, BodyTuning, read_body, spreads_across
-from .facing import toes_way
+from .facing import role_bones, toes_way
 from .polyline import arc_lengths, length, nearest_on_segments
 from .roles import RoleTuning, assign_roles, joint_places, twin_paths
 from .stages import MirrorPlane
@@ -184,8 +184,7 @@ def _ankles(skeleton, roles, up):
     """Per side, where the leg's foot begins, else its leg's lowest bone end."""
     ankles = []
     for side in ("L", "R"):
-        feet = [bone for bone, role in enumerate(roles) if role.role == "foot" and role.side == side]
-        legs = [bone for bone, role in enumerate(roles) if role.role in ("thigh", "shin") and role.side == side]
+        feet, legs = role_bones(roles, ("foot",), side), role_bones(roles, ("thigh", "shin"), side)
         if feet:
             ankles.append(skeleton.heads[feet[0]])
         elif legs:

@@ -129,9 +129,9 @@ def toes_way(vertices, ankles, up, reach):
     the ``vertices`` within ``reach`` of each across up and no higher than half that above it (a foot runs farther
     ahead of its ankle than its heel behind; the shin above stands over it), summed; None when no vertex lies
     there."""
-    total = np.zeros(3)
+    vertices, total = np.asarray(vertices, dtype=np.float64), np.zeros(3)
     for ankle in ankles:
-        offsets = np.asarray(vertices, dtype=np.float64) - ankle
+        offsets = vertices - ankle
         height = offsets @ up
         across = offsets - height[:, None] * up
         near = (height < 0.5 * reach) & (np.linalg.norm(across, axis=1) <= reach)

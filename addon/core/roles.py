@@ -278,6 +278,7 @@ class TwinPath:
         if self.mirrored:
             self.points = 0.5 * (self.points + body.plane.reflect(body.graph.points[list(twin.main)]))
             self.radius = 0.5 * (self.radius + body.radius[list(twin.main)])
+        self._leg_joints = {}
 
     @cached_property
     def reach(self):
@@ -285,6 +286,13 @@ class TwinPath:
         if not self.mirrored:
             return reach
         return 0.5 * (reach + _reach(self.body, self.body.plane.reflect(self.points), self.twin, self.margin))
+
+    def leg_joints(self, front, kind, tuning):
+        """:func:`_leg_joints` along this path, found once for the roles and the named joints."""
+        key = (front, kind, tuning)
+        if key not in self._leg_joints:
+            self._leg_joints[key] = _leg_joints(self.body, self, arc_lengths(self.points), front, tuning, kind)
+        return self._leg_joints[key]
 
 
 def _paths(limb):
@@ -399,7 +407,7 @@ def _leg(body, limb, path, front, kind, tuning, put):
     knee = ankle
     if ankle - thigh >= 2:
         arc = arc_lengths(points)
-        _, _, knee_arc, ankle_arc, ball_arc = _leg_joints(body, path, arc, front, tuning, kind)
+        _, _, knee_arc, ankle_arc, ball_arc = path.leg_joints(front, kind, tuning)
         if ankle_arc < ball_arc:  # on its toes: the foot from the hock, the toes from the ground
             hock = min(range(thigh + 2, ankle + 1), key=lambda i: abs(arc[i] - ankle_arc))
             toe = ankle if ankle > hock else toe
@@ -862,7 +870,7 @@ def _leg_places(body, path, arc, front, tuning, kind):
     comes down to ``ankle_height``), and the heel."""
     points = path.points
     heights = body.height(points)
-    hip, hip_height, knee, ankle, ball = _leg_joints(body, path, arc, front, tuning, kind)
+    hip, hip_height, knee, ankle, ball = path.leg_joints(front, kind, tuning)
     tip = arc[-1] + path.reach
     toes = ankle < ball
     toe = ball if toes else ankle + tuning.toe_at * (tip - ankle)
