@@ -271,6 +271,22 @@ def test_same_skeleton_when_moved_rotated_or_scaled(default_rig, seed):
         assert chamfer_distance(back, reference.joints()) / size < 0.03
 
 
+@pytest.mark.parametrize("name", ["quadruped", "four_arms", "humanoid_knees"])
+def test_every_bone_keeps_its_name_when_the_mesh_is_scaled_or_moved(default_rig, name):
+    """The same mesh a hundred times bigger or moved rigs to the same bones, and each keeps its name: limbs are
+    numbered by where they lie, not in the order the triangulation met them (which a scale or a move reshuffles:
+    legs that were ``limb01`` became ``limb02``, so a saved pose or an animation on them fell on other bones)."""
+    vertices, triangles, reference = default_rig(name)
+    size = np.ptp(vertices, axis=0).max()
+    for scale, shift in ((100.0, 0.0), (1.0, np.array([3.3, -1.7, 0.9]) * size)):
+        skeleton = rigger.rig_mesh(vertices * scale + shift, triangles)
+        assert sorted(skeleton.names) == sorted(reference.names)
+        for bone, head, tail in zip(skeleton.names, skeleton.heads, skeleton.tails):
+            k = reference.names.index(bone)
+            assert np.linalg.norm((head - shift) / scale - reference.heads[k]) < 1e-6 * size, bone
+            assert np.linalg.norm((tail - shift) / scale - reference.tails[k]) < 1e-6 * size, bone
+
+
 @pytest.mark.parametrize("scale", [1e-300, 1e300])
 def test_same_skeleton_at_the_ends_of_floating_point_range(default_rig, scale):
     """Rigged at unit size (an exact power of two away), a model 1e-300 or 1e300 big rigs as at its own size; it

@@ -1,9 +1,12 @@
 """Bone names from chains: ``trunk.00``, ``limb03.01``, with ``.L`` / ``.R`` across a mirror plane."""
+import numpy as np
+
 from .mirror import mirror_chain_pairs
 
 
 def bone_names(chain_of_bone, index_in_chain, lines, symmetry=None):
-    """Names by chain and place in it: ``trunk.00``, ``limb03.01`` …, chains numbered in order from 1.
+    """Names by chain and place in it: ``trunk.00``, ``limb03.01`` …, limbs numbered from 1 by where they lie
+    (``_placed``), not by the order the method found them, so a mesh scaled, moved or renumbered keeps its names.
 
     With a ``symmetry``, every bone of a chain off the plane (on average; for a chain with a mirror twin, at its
     tip) gets ``.L`` on the side of the plane's positive axis (Blender's convention for a character's left) or
@@ -19,7 +22,11 @@ def bone_names(chain_of_bone, index_in_chain, lines, symmetry=None):
             paired |= {i, j}
         for c, line in enumerate(lines):
             suffix[c] = {1: ".L", -1: ".R", 0: ""}[symmetry.side(line, by_tip=c in paired)]
-    number = {value: k for k, value in enumerate(sorted(set(label)))}  # the trunk (chain 0) keeps 0
+    places = {}  # label -> its chains' places: twins share a label, and the trunk's (chain 0's) keeps number 0
+    for c, line in enumerate(lines):
+        places.setdefault(label[c], []).append(_placed(line, lines[0][0]))
+    ranked = sorted(places, key=lambda value: (value != 0, min(places[value])))
+    number = {value: k for k, value in enumerate(ranked)}
     base = ["trunk" if number[label[c]] == 0 else f"limb{number[label[c]]:02d}" for c in range(len(lines))]
     names = [f"{base[c]}.{k:02d}{suffix[c]}" for c, k in zip(chain_of_bone, index_in_chain)]
     seen = {}
@@ -28,3 +35,12 @@ def bone_names(chain_of_bone, index_in_chain, lines, symmetry=None):
             names[i] = f"{name}.{i:03d}"
         seen[name] = i
     return names
+
+
+def _placed(line, root):
+    """A chain's place for numbering: how far from the ``root`` (the trunk's start) it starts, then ends; ties (a
+    chain and its unpaired mirror image) by its start's, then its end's, coordinates, larger first (``.L`` before
+    ``.R``). Distances stay in order however the mesh is scaled, moved or its vertices numbered."""
+    start, end = line[0], line[-1]
+    return (float(np.linalg.norm(start - root)), float(np.linalg.norm(end - root)), *(-start).tolist(),
+            *(-end).tolist())
