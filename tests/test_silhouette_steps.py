@@ -779,6 +779,24 @@ def test_mirror_planes_are_found_alike_at_any_tolerance():
         assert symmetric_planes(moved, column_bounds(moved), tolerance, TUNING) == []
 
 
+def test_a_mirror_plane_holds_or_not_wherever_the_mesh_lies():
+    """Whether a vertex has a mirror image is decided on exact distances, ``plane_reach`` tolerances: half a cloud's
+    images moved 0.9 of that off still fit, 1.1 of it off do not, however far the cloud is moved. Hashed to a grid
+    alone, the answer hung on where the cells fell: rignet_8184 moved a fifth of its height lost its plane."""
+    rng = np.random.default_rng(4)
+    half = rng.uniform([0.25, 0.0, 0.0], [1.0, 1.0, 0.6], (600, 3))
+    away = rng.normal(size=half.shape) * [0, 1, 1]  # across the plane's normal: the box and its centre stay
+    away /= np.linalg.norm(away, axis=1, keepdims=True)
+    tolerance, reach = 0.02, TUNING.plane_reach * 0.02
+    for share, fits in ((0.9, True), (1.1, False)):
+        images = half * [-1, 1, 1] + [0.5, 0, 0]
+        images[::2] += share * reach * away[::2]  # every other point: half the images
+        for shift in rng.uniform(-1.0, 1.0, (8, 3)):
+            cloud = np.vstack([half, images]) + shift
+            planes = symmetric_planes(cloud, column_bounds(cloud), tolerance, TUNING)
+            assert [axis for axis, _, _ in planes] == ([0] if fits else []), (share, shift)
+
+
 def test_the_mirror_plane_reflects_a_front_view_onto_itself_and_a_side_view_not_at_all():
     """Two boxes mirrored across x = 2, joined by a bar: seen along Y or -Z every outline point reflects onto the
     outline; seen along X, across the plane, there is no reflection in the view, nor without a plane."""

@@ -12,8 +12,11 @@ from .tuning import TuningTable, tuned
 class MirrorTuning(TuningTable):
     """The tuned numbers of mirror symmetry (shares of the mesh size, or of the twin tolerance)."""
 
-    plane_match: float = tuned(0.01, "a vertex with a mirror image within this share of the size is symmetric")
+    plane_match: float = tuned(0.01, "the mirror tolerance, a share of the size: a vertex whose image lies near a "
+                                     "vertex (``plane_reach``) is symmetric")
     plane_samples: int = tuned(600, "vertices tested for a mirror image (at most)")
+    plane_reach: float = tuned(1.75, "a vertex has a mirror image when its image lies within this many tolerances "
+                                     "of a vertex")
     plane_share: float = tuned(0.95, "a plane holds when this share of the vertices tested has a mirror image (loose "
                                      "bits and seams aside)")
     twin_tolerance: float = tuned(0.05, "the twin tolerance, a share of the size: how closely twin chains mirror")
@@ -118,34 +121,80 @@ def mirrored(points, plane):
 def mirror_plane(vertices, bounds, tolerance, tuning):
     """The axis (0, 1, 2) and offset of a plane the ``vertices`` are mirror-symmetric about, or None: of the
     ``symmetric_planes`` within ``tolerance``, the one most vertices fit."""
-    planes = symmetric_planes(vertices, bounds, tolerance, tuning)
+    planes = symmetric_planes(vertices, bounds, tolerance, tuning, shares=True)
     return max(planes, key=lambda plane: plane[2])[:2] if planes else None
 
 
-def symmetric_planes(vertices, bounds, tolerance, tuning):
-    """(axis, offset, share) of each plane the ``vertices`` are mirror-symmetric about within ``tolerance``.
+def symmetric_planes(vertices, bounds, tolerance, tuning, shares=False):
+    """(axis, offset, share) of each plane the ``vertices`` are mirror-symmetric about within ``tolerance``, by axis
+    (``_fitting_planes``); the share of vertices that fit is exact with ``shares`` (to rank planes), else it may be
+    less where that decides nothing."""
+    return sorted(_fitting_planes(vertices, bounds, tolerance, tuning, shares))
+
+
+def mirrors_about_an_axis_plane(vertices, bounds, tolerance, tuning):
+    """Whether the ``vertices`` are mirror-symmetric about an axis plane within ``tolerance``: the likeliest plane
+    first, and no more once one holds."""
+    return next(_fitting_planes(vertices, bounds, tolerance, tuning, False), None) is not None
+
+
+def _fitting_planes(vertices, bounds, tolerance, tuning, shares):
+    """The planes ``symmetric_planes`` finds, the one most vertices surely fit first, each found when asked for.
 
     Tries the planes through the centre of ``bounds`` (their (2, 3) bounding box) perpendicular to X, Y and Z where
     the box is more than two ``tolerance`` deep (across a flat mesh's own plane nothing has a side); a plane fits
-    when a ``plane_share`` of (up to ``plane_samples``) vertices have a mirror image among the vertices within
-    ``tolerance``: vertices are hashed to a grid of that size and the mirrored ones looked up in it (``_CellSet``),
-    with their 26 neighbour cells.
+    when a ``plane_share`` of (up to ``plane_samples``) vertices have a mirror image within ``plane_reach``
+    tolerances of a vertex, by exact distances, so the answer does not hang on where grid cells fall: a mesh moved
+    keeps its plane. Vertices are hashed to a grid of cells whose diagonal is that reach: an image in a cell holding
+    a vertex has one, an image with no vertex in the cells within reach has none, and only the images in between are
+    measured (against a share of a dense mesh's vertices, ``_in_looked_cells``), where that decides or ranks.
     """
     low, high = bounds
-    origin = low - 2 * tolerance
-    span = np.floor((high - low) / tolerance).astype(np.int64) + 5
-    occupied = _CellSet(_cell_keys(np.floor((vertices - origin) / tolerance).astype(np.int64), span), span)
-    step = max(1, len(vertices) // tuning.plane_samples)
-    probe = vertices[::step]
-    planes = []
+    reach = tuning.plane_reach * tolerance
+    cell = reach / np.sqrt(3.0)
+    origin = low - 3 * cell
+    span = np.floor((high - low) / cell).astype(np.int64) + 7
+    keys = _cell_keys(np.floor((vertices - origin) / cell).astype(np.int64), span)
+    occupied = _CellSet(keys, span)
+    probe = vertices[::max(1, len(vertices) // tuning.plane_samples)]
+    least = tuning.plane_share * len(probe)
+    tried = []
     for axis in np.flatnonzero(high - low > 2 * tolerance):
         centre = 0.5 * (low[axis] + high[axis])
-        cells = np.floor((mirrored(probe, (axis, centre)) - origin) / tolerance).astype(np.int64)
-        around = np.clip(cells[:, None, :] + _NEIGHBOURS[None], 0, span - 1).reshape(-1, 3)
-        score = occupied.holds(_cell_keys(around, span)).reshape(len(probe), -1).any(axis=1).mean()
-        if score >= tuning.plane_share:
-            planes.append((int(axis), centre, score))
-    return planes
+        images = mirrored(probe, (axis, centre))
+        where = (images - origin) / cell  # in cells
+        # an image off the grid is put in an empty cell at its edge: in doubt at most, and measured
+        cells = np.minimum(np.maximum(np.floor(where).astype(np.int64), 2), span - 3)
+        found = occupied.holds(_cell_keys(cells, span))  # a vertex in its own cell lies within reach
+        rest = np.flatnonzero(~found)
+        block = cells[rest][:, None, :] + _WITHIN_TWO[None]  # the cells a point of which may lie within reach
+        owner, which = np.nonzero(occupied.holds(_cell_keys(block.reshape(-1, 3), span)).reshape(block.shape[:2]))
+        if found.sum() + len(np.unique(owner)) >= least:
+            tried.append((-found.sum(), int(axis), centre, found, images[rest], where[rest], block[owner, which],
+                          owner, rest))
+    for _, axis, centre, found, images, where, block, owner, rest in sorted(tried, key=lambda each: each[:2]):
+        if len(owner) and (shares or found.sum() < least):
+            gaps = np.maximum(np.maximum(block - where[owner], where[owner] - block - 1), 0.0)
+            within = (gaps ** 2).sum(axis=1) <= 3.0  # cells with a point within reach: a diagonal, 3 squared cells
+            looked, owner = _cell_keys(block[within], span), owner[within]
+            near, near_keys = _in_looked_cells(vertices, keys, looked, span, PLANE_CROWD)
+            at, owner = _in_cells(near_keys, looked, owner)
+            close = ((near[at] - images[owner]) ** 2).sum(axis=1) <= reach * reach
+            found = found.copy()
+            found[rest[owner[close]]] = True
+        if found.sum() >= least:
+            yield axis, centre, float(found.mean())
+
+
+def _in_cells(keys, looked, owner):
+    """(at, owner): the index into ``keys`` (cell keys of points) of every point in a cell of ``looked`` (cell keys),
+    in the order of the cells, and the ``owner`` (one per cell of ``looked``) of the cell it is in."""
+    order = np.argsort(keys, kind="stable")
+    ordered = keys[order]
+    starts = np.searchsorted(ordered, looked)
+    counts = np.searchsorted(ordered, looked, side="right") - starts
+    at = np.repeat(starts - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
+    return order[at], np.repeat(owner, counts)
 
 
 def sided_symmetry(vertices, bounds, size, lines, tuning):
@@ -196,6 +245,7 @@ def best_offset(vertices, plane, size, tuning):
 
 CROWD = 16  # vertices per grid cell, about, that _least_median compares with (a dense mesh's cells hold more)
 CROWD_SAMPLE = 20_000  # nearby vertices sampled to count the cells they occupy
+PLANE_CROWD = 4  # as many, about, that symmetric_planes measures an image against: one near is all it needs
 
 
 def _least_median(offsets, probe, vertices, axis, cap):
@@ -223,21 +273,8 @@ def _least_median(offsets, probe, vertices, axis, cap):
     looked = _cell_keys(np.clip((images[:, None, :] + around[None]).reshape(-1, 3), 0, span - 1), span)
 
     keys = _cell_keys(np.floor((vertices - origin) / cap).astype(np.int64), span)
-    near = _CellSet(looked, span).holds(keys)
-    vertices, keys = vertices[near], keys[near]
-    step = max(1, len(keys) // CROWD_SAMPLE)
-    crowd = len(keys) / _occupied(len(np.unique(keys[::step])), len(keys), 1.0 / step)
-    if crowd > CROWD:
-        index = np.flatnonzero(near).astype(np.uint64)
-        keep = (index * np.uint64(2654435761)) % np.uint64(1 << 32) < np.uint64(CROWD / crowd * (1 << 32))
-        vertices, keys = vertices[keep], keys[keep]
-    order = np.argsort(keys)  # the nearest of a cell's vertices is the same in any order
-    vertices, keys = vertices[order], keys[order]
-
-    starts, ends = np.searchsorted(keys, looked), np.searchsorted(keys, looked, side="right")
-    counts = ends - starts
-    at = np.repeat(starts - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
-    owner = np.repeat(np.arange(len(probe)), counts.reshape(len(probe), -1).sum(axis=1))
+    vertices, keys = _in_looked_cells(vertices, keys, looked, span)
+    at, owner = _in_cells(keys, looked, np.repeat(np.arange(len(probe)), len(around)))
     across = np.delete(np.arange(3), axis)
     squares = ((vertices[at][:, across] - probe[owner][:, across]) ** 2).sum(axis=1)
     sums = vertices[at, axis] + probe[owner, axis]  # a vertex lies sums - 2 * offset along the axis from an image
@@ -251,6 +288,22 @@ def _least_median(offsets, probe, vertices, axis, cap):
     medians = np.median(np.sqrt(nearest), axis=0)
     best = int(np.lexsort((np.abs(offsets - 0.5 * (low + high)), medians))[0])  # of equals, the middlemost
     return offsets[best], float(medians[best])
+
+
+def _in_looked_cells(vertices, keys, looked, span, crowd_most=None):
+    """The ``vertices`` (and their cell ``keys``) in the ``looked`` cells of a grid ``span`` cells wide; where those
+    cells hold more than ``crowd_most`` (default ``CROWD``) on average, an even share of them, picked by a hash of
+    their index (not of where they lie), stands for the rest, so the work is bounded on a dense mesh."""
+    crowd_most = CROWD if crowd_most is None else crowd_most
+    near = _CellSet(looked, span).holds(keys)
+    vertices, keys = vertices[near], keys[near]
+    step = max(1, len(keys) // CROWD_SAMPLE)
+    crowd = len(keys) / _occupied(len(np.unique(keys[::step])), len(keys), 1.0 / step)
+    if crowd > crowd_most:
+        index = np.flatnonzero(near).astype(np.uint64)
+        keep = (index * np.uint64(2654435761)) % np.uint64(1 << 32) < np.uint64(crowd_most / crowd * (1 << 32))
+        vertices, keys = vertices[keep], keys[keep]
+    return vertices, keys
 
 
 def _occupied(hit, count, share):
@@ -267,6 +320,8 @@ def _occupied(hit, count, share):
 
 
 _NEIGHBOURS = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)])
+# the cells a point of which may lie within a cell's diagonal of a point in the middle one (three away never do)
+_WITHIN_TWO = np.array([(dx, dy, dz) for dx in range(-2, 3) for dy in range(-2, 3) for dz in range(-2, 3)])
 
 
 def _cell_keys(cells, span):
@@ -378,7 +433,7 @@ def square_turn(mesh, tuning=MirrorTuning()):
     axis, its up kept."""
     tolerance = tuning.rough_match * mesh.scale
     vertices = mesh.used_vertices[::max(1, len(mesh.used_vertices) // tuning.square_sample)]
-    if symmetric_planes(vertices, mesh.bbox, tolerance, tuning):
+    if mirrors_about_an_axis_plane(vertices, mesh.bbox, tolerance, tuning):
         return None
     probe = vertices[::max(1, len(vertices) // (2 * tuning.square_probes))]
     pool = vertices[::max(1, len(vertices) // tuning.square_exact_pool)]
@@ -390,7 +445,8 @@ def square_turn(mesh, tuning=MirrorTuning()):
             continue  # square already: the axis planes were tried
         rotation = _turned_onto(normal, np.sign(normal[axis]) * np.eye(3)[axis])
         turned = vertices @ rotation.T
-        if not symmetric_planes(turned, np.stack([turned.min(axis=0), turned.max(axis=0)]), tolerance, tuning):
+        if not mirrors_about_an_axis_plane(turned, np.stack([turned.min(axis=0), turned.max(axis=0)]), tolerance,
+                                           tuning):
             continue  # squaring one principal axis squares the others: the plane found may be another's
         misfit = _refitted(probe, pool, normal, centre, tolerance)[3]
         if misfit < least:  # of planes that hold, the one the mesh mirrors about most closely
