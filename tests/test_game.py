@@ -112,6 +112,24 @@ def test_numbered_twins_are_numbered_alike_on_both_sides():
         assert parent["Right" + left[4:]] == "Right" + parent[left][4:]
 
 
+def test_a_mesh_scaled_or_moved_keeps_its_game_names_on_the_same_bones():
+    """The four-armed sample's second arms are ``Extra`` chains numbered ``_2``, ``_3``: numbered in the order the
+    skeleton's bones came in, which a scale or a move reshuffled, so ``LeftExtra1`` went from one arm to the other.
+    The bones now come in the order of their names, and chains of one name are numbered by where they lie."""
+    vertices, triangles = load_character("four_arms")
+    size = float(np.ptp(vertices, axis=0).max())
+    reference = game_skeleton(rigger.rig_mesh(vertices, triangles), vertices).skeleton
+    assert any("Extra" in name for name in reference.names)
+    for scale, shift in ((3.0, 0.0), (1.0, np.array([3.3, -1.7, 0.9]) * size)):
+        moved = vertices * scale + shift
+        bones = game_skeleton(rigger.rig_mesh(moved, triangles), moved).skeleton
+        assert sorted(bones.names) == sorted(reference.names)
+        for name, head, tail in zip(bones.names, bones.heads, bones.tails):
+            k = reference.names.index(name)
+            assert np.linalg.norm((head - shift) / scale - reference.heads[k]) < 1e-6 * size, name
+            assert np.linalg.norm((tail - shift) / scale - reference.tails[k]) < 1e-6 * size, name
+
+
 @pytest.mark.parametrize("degrees", [90, 180])
 def test_a_figure_whose_skeleton_has_no_feet_keeps_its_own_left_however_it_is_turned(degrees):
     """rignet_smith's stubby feet get no foot bones, so which way he faces came from Blender's convention, ``.L`` on

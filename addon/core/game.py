@@ -117,7 +117,7 @@ def game_skeleton(skeleton, vertices):
     for chain in chains:
         if chain is not trunk:
             bones.chain(chain)
-    bones.name_instances(up, skeleton.stages.get("mirror_plane"), TWIN_TOLERANCE * size)
+    bones.name_instances(up, size, skeleton.stages.get("mirror_plane"))
     bones.at_named_joints(MERGE_TOLERANCE * size)
     names, heads, tails, parents, roles = bones.finished(arriving)
     faced = facing(skeleton)
@@ -397,13 +397,15 @@ class _Bones:
                       chain.nodes[0] if number == 1 else None, id(chain), chain.edges[low:high],
                       chain.nodes[low + 1:high + 1], hang if number == 1 else None)
 
-    def name_instances(self, up, plane=None, tolerance=0.0):
+    def name_instances(self, up, size, plane=None):
         """``_2``, ``_3`` after the names that several chains share: ordered by the number of the bone each hangs
         from (a forearm on ``LeftArm_2`` is ``LeftForeArm_2``), then the chains going on from that bone's end before
-        those branching off it on the way, then from the highest start. Names are numbered from the hips outwards,
-        so a chain's parent is numbered before it. With a mirror ``plane``, a right chain whose ends lie within
-        ``tolerance`` of a left chain's mirror image then takes that chain's number (a rock monster's claws and
-        elbow spikes, numbered alike on both sides whatever order the skeleton met them in)."""
+        those branching off it on the way, then from the highest start, then to the highest end (heights within a
+        billionth of the ``size`` alike), then by where that end lies: by where the chains are, not by the order
+        the skeleton met them in, so a mesh scaled or moved keeps its numbers. Names are numbered from the hips
+        outwards, so a chain's parent is numbered before it. With a mirror ``plane``, a right chain whose ends lie
+        within ``TWIN_TOLERANCE`` of a left chain's mirror image then takes that chain's number (a rock monster's
+        claws and elbow spikes, numbered alike on both sides)."""
         first_of_chain, last_of_chain = {}, {}
         for index, bone in enumerate(self.bones):
             first_of_chain.setdefault(bone["chain"], index)
@@ -425,10 +427,12 @@ class _Bones:
             return owner is not None and self.bones[owner]["chain"] != chain and \
                 not np.allclose(first["head"], self.bones[owner]["tail"])
 
+        def placed(chain):
+            start, end = self.bones[first_of_chain[chain]]["head"], self.bones[last_of_chain[chain]]["tail"]
+            return (-round(float(start @ up) / size, 9), -round(float(end @ up) / size, 9), *(-end).tolist())
+
         for chains in by_name.values():
-            chains.sort(key=lambda chain: (parent_number(chain), branching(chain),
-                                           -round(float(self.bones[first_of_chain[chain]]["head"] @ up), 9),
-                                           first_of_chain[chain]))
+            chains.sort(key=lambda chain: (parent_number(chain), branching(chain), *placed(chain)))
             for count, chain in enumerate(chains[1:], start=2):
                 self._suffixed(chain, f"_{count}")
         if plane is None:
@@ -443,7 +447,7 @@ class _Bones:
                            for k, right in enumerate(rights) for left in lefts)
             twin = {}
             for gap, k, left in pairs:
-                if gap <= tolerance and k not in twin and left not in twin.values():
+                if gap <= TWIN_TOLERANCE * size and k not in twin and left not in twin.values():
                     twin[k] = left
             if not twin:
                 continue

@@ -44,3 +44,22 @@ def _placed(line, root):
     start, end = line[0], line[-1]
     return (float(np.linalg.norm(start - root)), float(np.linalg.norm(end - root)), *(-start).tolist(),
             *(-end).tolist())
+
+
+def in_name_order(names, heads, tails, parents):
+    """The bones (``names`` and their (B, 3) ``heads``, ``tails`` and ``parents``) reordered depth first from the
+    roots, a bone's children (and the roots) in the order of their names: an order given by the names, so by where
+    the bones are, not by the order a method found them in. Returns (names, heads, tails, parents)."""
+    children = {}
+    for bone, parent in enumerate(parents):
+        children.setdefault(int(parent), []).append(bone)
+    order, stack = [], sorted(children.get(-1, []), key=names.__getitem__, reverse=True)
+    while stack:
+        bone = stack.pop()
+        order.append(bone)
+        stack.extend(sorted(children.get(bone, []), key=names.__getitem__, reverse=True))
+    place = np.empty(len(order), dtype=np.int64)
+    place[order] = np.arange(len(order))
+    parents = np.asarray(parents, dtype=np.int64)[order]
+    return ([names[bone] for bone in order], np.asarray(heads)[order], np.asarray(tails)[order],
+            np.where(parents >= 0, place[np.maximum(parents, 0)], -1))

@@ -11,6 +11,7 @@ import numpy as np
 
 from ... import silhouette
 from ...core.mirror import sided_symmetry
+from ...core.naming import in_name_order
 from ...core.params import Param
 from ...core.registry import RigMethod
 from ...core.skeleton import Skeleton
@@ -121,8 +122,7 @@ class SilhouetteMethod(RigMethod):
                 builder = _bones(sil, islands, hidden, rules, sides)
         clock.lap("depth_bones")
 
-        heads, tails, parents = builder.arrays()
-        names = builder.names()
+        names, heads, tails, parents = in_name_order(builder.names(), *builder.arrays())
         clock.lap("names")
 
         view_frame_stage = Frame(sil.origin, sil.u, sil.v, sil.direction,
