@@ -1,4 +1,4 @@
-"""Bone names from chains: ``trunk.00``, ``limb03.01``, with ``.L`` / ``.R`` across a mirror plane."""
+"""Bone names from chains (``trunk.00``, ``limb03.01``, ``.L`` / ``.R`` across a mirror plane) and an order by them."""
 import numpy as np
 
 from .mirror import mirror_chain_pairs
