@@ -6,9 +6,11 @@ and a decision near its threshold (a branch's reach against ``prune``) may go th
 turned back) in its file's own frame, in four frames turned from it (a quarter turn about X, about Y and about Z,
 a half turn about Z), and as Blender's OBJ importer reads it (``bodyplan.MODELS``' up: a Y-up file turned so that
 Z is up); and with its vertices turned 7° and 30° about its up axis (``bodyplan.MODELS``' up), no axes given, as a
-mesh saved turned reaches Rigger (``rig_mesh`` rigs it square to its mirror plane), the skeleton turned back. Each
-skeleton is scored in the file's frame as the quality benchmark scores it (CD-J2J against the artist's joints, in
-its normalised units) and with the posing benchmark's limb recall, and its body plan compared with the file frame's.
+mesh saved turned reaches Rigger (``rig_mesh`` rigs it square to its mirror plane), the skeleton turned back; and
+scaled a hundredfold and moved by a third of its size (``MOVES``), which should change nothing at all. Each skeleton
+is scored in the file's frame as the quality benchmark scores it (CD-J2J against the artist's joints, in its
+normalised units) and with the posing benchmark's limb recall, and its body plan and bones compared with the file
+frame's: the same bones are the same names in the same order, each within ``SAME_PLACE`` of the size of its place.
 
     .venv/bin/python bench/frames.py [--models NAME ...] [--out DIR]
 
@@ -38,6 +40,8 @@ TURNS = {"file": np.eye(3),
          "Z 180°": np.array([[-1.0, 0, 0], [0, -1, 0], [0, 0, 1]])}
 BLENDER = "Blender"  # the frame Blender's OBJ importer reads the file in
 BAKED = {"up 7° baked": 7.0, "up 30° baked": 30.0}  # vertices turned about the model's up by so many degrees
+MOVES = {"×100": (100.0, (0.0, 0.0, 0.0)), "moved": (1.0, (0.37, -0.21, 0.11))}  # scale; shift in sizes
+SAME_PLACE = 1e-3  # bone ends this close (a share of the size) are in the same place
 
 
 def frames_of(name):
@@ -56,22 +60,31 @@ def baked_turn(name, degrees):
 
 
 def measure(folder):
-    """{frame: (CD-J2J, limb recall, bones, body plan)} of one model."""
+    """{frame: (CD-J2J, limb recall, bones, body plan, whether the bones are the file frame's)} of one model."""
     truth = quality.GroundTruth(folder)
     rig = truth.rig.attached()
     size = float(np.ptp(truth.vertices, axis=0).max())
     triangles = truth.triangles.astype(np.int32)
     result = {}
-    rigs = [(frame, rigger.rig_mesh(truth.vertices, triangles, axes=turn), np.eye(3))
+    rigs = [(frame, rigger.rig_mesh(truth.vertices, triangles, axes=turn), lambda points: points)
             for frame, turn in frames_of(folder.name).items()]
     for frame, degrees in BAKED.items():
         turn = baked_turn(folder.name, degrees)
-        rigs.append((frame, rigger.rig_mesh(truth.vertices @ turn.T, triangles), turn))
-    for frame, skeleton, turn in rigs:
-        heads, tails = skeleton.heads @ turn, skeleton.tails @ turn  # back in the file's frame
+        rigs.append((frame, rigger.rig_mesh(truth.vertices @ turn.T, triangles),
+                     lambda points, turn=turn: points @ turn))
+    for frame, (scale, shift) in MOVES.items():
+        shift = np.asarray(shift) * size
+        rigs.append((frame, rigger.rig_mesh(truth.vertices * scale + shift, triangles),
+                     lambda points, scale=scale, shift=shift: (points - shift) / scale))
+    file_bones = None
+    for frame, skeleton, back in rigs:
+        heads, tails = back(skeleton.heads), back(skeleton.tails)  # in the file's frame
+        file_bones = file_bones or (skeleton.names, heads, tails)
+        same = bool(skeleton.names == file_bones[0] and np.abs(heads - file_bones[1]).max() <= SAME_PLACE * size
+                    and np.abs(tails - file_bones[2]).max() <= SAME_PLACE * size)
         _, scores = quality.scored(truth, rigdata.Bones(heads, tails, np.asarray(skeleton.parents)))
         recall, _ = posing_math.limb_recall(rig.positions, rig.parents, heads, tails, skeleton.parents, size)
-        result[frame] = (float(scores["cd_j2j"]), float(recall), len(skeleton), skeleton.body_plan.kind)
+        result[frame] = (float(scores["cd_j2j"]), float(recall), len(skeleton), skeleton.body_plan.kind, same)
     return result
 
 
@@ -81,6 +94,7 @@ def report(records, run):
              for frame in frames}
     moved = {frame: sum(r[frame][2] != r["file"][2] for r in records.values()) for frame in frames}
     replanned = {frame: sum(r[frame][3] != r["file"][3] for r in records.values()) for frame in frames}
+    other = {frame: sum(not r[frame][4] for r in records.values()) for frame in frames}
     spread = {name: max(v[0] for v in r.values()) - min(v[0] for v in r.values()) for name, r in records.items()}
     load = ", ".join(f"{value:.2f}" for value in run["load"])
     lines = ["# Frames: one mesh read in different frames", "",
@@ -91,16 +105,21 @@ def report(records, run):
              f"`{BLENDER}`: as Blender's OBJ importer reads the file (Y-up files turned, Z-up ones read with "
              "`--up Z`).", "", "## Means by frame", ""]
     lines += markdown_table(["frame", "mean CD-J2J", "mean limb recall", "models whose bone count differs from the "
-                             "file frame's", "models whose body plan differs"],
+                             "file frame's", "models whose body plan differs", "models whose bones (names, order, "
+                             "places) differ"],
                             [[frame, f"{means[frame][0]:.4f}", f"{means[frame][1]:.3f}", moved[frame],
-                              replanned[frame]] for frame in frames])
+                              replanned[frame], other[frame]] for frame in frames])
     turned = [means[frame][0] for frame in TURNS if frame != "file"]
     lines += ["", f"Turned frames: mean CD-J2J {min(turned):.4f} to {max(turned):.4f} against {means['file'][0]:.4f} "
               "in the files' own frames. Per model, the largest CD-J2J minus the smallest over the frames: median "
               f"{np.median(list(spread.values())):.4f}, largest {max(spread.values()):.4f} "
               f"({max(spread, key=spread.get)}). Turns in the vertices: "
               + ", ".join(f"{frame} {means[frame][0]:.4f}, recall {means[frame][1]:.3f}, {replanned[frame]} plans "
-                          "changed" for frame in BAKED) + ".", "", "![CD-J2J per model and frame](frames.png)", "",
+                          "changed" for frame in BAKED) + ". The same bones as in the file frame, "
+              + ", ".join(f"{frame} on {len(records) - other[frame]} of {len(records)}"
+                          + (f" (not {', '.join(n for n, r in records.items() if not r[frame][4])})"
+                             if other[frame] else "") for frame in MOVES) + ".", "",
+              "![CD-J2J per model and frame](frames.png)", "",
               "## Per model", "", "CD-J2J / limb recall / bones per frame.", ""]
     lines += markdown_table(["model", *frames, "CD-J2J spread"],
                             [[name, *(f"{r[frame][0]:.4f} / {r[frame][1]:.2f} / {r[frame][2]}" for frame in frames),
@@ -144,8 +163,9 @@ def main(argv=None):
     records = {}
     for model in folders:
         records[model.name] = measure(model)
-        print(f"{model.name:30s} " + "  ".join(f"{frame} {cd:.4f}/{recall:.2f}/{bones}/{plan}"
-                                               for frame, (cd, recall, bones, plan) in records[model.name].items()),
+        print(f"{model.name:30s} " + "  ".join(f"{frame} {cd:.4f}/{recall:.2f}/{bones}/{plan}{'' if same else '*'}"
+                                               for frame, (cd, recall, bones, plan, same)
+                                               in records[model.name].items()),
               flush=True)
     run["seconds"] = time.perf_counter() - started
     (out / "frames.md").write_text(report(records, run))
