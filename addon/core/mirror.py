@@ -15,6 +15,7 @@ class MirrorTuning(TuningTable):
     plane_match: float = tuned(0.01, "the mirror tolerance, a share of the size: a vertex whose image lies near a "
                                      "vertex (``plane_reach``) is symmetric")
     plane_samples: int = tuned(600, "vertices tested for a mirror image (at most)")
+    plane_pool: int = tuned(10000, "vertices an image in doubt is measured against (at most: every k-th)")
     plane_reach: float = tuned(1.75, "a vertex has a mirror image when its image lies within this many tolerances "
                                      "of a vertex")
     plane_share: float = tuned(0.95, "a plane holds when this share of the vertices tested has a mirror image (loose "
@@ -147,7 +148,7 @@ def _fitting_planes(vertices, bounds, tolerance, tuning, shares):
     tolerances of a vertex, by exact distances, so the answer does not hang on where grid cells fall: a mesh moved
     keeps its plane. Vertices are hashed to a grid of cells whose diagonal is that reach: an image in a cell holding
     a vertex has one, an image with no vertex in the cells within reach has none, and only the images in between are
-    measured (against a share of a dense mesh's vertices, ``_in_looked_cells``), where that decides or ranks.
+    measured (against every k-th vertex, at most ``plane_pool``), where that decides or ranks.
     """
     low, high = bounds
     reach = tuning.plane_reach * tolerance
@@ -157,6 +158,8 @@ def _fitting_planes(vertices, bounds, tolerance, tuning, shares):
     keys = _cell_keys(np.floor((vertices - origin) / cell).astype(np.int64), span)
     occupied = _CellSet(keys, span)
     probe = vertices[::max(1, len(vertices) // tuning.plane_samples)]
+    pool_step = max(1, len(vertices) // tuning.plane_pool)
+    pool_keys = keys[::pool_step]
     least = tuning.plane_share * len(probe)
     tried = []
     for axis in np.flatnonzero(high - low > 2 * tolerance):
@@ -177,9 +180,10 @@ def _fitting_planes(vertices, bounds, tolerance, tuning, shares):
             gaps = np.maximum(np.maximum(block - where[owner], where[owner] - block - 1), 0.0)
             within = (gaps ** 2).sum(axis=1) <= 3.0  # cells with a point within reach: a diagonal, 3 squared cells
             looked, owner = _cell_keys(block[within], span), owner[within]
-            near, near_keys = _in_looked_cells(vertices, keys, looked, span, PLANE_CROWD)
-            at, owner = _in_cells(near_keys, looked, owner)
-            close = ((near[at] - images[owner]) ** 2).sum(axis=1) <= reach * reach
+            near = _CellSet(looked, span).holds(pool_keys)
+            at, owner = _in_cells(pool_keys[near], looked, owner)
+            at = np.flatnonzero(near)[at] * pool_step
+            close = ((vertices[at] - images[owner]) ** 2).sum(axis=1) <= reach * reach
             found = found.copy()
             found[rest[owner[close]]] = True
         if found.sum() >= least:
@@ -245,7 +249,6 @@ def best_offset(vertices, plane, size, tuning):
 
 CROWD = 16  # vertices per grid cell, about, that _least_median compares with (a dense mesh's cells hold more)
 CROWD_SAMPLE = 20_000  # nearby vertices sampled to count the cells they occupy
-PLANE_CROWD = 4  # as many, about, that symmetric_planes measures an image against: one near is all it needs
 
 
 def _least_median(offsets, probe, vertices, axis, cap):
@@ -273,7 +276,14 @@ def _least_median(offsets, probe, vertices, axis, cap):
     looked = _cell_keys(np.clip((images[:, None, :] + around[None]).reshape(-1, 3), 0, span - 1), span)
 
     keys = _cell_keys(np.floor((vertices - origin) / cap).astype(np.int64), span)
-    vertices, keys = _in_looked_cells(vertices, keys, looked, span)
+    near = _CellSet(looked, span).holds(keys)
+    vertices, keys = vertices[near], keys[near]
+    step = max(1, len(keys) // CROWD_SAMPLE)
+    crowd = len(keys) / _occupied(len(np.unique(keys[::step])), len(keys), 1.0 / step)
+    if crowd > CROWD:
+        index = np.flatnonzero(near).astype(np.uint64)
+        keep = (index * np.uint64(2654435761)) % np.uint64(1 << 32) < np.uint64(CROWD / crowd * (1 << 32))
+        vertices, keys = vertices[keep], keys[keep]
     at, owner = _in_cells(keys, looked, np.repeat(np.arange(len(probe)), len(around)))
     across = np.delete(np.arange(3), axis)
     squares = ((vertices[at][:, across] - probe[owner][:, across]) ** 2).sum(axis=1)
@@ -288,22 +298,6 @@ def _least_median(offsets, probe, vertices, axis, cap):
     medians = np.median(np.sqrt(nearest), axis=0)
     best = int(np.lexsort((np.abs(offsets - 0.5 * (low + high)), medians))[0])  # of equals, the middlemost
     return offsets[best], float(medians[best])
-
-
-def _in_looked_cells(vertices, keys, looked, span, crowd_most=None):
-    """The ``vertices`` (and their cell ``keys``) in the ``looked`` cells of a grid ``span`` cells wide; where those
-    cells hold more than ``crowd_most`` (default ``CROWD``) on average, an even share of them, picked by a hash of
-    their index (not of where they lie), stands for the rest, so the work is bounded on a dense mesh."""
-    crowd_most = CROWD if crowd_most is None else crowd_most
-    near = _CellSet(looked, span).holds(keys)
-    vertices, keys = vertices[near], keys[near]
-    step = max(1, len(keys) // CROWD_SAMPLE)
-    crowd = len(keys) / _occupied(len(np.unique(keys[::step])), len(keys), 1.0 / step)
-    if crowd > crowd_most:
-        index = np.flatnonzero(near).astype(np.uint64)
-        keep = (index * np.uint64(2654435761)) % np.uint64(1 << 32) < np.uint64(crowd_most / crowd * (1 << 32))
-        vertices, keys = vertices[keep], keys[keep]
-    return vertices, keys
 
 
 def _occupied(hit, count, share):
