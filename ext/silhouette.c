@@ -2145,6 +2145,7 @@ int sil_seal(const double *vertices, int64_t n, const int32_t *tris, int64_t m, 
     *moved = 0;
     memcpy(out, vertices, (size_t)(3 * n) * sizeof(double));
     int32_t *weld = NULL, *part = NULL, *cluster = NULL;
+    double *box = NULL;
     uint8_t *boundary = NULL;
     int rc = SIL_OK;
     if (m == 0 || one_piece(n, tris, m, &rc)) return rc;
@@ -2171,17 +2172,38 @@ int sil_seal(const double *vertices, int64_t n, const int32_t *tris, int64_t m, 
     for (int64_t i = 0; i < n; i++) cluster[i] = (int32_t)i;
     if (!(extent > 0.0)) goto done;
     if ((rc = cluster_seams(vertices, n, boundary, part, SIL_SEAM_GAP * extent, cluster)) != SIL_OK) goto done;
+    box = alloc_array(6 * n, sizeof(double)); /* per cluster root: the low and high corners of its members' box */
+    if (!box) {
+        rc = SIL_ERR_NOMEM;
+        goto done;
+    }
+    for (int64_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            box[6 * i + c] = INFINITY;
+            box[6 * i + 3 + c] = -INFINITY;
+        }
     for (int64_t i = 0; i < n; i++) {
-        int32_t root = find_root(cluster, weld[i]);
-        if (root == weld[i]) continue;
-        memcpy(out + 3 * i, vertices + 3 * (int64_t)root, 3 * sizeof(double));
-        (*moved)++;
+        double *corners = box + 6 * (int64_t)find_root(cluster, weld[i]);
+        for (int c = 0; c < 3; c++) {
+            corners[c] = fmin(corners[c], vertices[3 * i + c]);
+            corners[3 + c] = fmax(corners[3 + c], vertices[3 * i + c]);
+        }
+    }
+    for (int64_t i = 0; i < n; i++) {
+        const double *corners = box + 6 * (int64_t)find_root(cluster, weld[i]);
+        int same = 1;
+        for (int c = 0; c < 3; c++) {
+            out[3 * i + c] = 0.5 * (corners[c] + corners[3 + c]);
+            same = same && out[3 * i + c] == vertices[3 * i + c];
+        }
+        if (!same) (*moved)++;
     }
 done:
     free(weld);
     free(part);
     free(boundary);
     free(cluster);
+    free(box);
     return rc;
 }
 

@@ -78,7 +78,8 @@ int sil_share_components(SilTrace *trace, SilTrace *source);
 /* Close the seams of a mesh built of pieces that abut without sharing vertices: copy the n vertices to `out` (3n
  * doubles), then move every boundary vertex (of an edge one triangle alone uses) that lies within SIL_SEAM_GAP of a
  * boundary vertex of another part (parts: connected through triangles, vertices at identical positions welded), and
- * the vertices welded to it, onto the lowest-indexed vertex of its cluster. *moved counts the vertices moved. */
+ * the vertices welded to it, onto the middle of its cluster's bounding box (however the vertices are numbered, and
+ * mirror-image seams onto mirror-image points). *moved counts the vertices moved. */
 int sil_seal(const double *vertices, int64_t n, const int32_t *triangles, int64_t m, double *out, int64_t *moved);
 
 #ifdef __cplusplus

@@ -512,6 +512,20 @@ def test_sealed_joins_pieces_that_abut_along_an_open_seam():
             np.testing.assert_allclose(layers, [[bottom, bottom], [top, top]], atol=1e-12)
 
 
+def test_sealed_seams_land_where_they_land_however_the_vertices_are_numbered():
+    """A seam's vertices a hair apart move onto the middle of their cluster, not onto whichever of them comes first:
+    the same mesh with its vertices numbered backwards, or mirrored, seals to the same points (mirrored)."""
+    v, t = box((-1, 0, 0), (1, 1, 1))
+    lid = (v[t][:, :, 2] == 1).all(axis=1)
+    vertices, triangles = combine((v, t[~lid]), (v + [2e-5, 0, 1e-5], t[lid]))
+    sealed = silhouette.sealed(vertices, triangles)
+    backwards = np.arange(len(vertices))[::-1]
+    renumbered = silhouette.sealed(vertices[backwards], np.argsort(backwards)[triangles])
+    np.testing.assert_array_equal(renumbered, sealed[backwards])
+    mirrored = silhouette.sealed(vertices * [-1, 1, 1], triangles[:, ::-1])
+    np.testing.assert_array_equal(mirrored, sealed * [-1, 1, 1])
+
+
 def test_layers_keep_overlapping_pieces_of_one_part_solid():
     """Two closed, consistently wound shells of one part (sharing a vertex) that overlap: where both enclose the ray
     it is inside, by winding, not outside, by parity; turned inside out, the same."""
