@@ -7,10 +7,11 @@ turned back) in its file's own frame, in four frames turned from it (a quarter t
 a half turn about Z), and as Blender's OBJ importer reads it (``bodyplan.MODELS``' up: a Y-up file turned so that
 Z is up); and with its vertices turned 7° and 30° about its up axis (``bodyplan.MODELS``' up), no axes given, as a
 mesh saved turned reaches Rigger (``rig_mesh`` rigs it square to its mirror plane), the skeleton turned back; and
-scaled a hundredfold and moved by a third of its size (``MOVES``), which should change nothing at all. Each skeleton
-is scored in the file's frame as the quality benchmark scores it (CD-J2J against the artist's joints, in its
-normalised units) and with the posing benchmark's limb recall, and its body plan and bones compared with the file
-frame's: the same bones are the same names in the same order, each within ``SAME_PLACE`` of the size of its place.
+scaled a hundredfold, moved by a third of its size (``MOVES``) and with its vertices and triangles renumbered,
+which should change nothing at all. Each skeleton is scored in the file's frame as the quality benchmark scores it
+(CD-J2J against the artist's joints, in its normalised units) and with the posing benchmark's limb recall, and its
+body plan and bones compared with the file frame's: the same bones are the same names in the same order, each
+within ``SAME_PLACE`` of the size of its place.
 
     .venv/bin/python bench/frames.py [--models NAME ...] [--out DIR]
 
@@ -41,6 +42,7 @@ TURNS = {"file": np.eye(3),
 BLENDER = "Blender"  # the frame Blender's OBJ importer reads the file in
 BAKED = {"up 7° baked": 7.0, "up 30° baked": 30.0}  # vertices turned about the model's up by so many degrees
 MOVES = {"×100": (100.0, (0.0, 0.0, 0.0)), "moved": (1.0, (0.37, -0.21, 0.11))}  # scale; shift in sizes
+RENUMBERED = "renumbered"  # the vertices and the triangles in another order (seeded)
 SAME_PLACE = 1e-3  # bone ends this close (a share of the size) are in the same place
 
 
@@ -76,6 +78,10 @@ def measure(folder):
         shift = np.asarray(shift) * size
         rigs.append((frame, rigger.rig_mesh(truth.vertices * scale + shift, triangles),
                      lambda points, scale=scale, shift=shift: (points - shift) / scale))
+    rng = np.random.default_rng(0)
+    order = rng.permutation(len(truth.vertices))
+    renumbered = np.argsort(order)[triangles][rng.permutation(len(triangles))].astype(np.int32)
+    rigs.append((RENUMBERED, rigger.rig_mesh(truth.vertices[order], renumbered), lambda points: points))
     file_bones = None
     for frame, skeleton, back in rigs:
         heads, tails = back(skeleton.heads), back(skeleton.tails)  # in the file's frame
@@ -118,7 +124,7 @@ def report(records, run):
                           "changed" for frame in BAKED) + ". The same bones as in the file frame, "
               + ", ".join(f"{frame} on {len(records) - other[frame]} of {len(records)}"
                           + (f" (not {', '.join(n for n, r in records.items() if not r[frame][4])})"
-                             if other[frame] else "") for frame in MOVES) + ".", "",
+                             if other[frame] else "") for frame in [*MOVES, RENUMBERED]) + ".", "",
               "![CD-J2J per model and frame](frames.png)", "",
               "## Per model", "", "CD-J2J / limb recall / bones per frame.", ""]
     lines += markdown_table(["model", *frames, "CD-J2J spread"],
