@@ -512,7 +512,7 @@ def test_sealed_joins_pieces_that_abut_along_an_open_seam():
             np.testing.assert_allclose(layers, [[bottom, bottom], [top, top]], atol=1e-12)
 
 
-def test_sealed_seams_land_where_they_land_however_the_vertices_are_numbered():
+def test_sealed_seams_are_the_same_however_the_vertices_are_numbered():
     """A seam's vertices a hair apart move onto the middle of their cluster, not onto whichever of them comes first:
     the same mesh with its vertices numbered backwards, or mirrored, seals to the same points (mirrored)."""
     v, t = box((-1, 0, 0), (1, 1, 1))
