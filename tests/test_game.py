@@ -206,13 +206,22 @@ def test_a_cow_s_front_legs_end_in_a_hoof_of_their_own():
 
 
 def test_a_bird_s_one_neck_bone_gets_a_head_after_it():
-    """Turned Z up as Blender imports it, rignet_17872's spine ends in one bone past its chest, a neck, and its game
-    skeleton had no Head: only humanoids' necks were completed. Now every plan's are, on along the neck."""
+    """rignet_17872, a bird, turned Z up as Blender imports it, with its neck cut to the first bone (as the skeleton
+    once had it): its game skeleton had no Head, as only humanoids' necks were completed. Now every plan's are, on
+    along the neck."""
     vertices, triangles, _ = load_ground_truth(shared_path("models", "gt", "rignet_17872"))
     vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])  # Y up to Blender's Z up
-    skeleton = rigger.rig_mesh(vertices, triangles)
-    bones = game_skeleton(skeleton, vertices).skeleton
+    whole = rigger.rig_mesh(vertices, triangles)
+    neck = [bone for bone, role in enumerate(whole.roles) if role.role in ("neck", "head")]
+    kept = [bone for bone in range(len(whole)) if bone not in neck[1:]]  # no bone hangs from the neck's others
+    skeleton = Skeleton([whole.names[bone] for bone in kept], whole.heads[kept], whole.tails[kept],
+                        [kept.index(whole.parents[bone]) if whole.parents[bone] >= 0 else -1 for bone in kept],
+                        whole.stages)
+    skeleton.body_plan, skeleton.roles = recognise(skeleton, (vertices, triangles),
+                                                   plane=whole.stages.get("mirror_plane"))
     assert skeleton.body_plan.kind == "bird"
+    assert [role.role for role in skeleton.roles].count("neck") == 1 and "head" not in {r.role for r in skeleton.roles}
+    bones = game_skeleton(skeleton, vertices).skeleton
     head, neck = bones.names.index("Head"), bones.names.index("Neck")
     assert bones.parents[head] == neck and bones.heads[head] == pytest.approx(bones.tails[neck])
     along = bones.tails[neck] - bones.heads[neck]

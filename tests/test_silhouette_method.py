@@ -491,6 +491,19 @@ def test_limbs_pruned_unlike_on_a_symmetric_model_are_still_twins(model, images)
         assert_side_bones_paired(skeleton, 4)
 
 
+def test_a_fork_one_side_alone_makes_is_mirrored_onto_the_other():
+    """rignet_17872, a bird, turned Z up as Blender imports it: its outline mirrors exactly, but the triangulation
+    forks the left wing and the tuft beside it from a short stem off the middle and the right ones at the middle, so
+    the stem paired with the whole right wing and 21 bones went without a twin. The right side gets the images of the
+    stem and its children, and every ``.L`` bone has its mirror-image ``.R`` twin, as read in the file's frame."""
+    vertices, triangles = load_obj(shared_path("models", "gt", "rignet_17872", "rignet_17872.obj"))
+    vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])  # Y up to Blender's Z up
+    skeleton = rigger.rig_mesh(vertices, triangles)
+    assert skeleton.body_plan.kind == "bird"
+    size = np.ptp(vertices, axis=0).max()
+    assert_mirror_image_pairs(skeleton, 14, 1e-9 * size, heads="all", plane=skeleton.stages["mirror_plane"])
+
+
 @pytest.mark.parametrize("model, hands", [("woody", [(0.02, 0.55), (0.96, 0.57)]),
                                           ("cheburashka", [(0.24, 0.27), (0.72, 0.28)])])
 def test_stubby_arms_of_a_figure_without_a_mirror_plane_get_bones(model, hands):

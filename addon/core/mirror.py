@@ -76,6 +76,16 @@ class Symmetry:
         """``mirrored(points, plane)``."""
         return mirrored(points, self.plane)
 
+    def ends_misfit(self, line, other):
+        """How far the ends of polyline ``other`` lie from the mirror images of ``line``'s ends, summed."""
+        ends = np.array([line[0], line[-1]])
+        return float(np.linalg.norm(self.reflect(ends) - np.array([other[0], other[-1]]), axis=1).sum())
+
+    def whole_twins(self, line, other):
+        """Whether two polylines are whole mirror twins: their ends' ``ends_misfit`` within ``twin_ends``
+        tolerances."""
+        return self.ends_misfit(line, other) <= self.tuning.twin_ends * self.tolerance
+
     def covers(self, gaps):
         """Whether a polyline covers another whose ``covering_fit`` against it is ``gaps``: their starts within
         ``cover_start`` tolerances, the other's tip within ``cover_tip`` of the polyline."""
@@ -352,8 +362,6 @@ def mirror_chain_pairs(lines, symmetry):
     own images; whole twins pair before partial ones, so a stub off a shoulder never takes an arm from its exact
     twin. Chains on the plane are never paired; one that lies on it on average but whose tip is off it (legs from
     the middle of the hips) is on its tip's side."""
-    ends = np.array([[line[0], line[-1]] for line in lines])  # (C, 2, 3)
-    images = symmetry.reflect(ends)
     side = np.array([symmetry.side(line, by_tip=True) for line in lines])
     pairs, taken = [], np.zeros(len(lines), bool)
     for partial in (False, True):
@@ -366,10 +374,8 @@ def mirror_chain_pairs(lines, symmetry):
                 gaps = min((covering_fit(image, lines[j]), covering_fit(lines[j], image)), key=sum)
                 if symmetry.covers(gaps):
                     fits.append((sum(gaps), min(i, j), max(i, j)))
-            else:
-                cost = float(np.linalg.norm(ends[j] - images[i], axis=1).sum())
-                if cost <= symmetry.tuning.twin_ends * symmetry.tolerance:
-                    fits.append((cost, min(i, j), max(i, j)))
+            elif symmetry.whole_twins(lines[i], lines[j]):
+                fits.append((symmetry.ends_misfit(lines[i], lines[j]), min(i, j), max(i, j)))
         for _, i, j in sorted(fits):
             if not taken[i] and not taken[j]:
                 pairs.append((int(i), int(j)))

@@ -38,6 +38,7 @@ class BoneBuilder:
         if self.symmetry is not None:
             placed = self._on_plane_parents(placed)
             if self.exact:
+                placed = self._forks_mirrored(placed)
                 placed = self._twins_together(placed)
                 if sil is not None:
                     placed, from_start = self._stem(root_point, placed, sil)
@@ -94,6 +95,35 @@ class BoneBuilder:
                 start, parent = placed[parent][0][0], placed[parent][1]
             moved[i] = (np.vstack([start, line[1:]]), parent, widths)
         return moved
+
+    def _forks_mirrored(self, placed):
+        """The placed chains with every fork that one side alone has mirrored onto the other: a chain off the plane
+        with no mirror twin (a stem) whose children, run on from its start, each have one among the chains that
+        leave the same place on the other side. The triangulation of a mirror-image outline may fork two limbs a
+        little way out on one side (a bird's wing and the tuft beside it, from a short stem) and at the middle on the
+        other; that side gets the images of the stem and its children in their stead (the mesh mirrors exactly), so
+        both sides carry the same chains and twins are named alike."""
+        lines = [line for line, _, _ in placed]
+        paired = {k for i, j in mirror_chain_pairs(lines, self.symmetry)
+                  if self.symmetry.whole_twins(lines[i], lines[j]) for k in (i, j)}
+        moved, added, taken = list(placed), [], set()
+        for stem, (line, parent, widths) in enumerate(placed):
+            side = self.symmetry.side(line, by_tip=True)
+            children = [k for k, (_, up, _) in enumerate(placed) if up == stem]
+            if side == 0 or stem in paired or len(children) < 2:
+                continue
+            others = [j for j, (other, up, _) in enumerate(placed) if up == parent and j not in taken
+                      and j not in paired and self.symmetry.side(other, by_tip=True) == -side]
+            twins = {k: next((j for j in others if self.symmetry.whole_twins(np.vstack([line, lines[k][1:]]),
+                                                                             lines[j])), None) for k in children}
+            if None in twins.values() or len(set(twins.values())) < len(children):
+                continue
+            image = len(placed) + len(added)
+            added.append((self.symmetry.reflect(line), parent, widths))
+            for k, j in twins.items():
+                moved[j] = (self.symmetry.reflect(lines[k]), image, placed[k][2])
+                taken.add(j)
+        return moved + added
 
     def _twins_together(self, placed):
         """The placed chains with mirror twins that start apart, one of them on the plane, both starting there, from
