@@ -104,16 +104,16 @@ class BoneBuilder:
         other; that side gets the images of the stem and its children in their stead (the mesh mirrors exactly), so
         both sides carry the same chains and twins are named alike."""
         lines = [line for line, _, _ in placed]
+        sides = [self.symmetry.side(line, by_tip=True) for line in lines]
         paired = {k for i, j in mirror_chain_pairs(lines, self.symmetry)
                   if self.symmetry.whole_twins(lines[i], lines[j]) for k in (i, j)}
         moved, added, taken = list(placed), [], set()
         for stem, (line, parent, widths) in enumerate(placed):
-            side = self.symmetry.side(line, by_tip=True)
             children = [k for k, (_, up, _) in enumerate(placed) if up == stem]
-            if side == 0 or stem in paired or len(children) < 2:
+            if sides[stem] == 0 or stem in paired or len(children) < 2:
                 continue
-            others = [j for j, (other, up, _) in enumerate(placed) if up == parent and j not in taken
-                      and j not in paired and self.symmetry.side(other, by_tip=True) == -side]
+            others = [j for j, (_, up, _) in enumerate(placed)
+                      if up == parent and j not in taken and j not in paired and sides[j] == -sides[stem]]
             twins = {k: next((j for j in others if self.symmetry.whole_twins(np.vstack([line, lines[k][1:]]),
                                                                              lines[j])), None) for k in children}
             if None in twins.values() or len(set(twins.values())) < len(children):
